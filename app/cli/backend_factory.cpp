@@ -1,0 +1,28 @@
+// Backend selection for the CLI (CPU only until the CUDA backend is linked in).
+#include "backend_factory.h"
+
+#include <cstdio>
+
+#include "flashgs/error.h"
+
+#ifdef FLASHGS_HAVE_CUDA
+#include "flashgs/cuda_renderer.h"
+#endif
+
+namespace flashgs::cli {
+
+std::unique_ptr<Renderer> create_backend(const std::string& which) {
+#ifdef FLASHGS_HAVE_CUDA
+  if (which == "cuda" || which == "auto") {
+    std::string why;
+    if (cuda_available(&why)) return make_cuda_renderer();
+    if (which == "cuda") throw Error("the CUDA backend is unavailable: " + why);
+    std::fprintf(stderr, "note: no usable CUDA device (%s); rendering on the CPU\n", why.c_str());
+  }
+#else
+  if (which == "cuda") throw Error("this build has no CUDA backend (configure with -DFLASHGS_WITH_CUDA=ON)");
+#endif
+  return make_cpu_renderer();
+}
+
+}  // namespace flashgs::cli

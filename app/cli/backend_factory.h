@@ -1,0 +1,15 @@
+// Creates a rendering backend by name; the CUDA one only when built with CUDA.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "flashgs/renderer.h"
+
+namespace flashgs::cli {
+
+// "cpu", "cuda" (throws flashgs::Error when unavailable) or "auto" (CUDA if a device works).
+// Prints which backend was chosen, and why, to stderr.
+std::unique_ptr<Renderer> create_backend(const std::string& which);
+
+}  // namespace flashgs::cli

@@ -1,0 +1,22 @@
+// `flashgs info`: what a scene file holds and what loading it dropped.
+#include <cstdio>
+
+#include "commands.h"
+#include "flashgs/io.h"
+#include "flashgs/scene_summary.h"
+#include "scene_source.h"
+
+namespace flashgs::cli {
+
+void register_info(CLI::App& app) {
+  auto args = std::make_shared<SceneArgs>();
+  CLI::App* sub = app.add_subcommand("info", "summarise a scene: count, SH degree, bounds, statistics");
+  args->add_to(sub);
+  sub->callback([args] {
+    LoadReport report;
+    const Scene scene = load_ply(args->resolved_scene(), &report);
+    std::printf("%s", summarize_scene(scene, &report).c_str());
+  });
+}
+
+}  // namespace flashgs::cli

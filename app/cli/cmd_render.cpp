@@ -1,0 +1,53 @@
+// `flashgs render`: one frame of a scene to an image file, with its statistics.
+#include <cstdio>
+
+#include "commands.h"
+#include "flashgs/image_io.h"
+#include "flashgs/io.h"
+#include "scene_source.h"
+#include "stats_format.h"
+
+namespace flashgs::cli {
+namespace {
+
+struct RenderCommand {
+  SceneArgs scene;
+  CameraArgs camera;
+  RenderArgs render;
+  std::string output = "render.png";
+  int repeat = 1;
+
+  void run() const {
+    const std::string scene_path = scene.resolved_scene();
+    auto loaded = load_scene_verbose(scene_path);
+    const Camera cam = camera.select(load_cameras(scene.resolved_cameras()));
+    auto renderer = make_backend(render.backend);
+    renderer->set_scene(loaded);
+    const RenderOptions options = render.options();
+    Image image;
+    FrameStats stats;
+    for (int i = 0; i < repeat; ++i) renderer->render(cam, options, image, &stats);
+    write_image(image, output);
+    std::printf("%s: %zu Gaussians (SH degree %d), camera %d \"%s\" at %dx%d, %s on %s\n", scene_path.c_str(),
+                loaded->size(), loaded->sh_degree, camera.index, cam.name.c_str(), cam.width, cam.height,
+                options.label().c_str(), renderer->name().c_str());
+    std::printf("%s", format_stats(stats).c_str());
+    std::printf("wrote %s\n", output.c_str());
+  }
+};
+
+}  // namespace
+
+void register_render(CLI::App& app) {
+  auto command = std::make_shared<RenderCommand>();
+  CLI::App* sub = app.add_subcommand("render", "render one frame to an image (PNG, EXR, PPM, PFM)");
+  command->scene.add_to(sub);
+  command->camera.add_to(sub);
+  command->render.add_to(sub);
+  sub->add_option("--output,-o", command->output, "output image (the extension picks the format)");
+  sub->add_option("--repeat", command->repeat, "render this many times (statistics of the last)")
+      ->check(CLI::PositiveNumber);
+  sub->callback([command] { command->run(); });
+}
+
+}  // namespace flashgs::cli

@@ -1,0 +1,105 @@
+// Scene, camera, option and backend selection shared by the CLI subcommands.
+#include "scene_source.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "backend_factory.h"
+#include "flashgs/error.h"
+#include "flashgs/io.h"
+
+namespace flashgs::cli {
+
+std::string demo_scene_path() {
+  // Installed next to the binary's source tree; FLASHGS_ASSET_DIR is set by CMake.
+  return std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply";
+}
+
+void SceneArgs::add_to(CLI::App* command) {
+  command->add_option("scene", scene_path, "3DGS PLY file (default: the bundled demo scene)");
+  command->add_option("--cameras", cameras_path, "cameras.json (default: the one beside the PLY)");
+}
+
+std::string SceneArgs::resolved_scene() const { return scene_path.empty() ? demo_scene_path() : scene_path; }
+
+std::string SceneArgs::resolved_cameras() const {
+  if (!cameras_path.empty()) return cameras_path;
+  return (std::filesystem::path(resolved_scene()).parent_path() / "cameras.json").string();
+}
+
+std::shared_ptr<const Scene> load_scene_verbose(const std::string& path) {
+  LoadReport report;
+  auto scene = std::make_shared<Scene>(load_ply(path, &report));
+  if (report.dropped_non_finite)
+    std::fprintf(stderr, "%s: dropped %zu Gaussians with NaN/Inf attributes (or exp(scale) overflow)\n",
+                 path.c_str(), report.dropped_non_finite);
+  if (report.repaired_zero_quaternion)
+    std::fprintf(stderr, "%s: %zu zero quaternions set to identity\n", path.c_str(), report.repaired_zero_quaternion);
+  return scene;
+}
+
+void RenderArgs::add_to(CLI::App* command) {
+  command->add_option("--algorithm,-a", algorithm, "flash or baseline")->check(CLI::IsMember({"flash", "baseline"}));
+  command->add_flag("--no-opacity-radius", no_opacity_radius, "flash: 3-sigma extent instead of sqrt(2 ln(o/tau))");
+  command->add_flag("--no-tight-bbox", no_tight_bbox, "flash: square box instead of the per-axis box");
+  command->add_flag("--no-exact-tile-test", no_exact_tile_test, "flash: every tile of the box gets a key");
+  command->add_flag("--no-warp-emit", no_warp_emit, "CUDA flash: one thread per Gaussian for all sizes");
+  command->add_flag("--no-fused-emit", no_fused_emit, "CUDA flash: emit keys in a separate pass");
+  command->add_flag("--no-sort-bits", no_sort_bits, "CUDA flash: sort all 64 key bits");
+  command->add_flag("--no-pipelined-blend", no_pipelined_blend, "CUDA flash: no prefetch in the render loop");
+  command->add_flag("--no-exp2-alpha", no_exp2_alpha, "CUDA flash: expf instead of exp2 of a pre-scaled form");
+  command->add_option("--tau", tau, "alpha threshold of the opacity-aware extent")->check(CLI::Range(1e-6, 0.99));
+  command->add_option("--background", background, "background colour r,g,b")->delimiter(',')->expected(3);
+  command->add_option("--sh-degree", sh_degree, "use at most this many SH bands")->check(CLI::Range(0, 3));
+  command->add_option("--backend", backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+}
+
+RenderOptions RenderArgs::options() const {
+  RenderOptions o = algorithm == "baseline" ? RenderOptions::baseline() : RenderOptions{};
+  if (algorithm != "baseline") {
+    o.opacity_aware_radius = !no_opacity_radius;
+    o.tight_bbox = !no_tight_bbox;
+    o.exact_tile_test = !no_exact_tile_test;
+    o.warp_cooperative_emit = !no_warp_emit;
+    o.fused_emit = !no_fused_emit;
+    o.minimal_sort_bits = !no_sort_bits;
+    o.pipelined_blend = !no_pipelined_blend;
+    o.exp2_alpha = !no_exp2_alpha;
+  }
+  o.tau = tau;
+  for (int k = 0; k < 3; ++k) o.background[k] = background[k];
+  o.sh_degree_cap = sh_degree;
+  return o;
+}
+
+void CameraArgs::add_to(CLI::App* command) {
+  command->add_option("--camera,-c", index, "camera index in cameras.json");
+  command->add_option("--resolution,-r", resolution, "render size WxH (field of view kept)");
+}
+
+void parse_resolution(const std::string& text, int* width, int* height) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 || h < 1 ||
+      w > 65536 || h > 65536)
+    throw Error("resolution \"" + text + "\": expected WxH with 1 <= W, H <= 65536");
+  *width = w;
+  *height = h;
+}
+
+Camera CameraArgs::select(const std::vector<Camera>& cameras) const {
+  if (index < 0 || index >= static_cast<int>(cameras.size()))
+    throw Error("camera " + std::to_string(index) + " does not exist (the file has " + std::to_string(cameras.size()) +
+                ": 0.." + std::to_string(cameras.size() - 1) + ")");
+  Camera camera = cameras[index];
+  if (!resolution.empty()) {
+    int w, h;
+    parse_resolution(resolution, &w, &h);
+    camera = camera.resized(w, h);
+  }
+  return camera;
+}
+
+std::unique_ptr<Renderer> make_backend(const std::string& which) { return create_backend(which); }
+
+}  // namespace flashgs::cli

@@ -1,0 +1,57 @@
+// Where the CLI's scene, cameras and renderer come from (shared by every subcommand).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "flashgs/camera.h"
+#include "flashgs/options.h"
+#include "flashgs/renderer.h"
+#include "flashgs/scene.h"
+
+namespace flashgs::cli {
+
+// The bundled demo scene (assets/demo/point_cloud.ply).
+std::string demo_scene_path();
+
+struct SceneArgs {
+  std::string scene_path;    // empty: the demo scene
+  std::string cameras_path;  // empty: cameras.json beside the PLY
+  void add_to(CLI::App* command);
+  std::string resolved_scene() const;
+  std::string resolved_cameras() const;
+};
+
+// Loads the scene, printing what the loader dropped to stderr.
+std::shared_ptr<const Scene> load_scene_verbose(const std::string& path);
+
+struct RenderArgs {
+  std::string algorithm = "flash";
+  bool no_opacity_radius = false, no_tight_bbox = false, no_exact_tile_test = false;
+  bool no_warp_emit = false, no_fused_emit = false, no_sort_bits = false;
+  bool no_pipelined_blend = false, no_exp2_alpha = false;
+  float tau = 1.0f / 255.0f;
+  std::vector<float> background = {0, 0, 0};
+  int sh_degree = 3;
+  std::string backend = "auto";
+  void add_to(CLI::App* command);
+  RenderOptions options() const;
+};
+
+struct CameraArgs {
+  int index = 0;
+  std::string resolution;  // "WxH"; empty: the camera's own
+  void add_to(CLI::App* command);
+  Camera select(const std::vector<Camera>& cameras) const;
+};
+
+// "1920x1080" -> (1920, 1080); throws flashgs::Error on anything else.
+void parse_resolution(const std::string& text, int* width, int* height);
+
+// "cpu", "cuda" or "auto" (CUDA when a device is present, otherwise the CPU).
+std::unique_ptr<Renderer> make_backend(const std::string& which);
+
+}  // namespace flashgs::cli

@@ -1,0 +1,336 @@
+// Per-Gaussian math shared bit for bit by the CPU backend and the CUDA kernels.
+//
+// Only +, -, *, /, sqrt, floor and ceil appear on the path that decides which tiles a
+// Gaussian touches, so that the CPU and the GPU emit exactly the same Gaussian-tile pairs:
+// those operations are correctly rounded on both. The CUDA files that include this header
+// are compiled with -fmad=false and the host with -ffp-contract=off so that neither side
+// fuses a multiply and an add the other does not. ln() is therefore our own (portable_log).
+#pragma once
+
+#include <math.h>
+
+#include <cstdint>
+#include <cstring>
+
+#if defined(__CUDACC__)
+#define FLASHGS_HD __host__ __device__ __forceinline__
+#else
+#define FLASHGS_HD inline
+#endif
+
+namespace flashgs {
+namespace gm {
+
+constexpr int kTileSize = 16;
+constexpr float kNearZ = 0.2f;           // 3DGS culls at view-space z <= 0.2
+constexpr float kDilation = 0.3f;        // added to the 2D covariance diagonal (3DGS)
+constexpr float kAlphaMax = 0.99f;       // alpha clamp (3DGS)
+constexpr float kAlphaMin = 1.0f / 255.0f;    // blend skips alpha below this
+constexpr float kTransmittanceMin = 1e-4f;    // stop once T would fall below this
+constexpr float kBaselineSigmas = 3.0f;
+
+// Camera in the form the kernels need (plain data, copied to the GPU by value).
+struct CameraParams {
+  float rotation[9];  // world-to-camera, row-major
+  float position[3];  // camera centre
+  float fx, fy, cx, cy;
+  int width, height;
+  int tiles_x, tiles_y;
+};
+
+// Which geometry a frame uses; derived from RenderOptions.
+struct GeometryParams {
+  bool baseline;             // original 3DGS box and tile rule
+  bool opacity_radius;       // extent sqrt(2 ln(o / tau)) instead of 3 sigma
+  bool tight_bbox;           // per-axis half widths instead of a square
+  float tau;
+};
+
+enum CullReason : std::uint8_t {
+  kVisible = 0,
+  kCulledNear = 1,
+  kCulledOffscreen = 2,
+  kCulledLowOpacity = 3,
+  kCulledDegenerate = 4,
+};
+
+// The screen-space footprint of one Gaussian.
+struct Footprint {
+  float mean_x, mean_y;            // pixel-index coordinates (pixel centres are integers)
+  float depth;                     // view-space z, > kNearZ
+  float conic_a, conic_b, conic_c; // inverse 2D covariance: q = a dx^2 + 2 b dx dy + c dy^2
+  float threshold;                 // the ellipse is q <= threshold
+  int tile_x0, tile_y0;            // first tile of the box
+  int tile_x1, tile_y1;            // one past the last tile of the box
+};
+
+FLASHGS_HD float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+FLASHGS_HD float minf(float a, float b) { return a < b ? a : b; }
+FLASHGS_HD float maxf(float a, float b) { return a > b ? a : b; }
+
+FLASHGS_HD bool is_finite(float v) {
+  // v - v is NaN for NaN and Inf; written without std::isfinite so that it behaves the same
+  // under every compiler flag (fast-math would fold isfinite away).
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, 4);
+  return (bits & 0x7f800000u) != 0x7f800000u;
+}
+
+// Natural log from + - * / and the float's exponent field: the same result on CPU and GPU
+// (library logf differs between them by an ulp, which would flip tile decisions).
+// Accurate to a few ulp for normal positive x; returns -inf for x <= 0.
+FLASHGS_HD float portable_log(float x) {
+  if (!(x > 0.0f)) return -INFINITY;
+  std::uint32_t bits;
+  std::memcpy(&bits, &x, 4);
+  int exponent = static_cast<int>((bits >> 23) & 0xffu) - 127;
+  if (exponent == -127) {  // subnormal: scale into the normal range first
+    float scaled = x * 8388608.0f;  // 2^23
+    std::memcpy(&bits, &scaled, 4);
+    exponent = static_cast<int>((bits >> 23) & 0xffu) - 127 - 23;
+  }
+  std::uint32_t mantissa_bits = (bits & 0x007fffffu) | 0x3f800000u;  // m in [1, 2)
+  float m;
+  std::memcpy(&m, &mantissa_bits, 4);
+  if (m > 1.41421356f) {  // keep m in [sqrt(1/2), sqrt(2)) so the series converges fast
+    m = m * 0.5f;
+    exponent += 1;
+  }
+  // ln m = 2 atanh(s), s = (m - 1) / (m + 1), |s| < 0.172
+  const float s = (m - 1.0f) / (m + 1.0f);
+  const float s2 = s * s;
+  const float series =
+      s * (2.0f + s2 * (0.666666667f + s2 * (0.4f + s2 * (0.285714286f + s2 * 0.222222222f))));
+  return static_cast<float>(exponent) * 0.693147181f + series;
+}
+
+// Normalised quaternion (w, x, y, z) to a rotation matrix, row-major.
+FLASHGS_HD void quaternion_to_matrix(const float q[4], float m[9]) {
+  const float w = q[0], x = q[1], y = q[2], z = q[3];
+  m[0] = 1.0f - 2.0f * (y * y + z * z);
+  m[1] = 2.0f * (x * y - w * z);
+  m[2] = 2.0f * (x * z + w * y);
+  m[3] = 2.0f * (x * y + w * z);
+  m[4] = 1.0f - 2.0f * (x * x + z * z);
+  m[5] = 2.0f * (y * z - w * x);
+  m[6] = 2.0f * (x * z - w * y);
+  m[7] = 2.0f * (y * z + w * x);
+  m[8] = 1.0f - 2.0f * (x * x + y * y);
+}
+
+// View-space position: R (p - c). Subtracting first is exact when p and c are close
+// (Sterbenz), so a scene at 1e7 seen from nearby keeps its relative precision.
+FLASHGS_HD void to_view(const CameraParams& cam, const float p[3], float v[3]) {
+  const float d0 = p[0] - cam.position[0], d1 = p[1] - cam.position[1],
+              d2 = p[2] - cam.position[2];
+  v[0] = cam.rotation[0] * d0 + cam.rotation[1] * d1 + cam.rotation[2] * d2;
+  v[1] = cam.rotation[3] * d0 + cam.rotation[4] * d1 + cam.rotation[5] * d2;
+  v[2] = cam.rotation[6] * d0 + cam.rotation[7] * d1 + cam.rotation[8] * d2;
+}
+
+// Projects one Gaussian. The 2D covariance is M M^T with M = J W R S (2x3). Its determinant
+// comes from Cauchy-Binet as a sum of squared 2x2 minors of M, never as a*c - b*b: for a
+// needle or pancake (scale ratios of 1e6 and more) a*c and b*b agree in every float digit
+// and their difference is noise, often negative. The dilated determinant
+// det + 0.3 (a + c) + 0.09 is then a sum of positive terms, so the conic stays finite and
+// positive definite for any finite input.
+FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo,
+                              const float position[3], const float scale[3],
+                              const float quaternion[4], float opacity, Footprint& out) {
+  float v[3];
+  to_view(cam, position, v);
+  if (!(v[2] > kNearZ)) return is_finite(v[2]) ? kCulledNear : kCulledDegenerate;
+
+  float threshold = kBaselineSigmas * kBaselineSigmas;
+  if (geo.opacity_radius) {
+    // alpha = o exp(-q / 2) >= tau  <=>  q <= 2 ln(o / tau)
+    if (!(opacity > geo.tau)) return kCulledLowOpacity;
+    threshold = 2.0f * portable_log(opacity / geo.tau);
+  }
+
+  const float inv_z = 1.0f / v[2];
+  const float mean_x = cam.fx * v[0] * inv_z + cam.cx;
+  const float mean_y = cam.fy * v[1] * inv_z + cam.cy;
+  // J W: rows of the projection Jacobian times the world-to-camera rotation.
+  const float j00 = cam.fx * inv_z, j02 = -cam.fx * v[0] * inv_z * inv_z;
+  const float j11 = cam.fy * inv_z, j12 = -cam.fy * v[1] * inv_z * inv_z;
+  float t0[3], t1[3];
+  for (int k = 0; k < 3; ++k) {
+    t0[k] = j00 * cam.rotation[k] + j02 * cam.rotation[6 + k];
+    t1[k] = j11 * cam.rotation[3 + k] + j12 * cam.rotation[6 + k];
+  }
+  float r[9];
+  quaternion_to_matrix(quaternion, r);
+  // M = (J W) R S: column k is (J W) times the k-th rotated axis scaled by s_k.
+  float m0[3], m1[3];
+  for (int k = 0; k < 3; ++k) {
+    const float ax = r[k] * scale[k], ay = r[3 + k] * scale[k], az = r[6 + k] * scale[k];
+    m0[k] = t0[0] * ax + t0[1] * ay + t0[2] * az;
+    m1[k] = t1[0] * ax + t1[1] * ay + t1[2] * az;
+  }
+  const float a = m0[0] * m0[0] + m0[1] * m0[1] + m0[2] * m0[2];
+  const float b = m0[0] * m1[0] + m0[1] * m1[1] + m0[2] * m1[2];
+  const float c = m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2];
+  const float minor01 = m0[0] * m1[1] - m0[1] * m1[0];
+  const float minor02 = m0[0] * m1[2] - m0[2] * m1[0];
+  const float minor12 = m0[1] * m1[2] - m0[2] * m1[1];
+  const float det = minor01 * minor01 + minor02 * minor02 + minor12 * minor12;
+
+  const float ad = a + kDilation, cd = c + kDilation;
+  const float det_d = det + kDilation * (a + c) + kDilation * kDilation;
+  if (!is_finite(mean_x) || !is_finite(mean_y) || !is_finite(ad) || !is_finite(cd) ||
+      !is_finite(b) || !is_finite(det_d) || !(det_d > 0.0f))
+    return kCulledDegenerate;
+  const float inv_det = 1.0f / det_d;
+
+  float half_x, half_y;
+  if (geo.tight_bbox) {
+    // max |dx| on q = t is sqrt(t * Sigma_xx) (same for y)
+    half_x = sqrtf(threshold * ad);
+    half_y = sqrtf(threshold * cd);
+  } else {
+    // largest eigenvalue without cancellation: mid + sqrt(((a - c) / 2)^2 + b^2)
+    const float half_diff = 0.5f * (ad - cd);
+    const float lambda_max = 0.5f * (ad + cd) + sqrtf(half_diff * half_diff + b * b);
+    const float radius = sqrtf(threshold * lambda_max);
+    half_x = half_y = geo.baseline ? ceilf(radius) : radius;
+  }
+  if (!is_finite(half_x) || !is_finite(half_y)) return kCulledDegenerate;
+
+  const float tiles_x = static_cast<float>(cam.tiles_x), tiles_y = static_cast<float>(cam.tiles_y);
+  const float ts = static_cast<float>(kTileSize);
+  if (geo.baseline) {
+    // 3DGS getRect: [trunc((m - r) / 16), trunc((m + r + 15) / 16)), clamped to the grid.
+    // Clamped in float first: a huge radius must not overflow the int conversion.
+    out.tile_x0 = static_cast<int>(clampf((mean_x - half_x) / ts, 0.0f, tiles_x));
+    out.tile_x1 = static_cast<int>(clampf((mean_x + half_x + ts - 1.0f) / ts, 0.0f, tiles_x));
+    out.tile_y0 = static_cast<int>(clampf((mean_y - half_y) / ts, 0.0f, tiles_y));
+    out.tile_y1 = static_cast<int>(clampf((mean_y + half_y + ts - 1.0f) / ts, 0.0f, tiles_y));
+  } else {
+    // Exactly the tiles holding a pixel centre within the box.
+    const float px0 = maxf(ceilf(mean_x - half_x), 0.0f);
+    const float px1 = minf(floorf(mean_x + half_x), static_cast<float>(cam.width - 1));
+    const float py0 = maxf(ceilf(mean_y - half_y), 0.0f);
+    const float py1 = minf(floorf(mean_y + half_y), static_cast<float>(cam.height - 1));
+    if (!(px0 <= px1) || !(py0 <= py1)) return kCulledOffscreen;
+    out.tile_x0 = static_cast<int>(px0) / kTileSize;
+    out.tile_x1 = static_cast<int>(px1) / kTileSize + 1;
+    out.tile_y0 = static_cast<int>(py0) / kTileSize;
+    out.tile_y1 = static_cast<int>(py1) / kTileSize + 1;
+  }
+  if (out.tile_x0 >= out.tile_x1 || out.tile_y0 >= out.tile_y1) return kCulledOffscreen;
+
+  out.mean_x = mean_x;
+  out.mean_y = mean_y;
+  out.depth = v[2];
+  out.conic_a = cd * inv_det;
+  out.conic_b = -b * inv_det;
+  out.conic_c = ad * inv_det;
+  out.threshold = threshold;
+  return kVisible;
+}
+
+// Does the ellipse q(d) <= t meet the rectangle [dx0, dx1] x [dy0, dy1] (offsets from the
+// centre)? FlashGS's exact test without square roots: if the centre is outside, the minimum
+// of the convex q over the rectangle lies on an edge facing the centre; along such an edge q
+// is a parabola whose minimum is found in closed form and clamped to the edge.
+FLASHGS_HD bool ellipse_meets_rect(float a, float b, float c, float t, float dx0, float dx1,
+                                   float dy0, float dy1) {
+  const bool inside_x = dx0 <= 0.0f && dx1 >= 0.0f;
+  const bool inside_y = dy0 <= 0.0f && dy1 >= 0.0f;
+  if (inside_x && inside_y) return true;
+  if (!inside_x) {
+    const float dx = dx0 > 0.0f ? dx0 : dx1;
+    const float dy = clampf(-b * dx / c, dy0, dy1);
+    if (a * dx * dx + 2.0f * b * dx * dy + c * dy * dy <= t) return true;
+  }
+  if (!inside_y) {
+    const float dy = dy0 > 0.0f ? dy0 : dy1;
+    const float dx = clampf(-b * dy / a, dx0, dx1);
+    if (a * dx * dx + 2.0f * b * dx * dy + c * dy * dy <= t) return true;
+  }
+  return false;
+}
+
+// The exact test for tile (tx, ty): the rectangle spanned by its pixel centres, clipped to
+// the image.
+FLASHGS_HD bool footprint_touches_tile(const Footprint& f, int tx, int ty, int width, int height) {
+  const float x0 = static_cast<float>(tx * kTileSize);
+  const float y0 = static_cast<float>(ty * kTileSize);
+  const float x1 = minf(x0 + (kTileSize - 1), static_cast<float>(width - 1));
+  const float y1 = minf(y0 + (kTileSize - 1), static_cast<float>(height - 1));
+  return ellipse_meets_rect(f.conic_a, f.conic_b, f.conic_c, f.threshold, x0 - f.mean_x,
+                            x1 - f.mean_x, y0 - f.mean_y, y1 - f.mean_y);
+}
+
+// Real spherical harmonics constants (degree 0..3) of the 3DGS colour model.
+constexpr float kShC0 = 0.28209479177387814f;
+constexpr float kShC1 = 0.4886025119029199f;
+constexpr float kShC2[5] = {1.0925484305920792f, -1.0925484305920792f, 0.31539156525252005f,
+                            -1.0925484305920792f, 0.5462742152960396f};
+constexpr float kShC3[7] = {-0.5900435899266435f, 2.890611442640554f, -0.4570457994644658f,
+                            0.3731763325901154f, -0.4570457994644658f, 1.445305721320277f,
+                            -0.5900435899266435f};
+
+// SH basis values for a unit direction, for bands 0..degree (DEGREE is a template argument so
+// that a degree-0 scene compiles to no SH work at all).
+template <int DEGREE>
+FLASHGS_HD void sh_basis(float x, float y, float z, float basis[16]) {
+  basis[0] = kShC0;
+  if (DEGREE > 0) {
+    basis[1] = -kShC1 * y;
+    basis[2] = kShC1 * z;
+    basis[3] = -kShC1 * x;
+  }
+  if (DEGREE > 1) {
+    const float xx = x * x, yy = y * y, zz = z * z;
+    basis[4] = kShC2[0] * x * y;
+    basis[5] = kShC2[1] * y * z;
+    basis[6] = kShC2[2] * (2.0f * zz - xx - yy);
+    basis[7] = kShC2[3] * x * z;
+    basis[8] = kShC2[4] * (xx - yy);
+    if (DEGREE > 2) {
+      basis[9] = kShC3[0] * y * (3.0f * xx - yy);
+      basis[10] = kShC3[1] * x * y * z;
+      basis[11] = kShC3[2] * y * (4.0f * zz - xx - yy);
+      basis[12] = kShC3[3] * z * (2.0f * zz - 3.0f * xx - 3.0f * yy);
+      basis[13] = kShC3[4] * x * (4.0f * zz - xx - yy);
+      basis[14] = kShC3[5] * z * (xx - yy);
+      basis[15] = kShC3[6] * x * (xx - 3.0f * yy);
+    }
+  }
+}
+
+// RGB of one Gaussian seen from `camera_position`: SH + 0.5, clamped at 0 (3DGS).
+// `rest` holds this Gaussian's coefficients 1..K-1 as [k][channel]; lower bands come first,
+// so a scene with more bands than DEGREE is evaluated by reading only its first ones.
+template <int DEGREE>
+FLASHGS_HD void sh_to_rgb(const float camera_position[3], const float position[3],
+                          const float dc[3], const float* rest, float rgb[3]) {
+  float basis[16];
+  float dx = position[0] - camera_position[0], dy = position[1] - camera_position[1],
+        dz = position[2] - camera_position[2];
+  if (DEGREE > 0) {
+    const float len2 = dx * dx + dy * dy + dz * dz;
+    const float inv = len2 > 0.0f ? 1.0f / sqrtf(len2) : 0.0f;
+    dx *= inv;
+    dy *= inv;
+    dz *= inv;
+  }
+  sh_basis<DEGREE>(dx, dy, dz, basis);
+  for (int ch = 0; ch < 3; ++ch) {
+    float sum = basis[0] * dc[ch];
+    for (int k = 1; k < (DEGREE + 1) * (DEGREE + 1); ++k) sum += basis[k] * rest[(k - 1) * 3 + ch];
+    rgb[ch] = maxf(sum + 0.5f, 0.0f);
+  }
+}
+
+// Sort key part for a depth: positive floats order like their bit patterns.
+FLASHGS_HD std::uint32_t depth_bits(float depth) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &depth, 4);
+  return bits;
+}
+
+}  // namespace gm
+}  // namespace flashgs

@@ -1,0 +1,18 @@
+// Image files: PNG/EXR/anything through OpenImageIO when built with it; PPM/PFM always.
+#pragma once
+
+#include <string>
+
+#include "flashgs/image.h"
+
+namespace flashgs {
+
+// Writes `image` to `path`; the extension picks the format. 8-bit formats get values clamped
+// to [0, 1] and rounded; EXR/PFM keep the floats. Throws flashgs::Error on failure.
+void write_image(const Image& image, const std::string& path);
+// Reads an image as float RGB (8-bit formats scaled to [0, 1]).
+Image read_image(const std::string& path);
+// Whether PNG/EXR are available (built with OpenImageIO).
+bool image_io_has_oiio();
+
+}  // namespace flashgs

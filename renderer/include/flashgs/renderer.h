@@ -1,0 +1,31 @@
+// Renderer: the interface every backend (CPU, CUDA) implements, and the CPU factory.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "flashgs/camera.h"
+#include "flashgs/image.h"
+#include "flashgs/options.h"
+#include "flashgs/scene.h"
+#include "flashgs/stats.h"
+
+namespace flashgs {
+
+class Renderer {
+ public:
+  virtual ~Renderer() = default;
+  virtual std::string name() const = 0;
+  // Makes `scene` the one rendered from now on (the CUDA backend uploads it once here).
+  // Throws flashgs::Error when the scene cannot be held (e.g. out of GPU memory); the
+  // previous scene then stays.
+  virtual void set_scene(std::shared_ptr<const Scene> scene) = 0;
+  // Renders one frame. `stats` may be null.
+  virtual void render(const Camera& camera, const RenderOptions& options, Image& out,
+                      FrameStats* stats) = 0;
+};
+
+// The multi-threaded CPU backend; `threads` = 0 uses every core.
+std::unique_ptr<Renderer> make_cpu_renderer(int threads = 0);
+
+}  // namespace flashgs

@@ -1,0 +1,39 @@
+// FrameStats: what one rendered frame cost and what it did, per stage.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace flashgs {
+
+// Milliseconds per stage; stage names are the same on every backend.
+struct StageTimes {
+  double project_ms = 0;  // cull, 3D->2D covariance, extent, box, SH -> colour
+  double emit_ms = 0;     // Gaussian-tile keys
+  double sort_ms = 0;     // by tile, then depth
+  double ranges_ms = 0;   // per-tile start/end in the sorted list
+  double blend_ms = 0;    // front-to-back compositing
+  double total_ms = 0;
+};
+
+struct FrameStats {
+  std::uint64_t kv_pairs = 0;  // Gaussian-tile pairs emitted this frame
+  int tiles_x = 0, tiles_y = 0;
+  // Pairs per tile, row-major tiles_y x tiles_x; filled only when
+  // RenderOptions::collect_tile_counts is set.
+  std::vector<std::uint32_t> tile_pair_counts;
+  std::uint32_t max_tile_pairs = 0;
+
+  std::uint64_t gaussians = 0;          // in the scene
+  std::uint64_t visible = 0;            // emitted at least one pair
+  std::uint64_t culled_near = 0;        // view-space z <= 0.2 (behind or straddling the near plane)
+  std::uint64_t culled_offscreen = 0;   // box misses the image
+  std::uint64_t culled_low_opacity = 0; // opacity below tau (flash opacity-aware radius only)
+  std::uint64_t culled_degenerate = 0;  // non-finite projection or empty covariance
+
+  StageTimes times;
+  std::uint64_t device_memory_bytes = 0;  // backend working memory now (GPU; 0 on CPU)
+  std::uint64_t device_peak_bytes = 0;    // high-water mark of the above
+};
+
+}  // namespace flashgs

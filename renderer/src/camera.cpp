@@ -1,0 +1,41 @@
+// Camera construction from a pose, and resizing with the field of view kept.
+#include "flashgs/camera.h"
+
+#include <cmath>
+
+namespace flashgs {
+
+Camera Camera::from_pose(int width, int height, float fx, float fy, const float camera_to_world[9],
+                         const float centre[3]) {
+  Camera camera;
+  camera.width = width;
+  camera.height = height;
+  camera.fx = fx;
+  camera.fy = fy;
+  // Pixel index i covers [i - 0.5, i + 0.5]; the optical axis hits the image centre.
+  camera.cx = 0.5f * static_cast<float>(width) - 0.5f;
+  camera.cy = 0.5f * static_cast<float>(height) - 0.5f;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) camera.rotation[r * 3 + c] = camera_to_world[c * 3 + r];
+  for (int k = 0; k < 3; ++k) camera.position[k] = centre[k];
+  return camera;
+}
+
+Camera Camera::resized(int new_width, int new_height) const {
+  Camera camera = *this;
+  const float sx = static_cast<float>(new_width) / static_cast<float>(width);
+  const float sy = static_cast<float>(new_height) / static_cast<float>(height);
+  camera.width = new_width;
+  camera.height = new_height;
+  camera.fx = fx * sx;
+  camera.fy = fy * sy;
+  camera.cx = (cx + 0.5f) * sx - 0.5f;
+  camera.cy = (cy + 0.5f) * sy - 0.5f;
+  return camera;
+}
+
+float Camera::horizontal_fov_degrees() const {
+  return static_cast<float>(2.0 * std::atan(0.5 * width / fx) * 180.0 / M_PI);
+}
+
+}  // namespace flashgs

@@ -1,0 +1,78 @@
+// CPU blend stage: front-to-back alpha compositing of each tile's sorted Gaussians.
+#include <cmath>
+
+#include "cpu_frame.h"
+
+namespace flashgs {
+namespace cpu {
+namespace {
+
+constexpr int kTilePixels = gm::kTileSize * gm::kTileSize;
+
+// Composites one tile. Gaussian-outer, pixel-inner: each Gaussian is read once per tile and
+// the pixel loop runs over contiguous arrays. Per pixel the rules are those of 3DGS: skip
+// power > 0, alpha = min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4.
+void blend_tile(const Frame& frame, const std::uint64_t* keys, std::uint64_t count, int tile_x,
+                int tile_y, const float background[3], float* rgb) {
+  const int width = frame.camera.width, height = frame.camera.height;
+  const int x_begin = tile_x * gm::kTileSize, y_begin = tile_y * gm::kTileSize;
+  const int tile_w = std::min(gm::kTileSize, width - x_begin);
+  const int tile_h = std::min(gm::kTileSize, height - y_begin);
+  float transmittance[kTilePixels];
+  float color[kTilePixels][3];
+  bool active[kTilePixels];
+  int active_count = tile_w * tile_h;
+  for (int p = 0; p < kTilePixels; ++p) {
+    transmittance[p] = 1.0f;
+    color[p][0] = color[p][1] = color[p][2] = 0.0f;
+    active[p] = true;
+  }
+  for (std::uint64_t k = 0; k < count && active_count > 0; ++k) {
+    const BlendGaussian& g = frame.blend_data[static_cast<std::uint32_t>(keys[k])];
+    for (int y = 0; y < tile_h; ++y) {
+      const float dy = static_cast<float>(y_begin + y) - g.mean_y;
+      for (int x = 0; x < tile_w; ++x) {
+        const int p = y * gm::kTileSize + x;
+        if (!active[p]) continue;
+        const float dx = static_cast<float>(x_begin + x) - g.mean_x;
+        const float power = -0.5f * (g.conic_a * dx * dx + g.conic_c * dy * dy) - g.conic_b * dx * dy;
+        if (power > 0.0f || power < g.power_cut) continue;
+        const float alpha = std::min(gm::kAlphaMax, g.opacity * std::exp(power));
+        if (alpha < gm::kAlphaMin) continue;
+        const float next_t = transmittance[p] * (1.0f - alpha);
+        if (next_t < gm::kTransmittanceMin) {
+          active[p] = false;
+          --active_count;
+          continue;
+        }
+        const float weight = alpha * transmittance[p];
+        color[p][0] += g.rgb[0] * weight;
+        color[p][1] += g.rgb[1] * weight;
+        color[p][2] += g.rgb[2] * weight;
+        transmittance[p] = next_t;
+      }
+    }
+  }
+  for (int y = 0; y < tile_h; ++y)
+    for (int x = 0; x < tile_w; ++x) {
+      const int p = y * gm::kTileSize + x;
+      float* out = rgb + (static_cast<std::size_t>(y_begin + y) * width + x_begin + x) * 3;
+      for (int ch = 0; ch < 3; ++ch) out[ch] = color[p][ch] + transmittance[p] * background[ch];
+    }
+}
+
+}  // namespace
+
+void blend(const RenderOptions& options, Frame& frame, float* rgb) {
+  const int tiles_x = frame.camera.tiles_x;
+  const std::int64_t tiles = static_cast<std::int64_t>(tiles_x) * frame.camera.tiles_y;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(frame.threads)
+  for (std::int64_t tile = 0; tile < tiles; ++tile) {
+    const std::uint64_t begin = frame.tile_start[tile], end = frame.tile_start[tile + 1];
+    blend_tile(frame, frame.sorted_keys.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
+               static_cast<int>(tile / tiles_x), options.background, rgb);
+  }
+}
+
+}  // namespace cpu
+}  // namespace flashgs

@@ -1,0 +1,79 @@
+// The CPU backend: runs the stages in order, times them, fills FrameStats.
+#include <chrono>
+#include <thread>
+
+#include "cpu_frame.h"
+#include "flashgs/error.h"
+#include "flashgs/frame_params.h"
+#include "flashgs/renderer.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace flashgs {
+
+namespace {
+
+class CpuRenderer final : public Renderer {
+ public:
+  explicit CpuRenderer(int threads) {
+#ifdef _OPENMP
+    frame_.threads = threads > 0 ? threads : omp_get_max_threads();
+#else
+    (void)threads;
+    frame_.threads = 1;
+#endif
+  }
+  std::string name() const override { return "cpu (" + std::to_string(frame_.threads) + " threads)"; }
+  void set_scene(std::shared_ptr<const Scene> scene) override { scene_ = std::move(scene); }
+
+  void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats_out) override {
+    using Clock = std::chrono::steady_clock;
+    auto ms_since = [](Clock::time_point t) {
+      return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
+    if (!scene_) throw Error("cpu renderer: no scene set");
+    if (camera.width < 1 || camera.height < 1) throw Error("cpu renderer: image size must be at least 1x1");
+    FrameStats stats;
+    const auto start = Clock::now();
+    frame_.camera = make_camera_params(camera);
+    frame_.geometry = make_geometry_params(options);
+    stats.gaussians = scene_->size();
+    stats.tiles_x = frame_.camera.tiles_x;
+    stats.tiles_y = frame_.camera.tiles_y;
+
+    auto t = Clock::now();
+    cpu::project(*scene_, options, frame_, stats);
+    stats.times.project_ms = ms_since(t);
+    t = Clock::now();
+    cpu::emit(*scene_, options, frame_, stats);
+    stats.times.emit_ms = ms_since(t);
+    t = Clock::now();
+    cpu::sort_by_tile(frame_, stats, &stats.times.ranges_ms);
+    stats.times.sort_ms = ms_since(t) - stats.times.ranges_ms;
+    t = Clock::now();
+    if (out.width != camera.width || out.height != camera.height) out.resize(camera.width, camera.height);
+    cpu::blend(options, frame_, out.rgb.data());
+    stats.times.blend_ms = ms_since(t);
+    stats.times.total_ms = ms_since(start);
+
+    if (options.collect_tile_counts) {
+      const std::size_t tiles = frame_.tile_start.size() - 1;
+      stats.tile_pair_counts.resize(tiles);
+      for (std::size_t i = 0; i < tiles; ++i)
+        stats.tile_pair_counts[i] = static_cast<std::uint32_t>(frame_.tile_start[i + 1] - frame_.tile_start[i]);
+    }
+    if (stats_out) *stats_out = std::move(stats);
+  }
+
+ private:
+  std::shared_ptr<const Scene> scene_;
+  cpu::Frame frame_;
+};
+
+}  // namespace
+
+std::unique_ptr<Renderer> make_cpu_renderer(int threads) { return std::make_unique<CpuRenderer>(threads); }
+
+}  // namespace flashgs

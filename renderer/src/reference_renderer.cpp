@@ -1,0 +1,183 @@
+// fp64 brute-force reference renderer (see reference_renderer.h).
+#include "flashgs/reference_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace flashgs {
+namespace {
+
+struct RefGaussian {
+  double mean_x, mean_y, depth;
+  double a, b, c;  // conic
+  double opacity;
+  double rgb[3];
+  std::size_t index;
+};
+
+// Real SH in double, same basis as gaussian_math.h.
+void sh_rgb_double(const Scene& scene, std::size_t i, int degree, const double dir[3], double rgb[3]) {
+  const double x = dir[0], y = dir[1], z = dir[2];
+  double basis[16] = {0.28209479177387814};
+  if (degree > 0) {
+    basis[1] = -0.4886025119029199 * y;
+    basis[2] = 0.4886025119029199 * z;
+    basis[3] = -0.4886025119029199 * x;
+  }
+  if (degree > 1) {
+    const double xx = x * x, yy = y * y, zz = z * z;
+    basis[4] = 1.0925484305920792 * x * y;
+    basis[5] = -1.0925484305920792 * y * z;
+    basis[6] = 0.31539156525252005 * (2 * zz - xx - yy);
+    basis[7] = -1.0925484305920792 * x * z;
+    basis[8] = 0.5462742152960396 * (xx - yy);
+    if (degree > 2) {
+      basis[9] = -0.5900435899266435 * y * (3 * xx - yy);
+      basis[10] = 2.890611442640554 * x * y * z;
+      basis[11] = -0.4570457994644658 * y * (4 * zz - xx - yy);
+      basis[12] = 0.3731763325901154 * z * (2 * zz - 3 * xx - 3 * yy);
+      basis[13] = -0.4570457994644658 * x * (4 * zz - xx - yy);
+      basis[14] = 1.445305721320277 * z * (xx - yy);
+      basis[15] = -0.5900435899266435 * x * (xx - 3 * yy);
+    }
+  }
+  const int rest_n = scene.sh_rest_per_gaussian();
+  for (int ch = 0; ch < 3; ++ch) {
+    double sum = basis[0] * scene.sh_dc[i * 3 + ch];
+    for (int k = 1; k < (degree + 1) * (degree + 1); ++k)
+      sum += basis[k] * scene.sh_rest[i * rest_n + (k - 1) * 3 + ch];
+    rgb[ch] = std::max(sum + 0.5, 0.0);
+  }
+}
+
+// Minimum of q(d) = a dx^2 + 2 b dx dy + c dy^2 over a rectangle of offsets (0 if it holds
+// the centre); see gm::ellipse_meets_rect.
+double min_q_over_rect(const RefGaussian& g, double dx0, double dx1, double dy0, double dy1) {
+  auto q = [&](double dx, double dy) { return g.a * dx * dx + 2 * g.b * dx * dy + g.c * dy * dy; };
+  const bool inside_x = dx0 <= 0 && dx1 >= 0, inside_y = dy0 <= 0 && dy1 >= 0;
+  if (inside_x && inside_y) return 0;
+  double best = std::numeric_limits<double>::infinity();
+  if (!inside_x) {
+    const double dx = dx0 > 0 ? dx0 : dx1;
+    best = std::min(best, q(dx, std::clamp(-g.b * dx / g.c, dy0, dy1)));
+  }
+  if (!inside_y) {
+    const double dy = dy0 > 0 ? dy0 : dy1;
+    best = std::min(best, q(std::clamp(-g.b * dy / g.a, dx0, dx1), dy));
+  }
+  return best;
+}
+
+}  // namespace
+
+Image render_reference(const Scene& scene, const Camera& camera, const RenderOptions& options,
+                       PixelWindow window) {
+  if (window.width < 0) window.width = camera.width;
+  if (window.height < 0) window.height = camera.height;
+  const int degree = std::max(0, std::min(scene.sh_degree, options.sh_degree_cap));
+  double rot[9], centre[3];
+  for (int k = 0; k < 9; ++k) rot[k] = camera.rotation[k];
+  for (int k = 0; k < 3; ++k) centre[k] = camera.position[k];
+
+  std::vector<RefGaussian> gaussians;
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    double d[3], v[3];
+    for (int k = 0; k < 3; ++k) d[k] = static_cast<double>(scene.positions[i * 3 + k]) - centre[k];
+    for (int r = 0; r < 3; ++r) v[r] = rot[r * 3] * d[0] + rot[r * 3 + 1] * d[1] + rot[r * 3 + 2] * d[2];
+    if (!(v[2] > 0.2)) continue;
+    const double opacity = scene.opacities[i];
+    if (!(opacity >= 1.0 / 255.0)) continue;  // alpha <= opacity can never reach 1/255
+    // Sigma_2D = M M^T, M = J W R S (double precision throughout).
+    const double qw = scene.rotations[i * 4], qx = scene.rotations[i * 4 + 1],
+                 qy = scene.rotations[i * 4 + 2], qz = scene.rotations[i * 4 + 3];
+    const double r[9] = {1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qw * qz),     2 * (qx * qz + qw * qy),
+                         2 * (qx * qy + qw * qz),     1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qw * qx),
+                         2 * (qx * qz - qw * qy),     2 * (qy * qz + qw * qx),     1 - 2 * (qx * qx + qy * qy)};
+    const double fx = camera.fx, fy = camera.fy, z = v[2];
+    const double j00 = fx / z, j02 = -fx * v[0] / (z * z), j11 = fy / z, j12 = -fy * v[1] / (z * z);
+    double t0[3], t1[3];
+    for (int k = 0; k < 3; ++k) {
+      t0[k] = j00 * rot[k] + j02 * rot[6 + k];
+      t1[k] = j11 * rot[3 + k] + j12 * rot[6 + k];
+    }
+    double m0[3], m1[3];
+    for (int k = 0; k < 3; ++k) {
+      const double s = scene.scales[i * 3 + k];
+      const double ax = r[k] * s, ay = r[3 + k] * s, az = r[6 + k] * s;
+      m0[k] = t0[0] * ax + t0[1] * ay + t0[2] * az;
+      m1[k] = t1[0] * ax + t1[1] * ay + t1[2] * az;
+    }
+    const double a = m0[0] * m0[0] + m0[1] * m0[1] + m0[2] * m0[2] + 0.3;
+    const double b = m0[0] * m1[0] + m0[1] * m1[1] + m0[2] * m1[2];
+    const double c = m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2] + 0.3;
+    const double n01 = m0[0] * m1[1] - m0[1] * m1[0], n02 = m0[0] * m1[2] - m0[2] * m1[0],
+                 n12 = m0[1] * m1[2] - m0[2] * m1[1];
+    const double det = n01 * n01 + n02 * n02 + n12 * n12 + 0.3 * (a + c - 0.6) + 0.09;
+    if (!std::isfinite(det) || !(det > 0) || !std::isfinite(a) || !std::isfinite(c)) continue;
+    RefGaussian g;
+    g.mean_x = fx * v[0] / z + camera.cx;
+    g.mean_y = fy * v[1] / z + camera.cy;
+    g.depth = z;
+    g.a = c / det;
+    g.b = -b / det;
+    g.c = a / det;
+    g.opacity = opacity;
+    g.index = i;
+    if (!std::isfinite(g.mean_x) || !std::isfinite(g.mean_y)) continue;
+    // Skip exactly the Gaussians whose alpha stays below 1/255 over the whole window.
+    const double q_min = min_q_over_rect(g, window.x0 - g.mean_x, window.x0 + window.width - 1 - g.mean_x,
+                                         window.y0 - g.mean_y, window.y0 + window.height - 1 - g.mean_y);
+    if (std::min(0.99, opacity * std::exp(-0.5 * q_min)) < 1.0 / 255.0) continue;
+    double dir[3];
+    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int k = 0; k < 3; ++k) dir[k] = len > 0 ? d[k] / len : 0.0;
+    sh_rgb_double(scene, i, degree, dir, g.rgb);
+    gaussians.push_back(g);
+  }
+  std::sort(gaussians.begin(), gaussians.end(), [](const RefGaussian& l, const RefGaussian& r) {
+    // Compare the float depths the renderers sort by, then the index: the same order.
+    const float lf = static_cast<float>(l.depth), rf = static_cast<float>(r.depth);
+    return lf != rf ? lf < rf : l.index < r.index;
+  });
+
+  Image image;
+  image.resize(window.width, window.height);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int y = 0; y < window.height; ++y)
+    for (int x = 0; x < window.width; ++x) {
+      const double px = window.x0 + x, py = window.y0 + y;
+      double t = 1.0, rgb[3] = {0, 0, 0};
+      for (const RefGaussian& g : gaussians) {
+        const double dx = px - g.mean_x, dy = py - g.mean_y;
+        const double power = -0.5 * (g.a * dx * dx + g.c * dy * dy) - g.b * dx * dy;
+        if (power > 0) continue;
+        const double alpha = std::min(0.99, g.opacity * std::exp(power));
+        if (alpha < 1.0 / 255.0) continue;
+        const double next_t = t * (1 - alpha);
+        if (next_t < 1e-4) break;
+        for (int ch = 0; ch < 3; ++ch) rgb[ch] += g.rgb[ch] * alpha * t;
+        t = next_t;
+      }
+      float* out = image.pixel(x, y);
+      for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<float>(rgb[ch] + t * options.background[ch]);
+    }
+  return image;
+}
+
+Image crop_image(const Image& image, const PixelWindow& window) {
+  Image out;
+  out.resize(window.width, window.height);
+  for (int y = 0; y < window.height; ++y)
+    for (int x = 0; x < window.width; ++x) {
+      const float* in = image.pixel(window.x0 + x, window.y0 + y);
+      float* o = out.pixel(x, y);
+      o[0] = in[0];
+      o[1] = in[1];
+      o[2] = in[2];
+    }
+  return out;
+}
+
+}  // namespace flashgs

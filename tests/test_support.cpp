@@ -1,0 +1,59 @@
+// Helpers shared by the test suites (see test_support.h).
+#include "test_support.h"
+
+#include <filesystem>
+#include <map>
+#include <mutex>
+
+#include "flashgs/image_io.h"
+#include "flashgs/io.h"
+
+namespace flashgs::test {
+
+std::string shared_scene_dir(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::path(FLASHGS_SHARED_SCENES) / name;
+  return std::filesystem::exists(dir / "point_cloud.ply") ? dir.string() : std::string();
+}
+
+std::vector<std::string> shared_scene_names() {
+  std::vector<std::string> names;
+  for (const char* name : {"pc_biker", "pc_guitar", "v3dg_donut", "kacytran_try", "pc_playbot"})
+    if (!shared_scene_dir(name).empty()) names.push_back(name);
+  return names;
+}
+
+std::shared_ptr<const Scene> load_shared_scene(const std::string& name) {
+  static std::mutex mutex;
+  static std::map<std::string, std::shared_ptr<const Scene>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[name];
+  if (!slot) slot = std::make_shared<Scene>(load_ply(shared_scene_dir(name) + "/point_cloud.ply"));
+  return slot;
+}
+
+std::vector<Camera> load_shared_cameras(const std::string& name) {
+  return load_cameras(shared_scene_dir(name) + "/cameras.json");
+}
+
+std::shared_ptr<const Scene> load_demo_scene() {
+  static std::shared_ptr<const Scene> scene =
+      std::make_shared<Scene>(load_ply(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply"));
+  return scene;
+}
+
+std::vector<Camera> load_demo_cameras() {
+  return load_cameras(std::string(FLASHGS_ASSET_DIR) + "/demo/cameras.json");
+}
+
+void dump_images(const std::string& stem, const Image& expected, const Image& actual) {
+  std::filesystem::create_directories(FLASHGS_TEST_OUTPUT_DIR);
+  const std::string base = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/" + stem;
+  write_image(expected, base + "_expected.pfm");
+  write_image(actual, base + "_actual.pfm");
+  Image diff = expected;
+  for (std::size_t i = 0; i < diff.rgb.size() && i < actual.rgb.size(); ++i)
+    diff.rgb[i] = std::abs(expected.rgb[i] - actual.rgb[i]) * 10.0f;
+  write_image(diff, base + "_diff_x10.pfm");
+}
+
+}  // namespace flashgs::test
