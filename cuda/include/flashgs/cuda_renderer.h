@@ -1,0 +1,32 @@
+// The CUDA backend's public face: no CUDA headers here, so the CLI and viewer build without them.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "flashgs/renderer.h"
+
+namespace flashgs {
+
+// True when a CUDA device can run our kernels; otherwise `why` says what is missing.
+bool cuda_available(std::string* why);
+
+class CudaRenderer : public Renderer {
+ public:
+  // Renders and writes the frame as RGBA8 (alpha 255, values clamped to [0, 1]) into a CUDA
+  // surface object (a cudaSurfaceObject_t, e.g. of a GL texture mapped through interop);
+  // image row 0 (the top) goes to surface row 0. No copy to the host.
+  virtual void render_to_surface(const Camera& camera, const RenderOptions& options,
+                                 std::uint64_t surface_object, FrameStats* stats) = 0;
+  // Per-tile pair counts of the last frame (row-major tiles_y x tiles_x), copied from the
+  // device only when this is called.
+  virtual void download_tile_counts(std::vector<std::uint32_t>& counts) = 0;
+  // The cudaStream_t all work is queued on (for interop map/unmap on the same stream).
+  virtual void* stream() const = 0;
+};
+
+std::unique_ptr<CudaRenderer> make_cuda_renderer();
+
+}  // namespace flashgs
