@@ -41,7 +41,7 @@ std::vector<Camera> parse_cameras(const std::string& json_text, const std::strin
   json doc;
   try {
     doc = json::parse(json_text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors, and numbers beyond double range
     throw Error(name + ": not valid JSON (" + e.what() + ")");
   }
   if (!doc.is_array()) throw Error(name + ": expected a JSON array of cameras");

@@ -1,0 +1,160 @@
+// Fly / orbit navigation: rotations about the world-up axis and the camera's right axis, motion scaled by dt.
+#include "camera_controller.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace flashgs::viewer {
+namespace {
+
+glm::mat3 axis_rotation(const glm::vec3& axis, float angle) {
+  return glm::mat3(glm::rotate(glm::mat4(1.0f), angle, glm::normalize(axis)));
+}
+
+// Re-orthonormalise so that many small incremental rotations cannot drift into a shear.
+glm::mat3 orthonormalised(const glm::mat3& r) {
+  glm::vec3 f = glm::normalize(r[2]);
+  glm::vec3 x = glm::normalize(r[0] - f * glm::dot(r[0], f));
+  glm::vec3 y = glm::cross(f, x);  // OpenCV: x cross y = z, so y = z cross x
+  return glm::mat3(x, y, f);
+}
+
+}  // namespace
+
+Pose pose_of(const Camera& camera) {
+  Pose pose;
+  // camera.rotation is world-to-camera, row-major: its rows are the camera axes in world space.
+  for (int axis = 0; axis < 3; ++axis)
+    pose.rotation[axis] = glm::vec3(camera.rotation[axis * 3 + 0], camera.rotation[axis * 3 + 1],
+                                    camera.rotation[axis * 3 + 2]);
+  pose.position = glm::vec3(camera.position[0], camera.position[1], camera.position[2]);
+  return pose;
+}
+
+void CameraController::reset(const glm::vec3& centre, float extent, const glm::vec3& world_up) {
+  m_centre = centre;
+  m_extent = extent > 0.0f && std::isfinite(extent) ? extent : 1.0f;
+  m_up = glm::normalize(world_up);
+  m_pivot = centre;
+  m_snapped_valid = false;
+  // Default view: from a distance of two extents, looking at the centre, level with the horizon.
+  glm::vec3 any = std::abs(m_up.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, 1);
+  glm::vec3 forward = glm::normalize(glm::cross(m_up, any));
+  forward = glm::normalize(forward - m_up * 0.3f);
+  const glm::vec3 right = glm::normalize(glm::cross(m_up, forward) * -1.0f);
+  m_pose.rotation = orthonormalised(glm::mat3(right, glm::cross(forward, right), forward));
+  m_pose.position = centre - forward * (2.0f * m_extent);
+  m_orbit_distance = 2.0f * m_extent;
+}
+
+void CameraController::snap_to(const Camera& camera) {
+  m_pose = pose_of(camera);
+  m_snapped = camera;
+  m_snapped_valid = true;
+  m_snapped_fov = camera.horizontal_fov_degrees();
+  place_pivot_ahead();
+}
+
+void CameraController::set_pose(const Pose& pose, float) {
+  m_pose = pose;
+  m_snapped_valid = false;
+  place_pivot_ahead();
+}
+
+void CameraController::place_pivot_ahead() {
+  // The pivot is the point ahead of the camera nearest the scene centre: orbiting then keeps
+  // the object in view.
+  const glm::vec3 forward = m_pose.rotation[2];
+  const float along = glm::dot(m_centre - m_pose.position, forward);
+  m_orbit_distance = std::max(along, 0.05f * m_extent);
+  m_pivot = m_pose.position + forward * m_orbit_distance;
+}
+
+void CameraController::set_mode(NavigationMode mode) {
+  if (mode == NavigationMode::orbit && m_mode != mode) place_pivot_ahead();
+  m_mode = mode;
+}
+
+void CameraController::flip_up() {
+  m_up = -m_up;
+  // Half a turn about the view axis: right and down swap sign, forward stays.
+  m_pose.rotation[0] = -m_pose.rotation[0];
+  m_pose.rotation[1] = -m_pose.rotation[1];
+  m_snapped_valid = false;
+}
+
+void CameraController::rotate_view(float yaw, float pitch) {
+  // Yaw about the world-up axis (right-hand rule; negative turns toward the camera's right).
+  glm::mat3 r = axis_rotation(m_up, yaw) * m_pose.rotation;
+  // Pitch about the camera's right axis, refused where it would pass over the pole (the view
+  // would flip upside down).
+  const glm::mat3 pitched = axis_rotation(r[0], pitch) * r;
+  const float cos_to_up = glm::dot(pitched[2], m_up);
+  if (std::abs(cos_to_up) < 0.995f || std::abs(cos_to_up) < std::abs(glm::dot(r[2], m_up))) r = pitched;
+  m_pose.rotation = orthonormalised(r);
+}
+
+bool CameraController::update(const NavigationInput& in, float dt, ViewerSettings& settings) {
+  if (m_mode != settings.mode) set_mode(settings.mode);
+  bool changed = false;
+  const float sens = settings.look_sensitivity;
+  if (m_mode == NavigationMode::fly) {
+    if (in.scroll != 0.0f) settings.move_speed = std::clamp(settings.move_speed * std::pow(1.2f, in.scroll), 1e-4f, 1e4f);
+    if (in.look_dx != 0.0f || in.look_dy != 0.0f) {
+      rotate_view(-in.look_dx * sens, -in.look_dy * sens);
+      changed = true;
+    }
+    const glm::vec3 right = m_pose.rotation[0], forward = m_pose.rotation[2];
+    glm::vec3 dir = forward * float(in.forward - in.back) + right * float(in.right - in.left) +
+                    m_up * float(in.up - in.down);
+    if (glm::dot(dir, dir) > 0.0f) {
+      const float speed = settings.move_speed * m_extent * (in.fast ? 4.0f : 1.0f);
+      m_pose.position += glm::normalize(dir) * (speed * dt);
+      changed = true;
+    }
+    if (changed) place_pivot_ahead();
+  } else {
+    if (in.look_dx != 0.0f || in.look_dy != 0.0f) {
+      rotate_view(-in.look_dx * sens, -in.look_dy * sens);
+      changed = true;
+    }
+    if (in.pan_dx != 0.0f || in.pan_dy != 0.0f) {
+      const float k = m_orbit_distance * 0.0015f;
+      m_pivot -= (m_pose.rotation[0] * in.pan_dx + m_pose.rotation[1] * in.pan_dy) * k;
+      changed = true;
+    }
+    if (in.scroll != 0.0f) {
+      m_orbit_distance = std::clamp(m_orbit_distance * std::pow(0.88f, in.scroll), 1e-4f * m_extent, 1e3f * m_extent);
+      changed = true;
+    }
+    // W/S dolly toward the pivot at a rate proportional to the distance (frame-rate independent).
+    const float dolly = float(in.back - in.forward) * (in.fast ? 4.0f : 1.0f);
+    if (dolly != 0.0f) {
+      m_orbit_distance = std::clamp(m_orbit_distance * std::exp(dolly * dt), 1e-4f * m_extent, 1e3f * m_extent);
+      changed = true;
+    }
+    if (changed) m_pose.position = m_pivot - m_pose.rotation[2] * m_orbit_distance;
+  }
+  if (changed) m_snapped_valid = false;
+  return changed;
+}
+
+Camera CameraController::render_camera(int width, int height, float fov_x_degrees) const {
+  if (m_snapped_valid && std::abs(fov_x_degrees - m_snapped_fov) < 1e-4f) {
+    const double aspect_scene = double(m_snapped.width) / m_snapped.height;
+    const double aspect_view = double(width) / height;
+    // Same aspect: the scene camera resized exactly as `flashgs render -r WxH` does.
+    if (std::abs(aspect_scene / aspect_view - 1.0) < 1e-3) return m_snapped.resized(width, height);
+  }
+  const float fov = std::clamp(fov_x_degrees, 1.0f, 170.0f) * float(M_PI / 180.0);
+  const float f = 0.5f * float(width) / std::tan(0.5f * fov);
+  float c2w[9];
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) c2w[row * 3 + col] = m_pose.rotation[col][row];
+  const float centre[3] = {m_pose.position.x, m_pose.position.y, m_pose.position.z};
+  return Camera::from_pose(width, height, f, f, c2w, centre);
+}
+
+}  // namespace flashgs::viewer

@@ -1,0 +1,72 @@
+// CameraController: fly and orbit navigation of the viewer camera, frame-rate independent (no GL, no window).
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "flashgs/camera.h"
+#include "viewer_settings.h"
+
+namespace flashgs::viewer {
+
+// One frame of navigation input, already translated from the window system.
+struct NavigationInput {
+  bool forward = false, back = false, left = false, right = false;  // W S A D
+  bool down = false, up = false;                                    // Q E
+  bool fast = false;                                                // Shift
+  float look_dx = 0, look_dy = 0;  // window points dragged with the look button this frame
+  float pan_dx = 0, pan_dy = 0;    // orbit: window points dragged with the pan button
+  float scroll = 0;                // wheel steps this frame
+};
+
+// A pose in world space: centre and camera-to-world rotation whose columns are the camera's
+// x (right), y (down) and z (forward) axes, OpenCV convention like the scene's cameras.
+struct Pose {
+  glm::vec3 position{0.0f};
+  glm::mat3 rotation{1.0f};
+};
+
+class CameraController {
+ public:
+  // `extent` sets the speed and zoom scale (a typical size of the scene in world units);
+  // `centre` is the default orbit pivot; `world_up` the axis Q/E and mouse yaw use.
+  void reset(const glm::vec3& centre, float extent, const glm::vec3& world_up);
+  // Places the camera exactly at a scene camera; render_camera() reproduces it bit for bit at
+  // the same aspect ratio until the camera moves.
+  void snap_to(const Camera& camera);
+  void set_pose(const Pose& pose, float fov_x_degrees);
+  // Applies one frame of input over `dt` seconds; returns whether the view changed.
+  bool update(const NavigationInput& input, float dt, ViewerSettings& settings);
+  // Inverts the world-up axis and rolls the camera half a turn so the picture turns upright.
+  void flip_up();
+  void set_mode(NavigationMode mode);
+
+  // The camera to render at width x height.
+  Camera render_camera(int width, int height, float fov_x_degrees) const;
+
+  const Pose& pose() const { return m_pose; }
+  const glm::vec3& world_up() const { return m_up; }
+  float extent() const { return m_extent; }
+  const glm::vec3& pivot() const { return m_pivot; }
+  // Whether the camera still sits exactly on the snapped scene camera.
+  bool on_scene_camera() const { return m_snapped_valid; }
+
+ private:
+  void rotate_view(float yaw, float pitch);
+  void place_pivot_ahead();
+
+  Pose m_pose;
+  glm::vec3 m_up{0.0f, -1.0f, 0.0f};
+  glm::vec3 m_centre{0.0f};
+  glm::vec3 m_pivot{0.0f};
+  float m_extent = 1.0f;
+  float m_orbit_distance = 1.0f;
+  NavigationMode m_mode = NavigationMode::fly;
+  Camera m_snapped;
+  bool m_snapped_valid = false;
+  float m_snapped_fov = 0.0f;
+};
+
+// Pose of a scene camera (inverse of Camera's world-to-camera rotation).
+Pose pose_of(const Camera& camera);
+
+}  // namespace flashgs::viewer

@@ -1,0 +1,40 @@
+// LoadedScene: a scene with its cameras and the framing the viewer derives from them; loading never leaves a half-made scene.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "flashgs/camera.h"
+#include "flashgs/scene.h"
+
+namespace flashgs::viewer {
+
+struct LoadedScene {
+  std::string path;                     // the PLY (or a description for generated scenes)
+  std::string cameras_path;             // empty when none was found
+  std::shared_ptr<const Scene> scene;
+  std::vector<Camera> cameras;          // may be empty
+  LoadReport report;
+  std::string cameras_note;             // why there are no cameras, if so
+  glm::vec3 centre{0.0f};               // orbit pivot / default look-at
+  float extent = 1.0f;                  // typical size, sets navigation speeds
+  glm::vec3 up{0.0f, -1.0f, 0.0f};      // guessed world up
+  double load_seconds = 0;
+};
+
+// Loads `ply_path` and the cameras.json beside it (or `cameras_path`). Throws flashgs::Error
+// naming the file and the problem; a missing or broken cameras.json is not fatal (noted).
+LoadedScene load_scene(const std::string& ply_path, const std::string& cameras_path = "");
+// The procedural demo scene (`count` Gaussians) with orbit cameras, for runs where no file can travel.
+LoadedScene generate_demo_scene(std::size_t count);
+// `copies` copies of a loaded scene on a grid (large-scene benchmarks); cameras kept.
+LoadedScene tile_loaded_scene(const LoadedScene& source, int copies);
+
+// Guesses world up from the cameras (their mean "up" = -y axis), snapped to a coordinate axis
+// when close; -y (the COLMAP habit) without cameras.
+glm::vec3 guess_up(const std::vector<Camera>& cameras);
+
+}  // namespace flashgs::viewer

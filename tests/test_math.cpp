@@ -1,0 +1,186 @@
+// Unit tests of the shared per-Gaussian math: log, projection, exact ellipse-tile test, SH.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "flashgs/frame_params.h"
+#include "flashgs/gaussian_math.h"
+
+namespace flashgs {
+namespace {
+
+TEST(PortableLog, MatchesStdLogToAFewUlp) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> exponent(-40.0f, 40.0f);
+  double worst = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const float x = std::pow(2.0f, exponent(rng));
+    const double expected = std::log(static_cast<double>(x));
+    const double err = std::abs(gm::portable_log(x) - expected);
+    worst = std::max(worst, err / std::max(1.0, std::abs(expected)));
+  }
+  EXPECT_LT(worst, 4e-7) << "portable_log is the extent of every flash Gaussian";
+  EXPECT_TRUE(std::isinf(gm::portable_log(0.0f)));
+  EXPECT_NEAR(gm::portable_log(1e-40f), std::log(1e-40), 1e-4);  // subnormal input
+}
+
+Camera test_camera(int width, int height) {
+  const float c2w[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const float centre[3] = {0, 0, 0};
+  return Camera::from_pose(width, height, 0.8f * width, 0.8f * width, c2w, centre);
+}
+
+// A random Gaussian in front of the camera: position, scales over 4 decades, any rotation.
+struct RandomGaussian {
+  float position[3], scale[3], quat[4], opacity;
+};
+
+RandomGaussian random_gaussian(std::mt19937& rng) {
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  RandomGaussian g;
+  const float z = 1.0f + 9.0f * uni(rng);
+  g.position[0] = (uni(rng) - 0.5f) * z * 1.6f;
+  g.position[1] = (uni(rng) - 0.5f) * z;
+  g.position[2] = z;
+  for (float& s : g.scale) s = std::pow(10.0f, -3.0f + 2.5f * uni(rng));
+  float n = 0;
+  for (float& q : g.quat) { q = normal(rng); n += q * q; }
+  for (float& q : g.quat) q /= std::sqrt(n);
+  g.opacity = 0.005f + 0.995f * uni(rng);
+  return g;
+}
+
+// The guarantee the flash path rests on: a tile is never dropped when a pixel centre in it
+// has alpha >= tau (q <= threshold). Checked against every pixel centre of every tile in a
+// window around the box; false positives (tiles kept that no pixel needs) are counted.
+TEST(ExactTileTest, NeverDropsATileWherePixelsReachTau) {
+  const Camera camera = test_camera(256, 192);
+  const gm::CameraParams cam = make_camera_params(camera);
+  std::mt19937 rng(42);
+  long kept = 0, needed = 0, false_positive = 0, box_misses = 0;
+  for (int variant = 0; variant < 4; ++variant) {
+    RenderOptions options;
+    options.opacity_aware_radius = variant & 1;
+    options.tight_bbox = (variant & 2) != 0;
+    const gm::GeometryParams geo = make_geometry_params(options);
+    for (int n = 0; n < 1500; ++n) {
+      const RandomGaussian g = random_gaussian(rng);
+      gm::Footprint f;
+      if (gm::project(cam, geo, g.position, g.scale, g.quat, g.opacity, f) != gm::kVisible) continue;
+      for (int ty = 0; ty < cam.tiles_y; ++ty)
+        for (int tx = 0; tx < cam.tiles_x; ++tx) {
+          bool pixel_needs_tile = false;
+          for (int y = ty * 16; y < std::min(ty * 16 + 16, cam.height) && !pixel_needs_tile; ++y)
+            for (int x = tx * 16; x < std::min(tx * 16 + 16, cam.width); ++x) {
+              const float dx = x - f.mean_x, dy = y - f.mean_y;
+              if (f.conic_a * dx * dx + 2 * f.conic_b * dx * dy + f.conic_c * dy * dy <= f.threshold) {
+                pixel_needs_tile = true;
+                break;
+              }
+            }
+          const bool in_box = tx >= f.tile_x0 && tx < f.tile_x1 && ty >= f.tile_y0 && ty < f.tile_y1;
+          const bool test = in_box && gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height);
+          if (pixel_needs_tile) {
+            ++needed;
+            EXPECT_TRUE(in_box) << "box misses a needed tile";
+            EXPECT_TRUE(test) << "exact test drops a needed tile (" << tx << "," << ty << ")";
+            box_misses += in_box ? 0 : 1;
+          }
+          if (test) ++kept;
+          if (test && !pixel_needs_tile) ++false_positive;
+        }
+    }
+  }
+  ASSERT_GT(needed, 1000);
+  EXPECT_EQ(box_misses, 0);
+  std::printf("exact tile test: %ld tiles kept, %ld needed, %ld false positives (%.2f%%)\n", kept, needed,
+              false_positive, 100.0 * false_positive / std::max(1L, kept));
+}
+
+TEST(ExactTileTest, EllipseRectCases) {
+  // Unit circle q = dx^2 + dy^2 <= 1.
+  EXPECT_TRUE(gm::ellipse_meets_rect(1, 0, 1, 1, -1, 1, -1, 1));      // centre inside
+  EXPECT_TRUE(gm::ellipse_meets_rect(1, 0, 1, 1, 0.5f, 2, -1, 1));   // edge crosses
+  EXPECT_FALSE(gm::ellipse_meets_rect(1, 0, 1, 1, 1.5f, 2, -1, 1));  // right of the circle
+  EXPECT_FALSE(gm::ellipse_meets_rect(1, 0, 1, 1, 0.75f, 2, 0.75f, 2));  // corner outside (0.75^2*2 > 1)
+  EXPECT_TRUE(gm::ellipse_meets_rect(1, 0, 1, 1, 0.7f, 2, 0.7f, 2));     // corner inside (0.98 <= 1)
+  // A thin diagonal needle along x = y: reaches (3, 3) but not (3, -3).
+  const float a = 0.5f * (1 / 100.0f + 1 / 0.01f), b = 0.5f * (1 / 100.0f - 1 / 0.01f);
+  EXPECT_TRUE(gm::ellipse_meets_rect(a, b, a, 1, 2.5f, 3.5f, 2.5f, 3.5f));
+  EXPECT_FALSE(gm::ellipse_meets_rect(a, b, a, 1, 2.5f, 3.5f, -3.5f, -2.5f));
+}
+
+// A needle with scale ratio 1e6: the 2D determinant computed as a*c - b*b in float is noise,
+// the Cauchy-Binet form must agree with a double computation.
+TEST(Projection, StiffCovarianceKeepsAPositiveAccurateConic) {
+  const Camera camera = test_camera(512, 512);
+  const gm::CameraParams cam = make_camera_params(camera);
+  const gm::GeometryParams geo = make_geometry_params(RenderOptions::baseline());
+  const float position[3] = {0.1f, 0.05f, 4.0f};
+  const float scale[3] = {1.0f, 1e-6f, 1e-6f};
+  const float s = std::sqrt(0.5f);
+  const float quat[4] = {s, 0, 0, s};  // needle rotated into the image plane
+  gm::Footprint f;
+  ASSERT_EQ(gm::project(cam, geo, position, scale, quat, 0.9f, f), gm::kVisible);
+  EXPECT_GT(f.conic_a, 0);
+  EXPECT_GT(f.conic_c, 0);
+  EXPECT_GT(f.conic_a * f.conic_c - f.conic_b * f.conic_b, 0);
+  // In double: the covariance is ((J R S)(J R S)^T) + 0.3 I; the needle lies along y on
+  // screen, so sigma_yy ~ (fy * 1 / 4)^2 and sigma_xx ~ 0.3.
+  const double fy = camera.fy, sigma_yy = std::pow(fy / 4.0, 2) + 0.3;
+  EXPECT_NEAR(1.0 / f.conic_a, 0.3, 0.3 * 1e-3);  // conic_a ~ 1 / sigma_xx when b ~ 0
+  EXPECT_NEAR(f.conic_c, 1.0 / sigma_yy, 1e-3 / sigma_yy);
+}
+
+TEST(Projection, CullsNearAndDegenerate) {
+  const gm::CameraParams cam = make_camera_params(test_camera(64, 64));
+  const gm::GeometryParams geo = make_geometry_params(RenderOptions{});
+  const float scale[3] = {0.1f, 0.1f, 0.1f}, quat[4] = {1, 0, 0, 0};
+  gm::Footprint f;
+  const float behind[3] = {0, 0, -1}, at_near[3] = {0, 0, 0.2f}, nan_pos[3] = {NAN, 0, 1};
+  EXPECT_EQ(gm::project(cam, geo, behind, scale, quat, 0.9f, f), gm::kCulledNear);
+  EXPECT_EQ(gm::project(cam, geo, at_near, scale, quat, 0.9f, f), gm::kCulledNear);
+  EXPECT_EQ(gm::project(cam, geo, nan_pos, scale, quat, 0.9f, f), gm::kCulledDegenerate);
+  const float front[3] = {0, 0, 2};
+  EXPECT_EQ(gm::project(cam, geo, front, scale, quat, 0.5f / 255.0f, f), gm::kCulledLowOpacity);
+  const float huge[3] = {1e30f, 1e30f, 1e30f};  // radius overflows: culled, never UB
+  EXPECT_NE(gm::project(cam, geo, front, huge, quat, 0.9f, f), gm::kVisible);
+}
+
+TEST(Projection, OpacityAwareExtentMatchesTheAlphaThreshold) {
+  const gm::CameraParams cam = make_camera_params(test_camera(128, 128));
+  RenderOptions options;
+  const gm::GeometryParams geo = make_geometry_params(options);
+  const float position[3] = {0, 0, 5}, scale[3] = {0.05f, 0.05f, 0.05f}, quat[4] = {1, 0, 0, 0};
+  gm::Footprint f;
+  ASSERT_EQ(gm::project(cam, geo, position, scale, quat, 0.8f, f), gm::kVisible);
+  // At q = threshold alpha equals tau.
+  EXPECT_NEAR(0.8 * std::exp(-0.5 * f.threshold), options.tau, 1e-6);
+}
+
+TEST(SphericalHarmonics, DegreeZeroIsTheDcTerm) {
+  const float cam[3] = {0, 0, 0}, pos[3] = {1, 2, 3}, dc[3] = {1.0f, -1.0f, 0.0f};
+  float rgb[3];
+  gm::sh_to_rgb<0>(cam, pos, dc, nullptr, rgb);
+  EXPECT_NEAR(rgb[0], 0.5f + gm::kShC0, 1e-6);
+  EXPECT_NEAR(rgb[1], 0.5f - gm::kShC0, 1e-6);
+  EXPECT_NEAR(rgb[2], 0.5f, 1e-6);
+}
+
+TEST(SphericalHarmonics, BandOneFollowsTheViewDirection) {
+  // Coefficient 3 multiplies -C1 * x: seen along +x the colour drops, along -x it rises.
+  const float cam[3] = {0, 0, 0}, dc[3] = {0, 0, 0};
+  float rest[9] = {0, 0, 0, 0, 0, 0, 1, 1, 1};
+  const float along_x[3] = {1, 0, 0}, against_x[3] = {-1, 0, 0};
+  float a[3], b[3];
+  gm::sh_to_rgb<1>(cam, along_x, dc, rest, a);
+  gm::sh_to_rgb<1>(cam, against_x, dc, rest, b);
+  EXPECT_NEAR(a[0], std::max(0.0f, 0.5f - gm::kShC1), 1e-6);
+  EXPECT_NEAR(b[0], 0.5f + gm::kShC1, 1e-6);
+}
+
+}  // namespace
+}  // namespace flashgs

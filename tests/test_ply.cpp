@@ -1,0 +1,254 @@
+// PLY loading: layouts read from the header, and one test per kind of malformed file.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "flashgs/error.h"
+#include "flashgs/io.h"
+#include "ply_builder.h"
+#include "test_support.h"
+
+namespace flashgs {
+namespace {
+
+using test::PlyBuilder;
+
+Scene parse(const std::string& bytes, LoadReport* report = nullptr) {
+  return parse_ply(bytes.data(), bytes.size(), "test.ply", report);
+}
+
+// Expects parsing to fail with a message naming the file and containing `fragment`.
+void expect_error(const std::string& bytes, const std::string& fragment) {
+  try {
+    parse(bytes);
+    ADD_FAILURE() << "expected an error containing \"" << fragment << "\"";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind("test.ply: ", 0), 0u) << message;
+    EXPECT_NE(message.find(fragment), std::string::npos) << "message: " << message;
+  }
+}
+
+TEST(PlyLoad, InriaLayoutAllDegrees) {
+  for (int degree = 0; degree <= 3; ++degree) {
+    LoadReport report;
+    const Scene s = parse(PlyBuilder::inria(degree, 5).bytes(), &report);
+    EXPECT_EQ(s.size(), 5u);
+    EXPECT_EQ(s.sh_degree, degree);
+    EXPECT_EQ(s.sh_rest.size(), 5u * s.sh_rest_per_gaussian());
+    EXPECT_EQ(report.ignored_properties, 3u);  // nx ny nz
+    EXPECT_NEAR(s.opacities[0], 1.0 / (1.0 + std::exp(-1.0)), 1e-6);
+    EXPECT_NEAR(s.scales[0], std::exp(-3.0), 1e-7);
+  }
+}
+
+TEST(PlyLoad, RestCoefficientsAreReorderedToCoefficientMajor) {
+  PlyBuilder b = PlyBuilder::inria(1, 1);
+  for (int k = 0; k < 9; ++k) b.vertices[0][b.index_of("f_rest_" + std::to_string(k))] = k;
+  const Scene s = parse(b.bytes());
+  // File: R0 R1 R2 G0 G1 G2 B0 B1 B2 -> ours [k][ch]: (R0 G0 B0) (R1 G1 B1) (R2 G2 B2)
+  const float expected[9] = {0, 3, 6, 1, 4, 7, 2, 5, 8};
+  for (int i = 0; i < 9; ++i) EXPECT_EQ(s.sh_rest[i], expected[i]);
+}
+
+TEST(PlyLoad, AnyPropertyOrderAndExtraProperties) {
+  PlyBuilder b = PlyBuilder::inria(0, 3);
+  PlyBuilder shuffled;
+  const std::vector<int> order = {12, 0, 5, 11, 1, 6, 7, 10, 2, 8, 9, 3, 4, 13, 14, 15, 16};
+  for (int i : order) shuffled.properties.push_back(b.properties[i]);
+  shuffled.properties.push_back({"double", "extra_thing"});
+  for (const auto& v : b.vertices) {
+    std::vector<double> w;
+    for (int i : order) w.push_back(v[i]);
+    w.push_back(123.0);
+    shuffled.vertices.push_back(w);
+  }
+  const Scene a = parse(b.bytes()), c = parse(shuffled.bytes());
+  EXPECT_EQ(a.positions, c.positions);
+  EXPECT_EQ(a.scales, c.scales);
+  EXPECT_EQ(a.opacities, c.opacities);
+  EXPECT_EQ(a.rotations, c.rotations);
+}
+
+TEST(PlyLoad, QuaternionsAreNormalised) {
+  PlyBuilder b = PlyBuilder::inria(0, 1);
+  b.vertices[0][b.index_of("rot_0")] = 2.0;
+  b.vertices[0][b.index_of("rot_1")] = 2.0;
+  const Scene s = parse(b.bytes());
+  EXPECT_NEAR(s.rotations[0], std::sqrt(0.5), 1e-6);
+  EXPECT_NEAR(s.rotations[1], std::sqrt(0.5), 1e-6);
+}
+
+TEST(PlyLoad, ZeroQuaternionBecomesIdentityAndIsCounted) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  b.vertices[1][b.index_of("rot_0")] = 0.0;
+  LoadReport report;
+  const Scene s = parse(b.bytes(), &report);
+  EXPECT_EQ(report.repaired_zero_quaternion, 1u);
+  EXPECT_EQ(s.rotations[4], 1.0f);
+}
+
+TEST(PlyLoad, BigEndianAndAsciiReadTheSameValues) {
+  const PlyBuilder little = PlyBuilder::inria(2, 4);
+  PlyBuilder big = little, ascii = little;
+  big.format = "binary_big_endian";
+  ascii.format = "ascii";
+  const Scene a = parse(little.bytes()), b = parse(big.bytes()), c = parse(ascii.bytes());
+  EXPECT_EQ(a.positions, b.positions);
+  EXPECT_EQ(a.sh_rest, b.sh_rest);
+  EXPECT_EQ(a.positions, c.positions);
+  EXPECT_EQ(a.sh_rest, c.sh_rest);
+  EXPECT_EQ(a.opacities, c.opacities);
+}
+
+TEST(PlyLoad, NonFiniteAttributesDropTheGaussianAndAreCounted) {
+  PlyBuilder b = PlyBuilder::inria(1, 6);
+  b.vertices[0][b.index_of("x")] = NAN;
+  b.vertices[1][b.index_of("opacity")] = INFINITY;
+  b.vertices[2][b.index_of("f_rest_4")] = -INFINITY;
+  b.vertices[3][b.index_of("scale_1")] = 100.0;  // exp(100) overflows float
+  LoadReport report;
+  const Scene s = parse(b.bytes(), &report);
+  EXPECT_EQ(s.size(), 2u);
+  EXPECT_EQ(report.dropped_non_finite, 4u);
+}
+
+TEST(PlyLoad, ExtremeButFiniteValuesLoad) {
+  PlyBuilder b = PlyBuilder::inria(0, 3);
+  b.vertices[0][b.index_of("opacity")] = 1e4;
+  b.vertices[1][b.index_of("opacity")] = -1e4;
+  b.vertices[2][b.index_of("scale_0")] = -100.0;
+  const Scene s = parse(b.bytes());
+  EXPECT_EQ(s.opacities[0], 1.0f);
+  EXPECT_EQ(s.opacities[1], 0.0f);
+  EXPECT_GE(s.scales[6], 0.0f);
+}
+
+TEST(PlyMalformed, NotAPlyFile) { expect_error("hello world\n", "not a PLY file"); }
+
+TEST(PlyMalformed, EmptyFile) { expect_error("", "not a PLY file"); }
+
+TEST(PlyMalformed, HeaderWithoutEnd) { expect_error("ply\nformat binary_little_endian 1.0\nelement vertex 3\n", "end_header"); }
+
+TEST(PlyMalformed, TruncatedData) {
+  const std::string bytes = PlyBuilder::inria(0, 10).bytes();
+  expect_error(bytes.substr(0, bytes.size() - 7), "truncated");
+}
+
+TEST(PlyMalformed, CountLargerThanData) {
+  PlyBuilder b = PlyBuilder::inria(0, 10);
+  b.declared_count = 11;
+  expect_error(b.bytes(), "truncated");
+}
+
+TEST(PlyMalformed, CountSmallerThanData) {
+  PlyBuilder b = PlyBuilder::inria(0, 10);
+  b.declared_count = 9;
+  expect_error(b.bytes(), "does not match the file size");
+}
+
+TEST(PlyMalformed, AbsurdVertexCount) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  b.declared_count = 4000000000000000LL;
+  expect_error(b.bytes(), "truncated");
+}
+
+TEST(PlyMalformed, ZeroVertices) {
+  PlyBuilder b = PlyBuilder::inria(0, 0);
+  expect_error(b.bytes(), "0 vertices");
+}
+
+TEST(PlyMalformed, MissingRequiredProperty) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  const int i = b.index_of("opacity");
+  b.properties.erase(b.properties.begin() + i);
+  for (auto& v : b.vertices) v.erase(v.begin() + i);
+  expect_error(b.bytes(), "no property \"opacity\"");
+}
+
+TEST(PlyMalformed, NonFloatPropertyType) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  b.properties[b.index_of("opacity")].first = "uchar";
+  expect_error(b.bytes(), "opacity has type uchar");
+}
+
+TEST(PlyMalformed, UnknownFormat) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  b.format = "binary_middle_endian";
+  expect_error(b.bytes(), "unknown PLY format");
+}
+
+TEST(PlyMalformed, WrongRestCount) {
+  PlyBuilder b = PlyBuilder::inria(1, 2);
+  const int i = b.index_of("f_rest_8");
+  b.properties.erase(b.properties.begin() + i);
+  for (auto& v : b.vertices) v.erase(v.begin() + i);
+  expect_error(b.bytes(), "8 f_rest properties");
+}
+
+TEST(PlyMalformed, GarbageInAscii) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  b.format = "ascii";
+  std::string bytes = b.bytes();
+  bytes[bytes.size() - 4] = 'q';
+  expect_error(bytes, "is not a number");
+}
+
+TEST(PlyMalformed, AllGaussiansNonFinite) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  for (auto& v : b.vertices) v[0] = NAN;
+  expect_error(b.bytes(), "NaN or Inf");
+}
+
+TEST(PlyMalformed, MissingFile) {
+  try {
+    load_ply("/nonexistent/scene.ply");
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.ply: cannot open"), std::string::npos) << e.what();
+  }
+}
+
+// The tool itself: a malformed file gives one line naming it, a non-zero exit, quickly.
+TEST(PlyMalformed, CommandLineExitsNonZeroWithTheMessage) {
+  const std::string dir = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/malformed";
+  std::filesystem::create_directories(dir);
+  const std::string ply = dir + "/truncated.ply";
+  const std::string bytes = PlyBuilder::inria(0, 10).bytes();
+  std::ofstream(ply, std::ios::binary) << bytes.substr(0, bytes.size() - 3);
+  const std::string log = dir + "/log.txt";
+  const auto start = std::chrono::steady_clock::now();
+  const int status = std::system((std::string(FLASHGS_CLI) + " info " + ply + " > " + log + " 2>&1").c_str());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::ifstream in(log);
+  const std::string output((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(status, 0);
+  EXPECT_NE(output.find(ply + ": "), std::string::npos) << output;
+  EXPECT_NE(output.find("truncated"), std::string::npos) << output;
+  EXPECT_LT(seconds, 1.0);
+}
+
+// The donut's untouched trainer output (no normals, no f_rest, other property order,
+// unnormalised quaternions) must load to the same Gaussians as its INRIA-layout twin.
+TEST(PlyRealScenes, DonutTrainerOutputMatchesItsInriaTwin) {
+  const std::string dir = test::shared_scene_dir("v3dg_donut");
+  if (dir.empty()) GTEST_SKIP() << "../shared/scenes/v3dg_donut is absent";
+  LoadReport report;
+  const Scene original = load_ply(dir + "/original_mip_splatting.ply", &report);
+  const Scene inria = load_ply(dir + "/point_cloud.ply");
+  ASSERT_EQ(original.size(), inria.size());
+  EXPECT_EQ(report.ignored_properties, 0u);
+  double worst = 0;
+  for (std::size_t i = 0; i < inria.rotations.size(); ++i)
+    worst = std::max(worst, static_cast<double>(std::abs(original.rotations[i] - inria.rotations[i])));
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_EQ(original.positions, inria.positions);
+}
+
+}  // namespace
+}  // namespace flashgs

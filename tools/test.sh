@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Sets up (packages, build) and runs every test. Real-scene tests use ../shared/scenes when it
+# exists and skip otherwise; GPU tests skip without a CUDA device.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bash "$root/tools/setup.sh"
+cd "${FLASHGS_BUILD_DIR:-$root/build}"
+ctest --output-on-failure -j "$(nproc)" "$@"
