@@ -29,9 +29,19 @@ void blend_tile(const Frame& frame, const std::uint64_t* keys, std::uint64_t cou
   }
   for (std::uint64_t k = 0; k < count && active_count > 0; ++k) {
     const BlendGaussian& g = frame.blend_data[static_cast<std::uint32_t>(keys[k])];
+    const float slope = -g.conic_b / g.conic_a;
     for (int y = 0; y < tile_h; ++y) {
       const float dy = static_cast<float>(y_begin + y) - g.mean_y;
-      for (int x = 0; x < tile_w; ++x) {
+      // Only the pixels of this row that can reach power_cut; the margins (0.5 in q, one
+      // pixel each side) exceed the float rounding of the per-pixel power, so pruning never
+      // changes which pixels pass the exact test below.
+      const float row_q = g.row_q_coeff * dy * dy;
+      if (!(row_q <= g.q_cut + 0.5f)) continue;
+      const float centre = g.mean_x + slope * dy - static_cast<float>(x_begin);
+      const float half = std::sqrt(std::max(0.0f, g.q_cut + 0.5f - row_q) / g.conic_a) + 1.0f;
+      const int x0 = static_cast<int>(std::max(0.0f, std::ceil(centre - half)));
+      const int x1 = static_cast<int>(std::min(static_cast<float>(tile_w - 1), std::floor(centre + half)));
+      for (int x = x0; x <= x1; ++x) {
         const int p = y * gm::kTileSize + x;
         if (!active[p]) continue;
         const float dx = static_cast<float>(x_begin + x) - g.mean_x;

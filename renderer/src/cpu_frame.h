@@ -20,6 +20,11 @@ struct BlendGaussian {
   float rgb[3];
   // Below this power, alpha < 1/255 for certain (a margin keeps the exact test authoritative).
   float power_cut;
+  // Row pruning: over a row at offset dy the smallest q is row_q_coeff * dy^2, reached at
+  // dx = -conic_b / conic_a * dy; pixels farther than sqrt((q_cut - q) / conic_a) from it
+  // cannot pass power_cut.
+  float row_q_coeff;
+  float q_cut;
 };
 
 // Reused from frame to frame; vectors only grow (high-water mark), nothing is freed.

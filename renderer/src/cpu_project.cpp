@@ -29,6 +29,11 @@ void project_all(const Scene& scene, Frame& frame) {
     g.conic_c = f.conic_c;
     g.opacity = opacity;
     g.power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
+    // (a c - b^2) / a in double: the float products are exact there, so a nearly singular
+    // conic (a needle on screen) keeps an accurate row minimum.
+    const double a = f.conic_a, b = f.conic_b, c = f.conic_c;
+    g.row_q_coeff = static_cast<float>(std::max(0.0, (a * c - b * b) / a));
+    g.q_cut = -2.0f * g.power_cut;
     gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], &scene.sh_dc[i * 3],
                           DEGREE > 0 ? rest + i * rest_n : nullptr, g.rgb);
   }
