@@ -266,11 +266,19 @@ FLASHGS_HD bool footprint_touches_tile(const Footprint& f, int tx, int ty, int w
 // Real spherical harmonics constants (degree 0..3) of the 3DGS colour model.
 constexpr float kShC0 = 0.28209479177387814f;
 constexpr float kShC1 = 0.4886025119029199f;
-constexpr float kShC2[5] = {1.0925484305920792f, -1.0925484305920792f, 0.31539156525252005f,
-                            -1.0925484305920792f, 0.5462742152960396f};
-constexpr float kShC3[7] = {-0.5900435899266435f, 2.890611442640554f, -0.4570457994644658f,
-                            0.3731763325901154f, -0.4570457994644658f, 1.445305721320277f,
-                            -0.5900435899266435f};
+// Scalars, not arrays: a namespace-scope constexpr array cannot be read in CUDA device code.
+constexpr float kShC2_0 = 1.0925484305920792f;
+constexpr float kShC2_1 = -1.0925484305920792f;
+constexpr float kShC2_2 = 0.31539156525252005f;
+constexpr float kShC2_3 = -1.0925484305920792f;
+constexpr float kShC2_4 = 0.5462742152960396f;
+constexpr float kShC3_0 = -0.5900435899266435f;
+constexpr float kShC3_1 = 2.890611442640554f;
+constexpr float kShC3_2 = -0.4570457994644658f;
+constexpr float kShC3_3 = 0.3731763325901154f;
+constexpr float kShC3_4 = -0.4570457994644658f;
+constexpr float kShC3_5 = 1.445305721320277f;
+constexpr float kShC3_6 = -0.5900435899266435f;
 
 // SH basis values for a unit direction, for bands 0..degree (DEGREE is a template argument so
 // that a degree-0 scene compiles to no SH work at all).
@@ -284,19 +292,19 @@ FLASHGS_HD void sh_basis(float x, float y, float z, float basis[16]) {
   }
   if (DEGREE > 1) {
     const float xx = x * x, yy = y * y, zz = z * z;
-    basis[4] = kShC2[0] * x * y;
-    basis[5] = kShC2[1] * y * z;
-    basis[6] = kShC2[2] * (2.0f * zz - xx - yy);
-    basis[7] = kShC2[3] * x * z;
-    basis[8] = kShC2[4] * (xx - yy);
+    basis[4] = kShC2_0 * x * y;
+    basis[5] = kShC2_1 * y * z;
+    basis[6] = kShC2_2 * (2.0f * zz - xx - yy);
+    basis[7] = kShC2_3 * x * z;
+    basis[8] = kShC2_4 * (xx - yy);
     if (DEGREE > 2) {
-      basis[9] = kShC3[0] * y * (3.0f * xx - yy);
-      basis[10] = kShC3[1] * x * y * z;
-      basis[11] = kShC3[2] * y * (4.0f * zz - xx - yy);
-      basis[12] = kShC3[3] * z * (2.0f * zz - 3.0f * xx - 3.0f * yy);
-      basis[13] = kShC3[4] * x * (4.0f * zz - xx - yy);
-      basis[14] = kShC3[5] * z * (xx - yy);
-      basis[15] = kShC3[6] * x * (xx - 3.0f * yy);
+      basis[9] = kShC3_0 * y * (3.0f * xx - yy);
+      basis[10] = kShC3_1 * x * y * z;
+      basis[11] = kShC3_2 * y * (4.0f * zz - xx - yy);
+      basis[12] = kShC3_3 * z * (2.0f * zz - 3.0f * xx - 3.0f * yy);
+      basis[13] = kShC3_4 * x * (4.0f * zz - xx - yy);
+      basis[14] = kShC3_5 * z * (xx - yy);
+      basis[15] = kShC3_6 * x * (xx - 3.0f * yy);
     }
   }
 }
