@@ -1,0 +1,429 @@
+// The CUDA backend's host side: scene upload, buffer growth, stage launches, events, stats.
+#include <cuda_runtime.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "flashgs/cuda_renderer.h"
+#include "flashgs/error.h"
+#include "flashgs/frame_params.h"
+#include "pipeline.h"
+
+namespace flashgs {
+
+namespace cuda {
+
+void check_cuda(cudaError_t status, const char* what) {
+  if (status == cudaSuccess) return;
+  cudaGetLastError();  // clear a sticky-free error so later calls are not blamed for it
+  throw Error(std::string("cuda renderer: ") + what + " failed: " + cudaGetErrorString(status));
+}
+
+}  // namespace cuda
+
+bool cuda_available(std::string* why) {
+  int count = 0;
+  const cudaError_t status = cudaGetDeviceCount(&count);
+  if (status != cudaSuccess) {
+    cudaGetLastError();
+    if (why) *why = cudaGetErrorString(status);
+    return false;
+  }
+  if (count == 0) {
+    if (why) *why = "no CUDA device";
+    return false;
+  }
+  cudaDeviceProp prop{};
+  if (cudaGetDeviceProperties(&prop, 0) != cudaSuccess || prop.major < 7) {
+    cudaGetLastError();
+    if (why) *why = "device 0 is older than compute capability 7.0";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+using cuda::check_cuda;
+
+// One device allocation; grows (discarding its content) but never shrinks. The owner's byte
+// counters follow every change so FrameStats can report current and peak memory.
+class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  ~DeviceBuffer() { release(); }
+  void bind(std::uint64_t* current, std::uint64_t* peak) {
+    current_ = current;
+    peak_ = peak;
+  }
+  // Ensures at least `bytes`; throws flashgs::Error when the device has no room.
+  void reserve(std::size_t bytes, const char* what) {
+    if (bytes <= bytes_) return;
+    release();
+    void* p = nullptr;
+    const cudaError_t status = cudaMalloc(&p, bytes);
+    if (status != cudaSuccess) {
+      cudaGetLastError();
+      std::size_t free_bytes = 0, total_bytes = 0;
+      cudaMemGetInfo(&free_bytes, &total_bytes);
+      throw Error(std::string("cuda renderer: out of GPU memory allocating ") + what + " (" +
+                  std::to_string(bytes >> 20) + " MiB; " + std::to_string(free_bytes >> 20) + " of " +
+                  std::to_string(total_bytes >> 20) + " MiB free)");
+    }
+    ptr_ = p;
+    bytes_ = bytes;
+    if (current_) {
+      *current_ += bytes;
+      *peak_ = std::max(*peak_, *current_);
+    }
+  }
+  void release() {
+    if (!ptr_) return;
+    cudaFree(ptr_);
+    if (current_) *current_ -= bytes_;
+    ptr_ = nullptr;
+    bytes_ = 0;
+  }
+  void swap(DeviceBuffer& other) {  // content and size; counters stay with each owner
+    std::swap(ptr_, other.ptr_);
+    std::swap(bytes_, other.bytes_);
+  }
+  template <typename T>
+  T* as() const { return static_cast<T*>(ptr_); }
+  std::size_t bytes() const { return bytes_; }
+
+ private:
+  void* ptr_ = nullptr;
+  std::size_t bytes_ = 0;
+  std::uint64_t* current_ = nullptr;
+  std::uint64_t* peak_ = nullptr;
+};
+
+int bits_for(std::uint64_t values) {  // bits to hold 0 .. values - 1
+  int bits = 0;
+  while (bits < 64 && (std::uint64_t{1} << bits) < values) ++bits;
+  return bits;
+}
+
+class CudaRendererImpl final : public CudaRenderer {
+ public:
+  CudaRendererImpl() {
+    check_cuda(cudaGetDevice(&device_), "cudaGetDevice");
+    cudaDeviceProp prop{};
+    check_cuda(cudaGetDeviceProperties(&prop, device_), "cudaGetDeviceProperties");
+    device_name_ = prop.name;
+    check_cuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "stream creation");
+    for (cudaEvent_t& e : events_) check_cuda(cudaEventCreate(&e), "event creation");
+    check_cuda(cudaMallocHost(&host_counters_, sizeof(cuda::FrameCounters)), "pinned counter allocation");
+    for (DeviceBuffer* b : working_buffers()) b->bind(&working_bytes_, &peak_bytes_);
+    counters_.reserve(sizeof(cuda::FrameCounters), "frame counters");
+  }
+
+  ~CudaRendererImpl() override {
+    if (stream_) cudaStreamSynchronize(stream_);
+    for (DeviceBuffer* b : working_buffers()) b->release();
+    for (DeviceBuffer* b : scene_buffers()) b->release();
+    for (cudaEvent_t e : events_)
+      if (e) cudaEventDestroy(e);
+    if (host_counters_) cudaFreeHost(host_counters_);
+    if (stream_) cudaStreamDestroy(stream_);
+  }
+
+  std::string name() const override { return "cuda (" + device_name_ + ")"; }
+  void* stream() const override { return stream_; }
+
+  void set_scene(std::shared_ptr<const Scene> scene) override {
+    if (!scene) throw Error("cuda renderer: null scene");
+    const std::size_t n = scene->size();
+    if (n >= (std::size_t{1} << 32) - 1)
+      throw Error("cuda renderer: " + std::to_string(n) + " Gaussians exceed the 32-bit Gaussian index");
+    const int degree = scene->sh_degree;
+    const int rest_floats = scene->sh_rest_per_gaussian();
+    const int stride_vec4 = (rest_floats + 3) / 4;
+
+    // Host staging in the device layout.
+    std::vector<float4> position_opacity(n), rotation(n), scale_dc_r(n), rest(n * stride_vec4);
+    std::vector<float2> dc_gb(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float* p = &scene->positions[i * 3];
+      const float* s = &scene->scales[i * 3];
+      const float* q = &scene->rotations[i * 4];
+      const float* dc = &scene->sh_dc[i * 3];
+      position_opacity[i] = make_float4(p[0], p[1], p[2], scene->opacities[i]);
+      rotation[i] = make_float4(q[0], q[1], q[2], q[3]);
+      scale_dc_r[i] = make_float4(s[0], s[1], s[2], dc[0]);
+      dc_gb[i] = make_float2(dc[1], dc[2]);
+      if (stride_vec4 > 0) {
+        float* dst = reinterpret_cast<float*>(&rest[i * stride_vec4]);
+        std::memset(dst, 0, sizeof(float4) * stride_vec4);
+        std::memcpy(dst, &scene->sh_rest[i * rest_floats], sizeof(float) * rest_floats);
+      }
+    }
+
+    // Allocate the new scene next to the old one; on failure the old one stays.
+    DeviceBuffer new_pos, new_rot, new_scale, new_dc, new_rest;
+    const std::size_t m = std::max<std::size_t>(n, 1);
+    new_pos.reserve(m * sizeof(float4), "scene positions");
+    new_rot.reserve(m * sizeof(float4), "scene rotations");
+    new_scale.reserve(m * sizeof(float4), "scene scales");
+    new_dc.reserve(m * sizeof(float2), "scene colours");
+    if (stride_vec4 > 0) new_rest.reserve(n * stride_vec4 * sizeof(float4), "scene SH bands");
+    // Per-Gaussian frame buffers of the fused path; the separate path's grow on first use.
+    blend_.reserve(m * sizeof(cuda::BlendGaussian), "per-Gaussian blend data");
+
+    check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation");
+    auto upload = [](DeviceBuffer& dst, const void* src, std::size_t bytes) {
+      if (bytes) check_cuda(cudaMemcpy(dst.as<void>(), src, bytes, cudaMemcpyHostToDevice), "scene upload");
+    };
+    upload(new_pos, position_opacity.data(), n * sizeof(float4));
+    upload(new_rot, rotation.data(), n * sizeof(float4));
+    upload(new_scale, scale_dc_r.data(), n * sizeof(float4));
+    upload(new_dc, dc_gb.data(), n * sizeof(float2));
+    upload(new_rest, rest.data(), rest.size() * sizeof(float4));
+    scene_pos_.swap(new_pos);
+    scene_rot_.swap(new_rot);
+    scene_scale_.swap(new_scale);
+    scene_dc_.swap(new_dc);
+    scene_rest_.swap(new_rest);
+
+    device_scene_.count = n;
+    device_scene_.sh_degree = degree;
+    device_scene_.rest_stride_vec4 = stride_vec4;
+    device_scene_.position_opacity = scene_pos_.as<float4>();
+    device_scene_.rotation = scene_rot_.as<float4>();
+    device_scene_.scale_dc_r = scene_scale_.as<float4>();
+    device_scene_.dc_gb = scene_dc_.as<float2>();
+    device_scene_.sh_rest = scene_rest_.as<float4>();
+    scene_ = std::move(scene);
+    last_tiles_ = 0;
+  }
+
+  void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
+    run_frame(camera, options, &out, 0, stats);
+  }
+
+  void render_to_surface(const Camera& camera, const RenderOptions& options, std::uint64_t surface_object,
+                         FrameStats* stats) override {
+    run_frame(camera, options, nullptr, surface_object, stats);
+  }
+
+  void download_tile_counts(std::vector<std::uint32_t>& counts) override {
+    std::vector<uint2> ranges(last_tiles_);
+    if (last_tiles_)
+      check_cuda(cudaMemcpyAsync(ranges.data(), ranges_.as<void>(), last_tiles_ * sizeof(uint2),
+                                 cudaMemcpyDeviceToHost, stream_),
+                 "tile range download");
+    check_cuda(cudaStreamSynchronize(stream_), "tile range download");
+    counts.resize(last_tiles_);
+    for (std::size_t t = 0; t < last_tiles_; ++t) counts[t] = ranges[t].y - ranges[t].x;
+  }
+
+ private:
+  enum Event { kBegin, kProjected, kScanned, kCounted, kEmitBegin, kEmitted, kSortBegin, kSorted, kRanged, kBlended,
+               kEventCount };
+
+  std::vector<DeviceBuffer*> working_buffers() {
+    return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
+            &values_[1], &ranges_, &image_, &cub_temp_};
+  }
+  std::vector<DeviceBuffer*> scene_buffers() { return {&scene_pos_, &scene_rot_, &scene_scale_, &scene_dc_, &scene_rest_}; }
+
+  cuda::FrameBuffers frame_buffers() const {
+    cuda::FrameBuffers b;
+    b.blend = blend_.as<cuda::BlendGaussian>();
+    b.footprints = footprints_.as<gm::Footprint>();
+    b.pair_counts = pair_counts_.as<std::uint32_t>();
+    b.pair_offsets = pair_offsets_.as<std::uint32_t>();
+    for (int k = 0; k < 2; ++k) {
+      b.keys[k] = keys_[k].as<std::uint64_t>();
+      b.values[k] = values_[k].as<std::uint32_t>();
+    }
+    b.pair_capacity = pair_capacity_;
+    b.tile_ranges = ranges_.as<uint2>();
+    b.tile_capacity = ranges_.bytes() / sizeof(uint2);
+    b.image_rgb = image_.as<float>();
+    b.pixel_capacity = image_.bytes() / (3 * sizeof(float));
+    b.cub_temp = cub_temp_.as<void>();
+    b.cub_temp_bytes = cub_temp_.bytes();
+    b.counters = counters_.as<cuda::FrameCounters>();
+    b.host_counters = host_counters_;
+    return b;
+  }
+
+  // Pair buffers for at least `pairs`, with a quarter of headroom so that a camera moving
+  // through the scene does not grow them every few frames.
+  void grow_pairs(std::uint64_t pairs) {
+    if (pairs <= pair_capacity_) return;
+    const std::uint64_t capacity = std::max<std::uint64_t>(pairs + pairs / 4, 1u << 16);
+    pair_capacity_ = 0;  // stays 0 if an allocation below throws: nothing can be written
+    for (int k = 0; k < 2; ++k) {
+      keys_[k].reserve(capacity * sizeof(std::uint64_t), "sort keys");
+      values_[k].reserve(capacity * sizeof(std::uint32_t), "sort values");
+    }
+    pair_capacity_ = capacity;
+    grow_cub_temp();
+  }
+
+  void grow_cub_temp() {
+    cub_temp_.reserve(std::max<std::size_t>(cuda::cub_temp_bytes_needed(device_scene_.count, pair_capacity_), 16),
+                      "sort scratch");
+  }
+
+  float elapsed(Event a, Event b) const {
+    float ms = 0;
+    check_cuda(cudaEventElapsedTime(&ms, events_[a], events_[b]), "event timing");
+    return ms;
+  }
+
+  void run_frame(const Camera& camera, const RenderOptions& options, Image* out, std::uint64_t surface,
+                 FrameStats* stats_out) {
+    if (!scene_) throw Error("cuda renderer: no scene set");
+    if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
+    const gm::CameraParams cam = make_camera_params(camera);
+    const std::uint64_t tiles = static_cast<std::uint64_t>(cam.tiles_x) * cam.tiles_y;
+    const std::uint64_t pixels = static_cast<std::uint64_t>(cam.width) * cam.height;
+    const std::size_t n = device_scene_.count;
+    const bool baseline = options.is_baseline();
+    const bool fused = !baseline && options.fused_emit;
+
+    ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
+    if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
+    if (!fused) {
+      footprints_.reserve(std::max<std::size_t>(n, 1) * sizeof(gm::Footprint), "per-Gaussian footprints");
+      pair_counts_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair counts");
+      pair_offsets_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair offsets");
+    }
+    if (!cub_temp_.bytes()) grow_cub_temp();
+
+    cuda::PreprocessArgs args{};
+    args.camera = cam;
+    args.geometry = make_geometry_params(options);
+    args.exact_tile_test = options.uses_exact_tile_test();
+    args.warp_cooperative = !baseline && options.warp_cooperative_emit;
+    args.exp2_alpha = !baseline && options.exp2_alpha;
+    args.sh_degree = std::max(0, std::min(device_scene_.sh_degree, options.sh_degree_cap));
+
+    // project (+ fused emit), then the frame's one read back: the pair count. Fused emission
+    // that overflowed wrote nothing past the capacity; grow and run it again.
+    std::uint64_t pairs = 0;
+    for (int attempt = 0;; ++attempt) {
+      const cuda::FrameBuffers b = frame_buffers();
+      check_cuda(cudaMemsetAsync(b.counters, 0, sizeof(cuda::FrameCounters), stream_), "counter reset");
+      check_cuda(cudaEventRecord(events_[kBegin], stream_), "event record");
+      cuda::launch_preprocess(device_scene_, b, args, fused, stream_);
+      check_cuda(cudaEventRecord(events_[kProjected], stream_), "event record");
+      if (!fused) cuda::launch_scan(n, b, stream_);
+      check_cuda(cudaEventRecord(events_[kScanned], stream_), "event record");
+      check_cuda(cudaMemcpyAsync(host_counters_, b.counters, sizeof(cuda::FrameCounters), cudaMemcpyDeviceToHost,
+                                 stream_),
+                 "pair count read back");
+      check_cuda(cudaEventRecord(events_[kCounted], stream_), "event record");
+      check_cuda(cudaEventSynchronize(events_[kCounted]), "preprocess");
+      pairs = host_counters_->pairs;
+      if (pairs > static_cast<std::uint64_t>(INT32_MAX))
+        throw Error("cuda renderer: the frame needs " + std::to_string(pairs) +
+                    " Gaussian-tile pairs, more than the 2^31 the sort can take");
+      if (pairs <= pair_capacity_) break;
+      grow_pairs(pairs);
+      if (!fused) break;  // nothing was written yet
+      if (attempt > 0) throw Error("cuda renderer: internal error, pair count changed between identical runs");
+    }
+
+    const cuda::FrameBuffers b = frame_buffers();
+    check_cuda(cudaEventRecord(events_[kEmitBegin], stream_), "event record");
+    if (!fused) cuda::launch_duplicate(n, b, cam, args.exact_tile_test, stream_);
+    check_cuda(cudaEventRecord(events_[kEmitted], stream_), "event record");
+
+    // 3DGS itself sorts 32 + bits(tiles); the flash switch turns that off to show its value.
+    const int tile_bits = std::max(bits_for(tiles), 1);
+    const int end_bit = (baseline || options.minimal_sort_bits) ? std::min(64, 32 + tile_bits) : 64;
+    check_cuda(cudaEventRecord(events_[kSortBegin], stream_), "event record");
+    const int which = cuda::launch_sort(pairs, end_bit, b, stream_);
+    check_cuda(cudaEventRecord(events_[kSorted], stream_), "event record");
+    cuda::launch_ranges(pairs, tiles, b.keys[which], b.values[which], b.tile_ranges, stream_);
+    check_cuda(cudaEventRecord(events_[kRanged], stream_), "event record");
+
+    cuda::BlendArgs blend{};
+    blend.width = cam.width;
+    blend.height = cam.height;
+    blend.tiles_x = cam.tiles_x;
+    blend.tiles_y = cam.tiles_y;
+    for (int k = 0; k < 3; ++k) blend.background[k] = options.background[k];
+    blend.kernel = baseline ? cuda::BlendKernel::per_pixel
+                            : (options.pipelined_blend ? cuda::BlendKernel::warp_tile_pipelined
+                                                       : cuda::BlendKernel::warp_tile);
+    blend.exp2_alpha = args.exp2_alpha;
+    blend.values = b.values[which];
+    blend.tile_ranges = b.tile_ranges;
+    blend.gaussians = b.blend;
+    blend.image_rgb = out ? b.image_rgb : nullptr;
+    blend.surface = surface;
+    cuda::launch_blend(blend, stream_);
+    check_cuda(cudaEventRecord(events_[kBlended], stream_), "event record");
+    last_tiles_ = tiles;
+
+    if (out) {
+      if (out->width != camera.width || out->height != camera.height) out->resize(camera.width, camera.height);
+      check_cuda(cudaMemcpyAsync(out->rgb.data(), b.image_rgb, pixels * 3 * sizeof(float), cudaMemcpyDeviceToHost,
+                                 stream_),
+                 "image download");
+      check_cuda(cudaStreamSynchronize(stream_), "frame");
+    } else if (stats_out) {
+      check_cuda(cudaEventSynchronize(events_[kBlended]), "frame");
+    }
+    if (!stats_out) return;
+
+    FrameStats stats;
+    const cuda::FrameCounters& c = *host_counters_;
+    stats.kv_pairs = pairs;
+    stats.tiles_x = cam.tiles_x;
+    stats.tiles_y = cam.tiles_y;
+    stats.gaussians = n;
+    stats.visible = c.visible;
+    stats.culled_near = c.culled_near;
+    stats.culled_offscreen = c.culled_offscreen;
+    stats.culled_low_opacity = c.culled_low_opacity;
+    stats.culled_degenerate = c.culled_degenerate;
+    // GPU time of each stage between events; host gaps (the pair-count wait) are not counted.
+    stats.times.project_ms = elapsed(kBegin, kProjected);
+    stats.times.emit_ms = elapsed(kProjected, kScanned) + elapsed(kEmitBegin, kEmitted);
+    stats.times.sort_ms = elapsed(kSortBegin, kSorted);
+    stats.times.ranges_ms = elapsed(kSorted, kRanged);
+    stats.times.blend_ms = elapsed(kRanged, kBlended);
+    stats.times.total_ms = stats.times.project_ms + stats.times.emit_ms + stats.times.sort_ms +
+                           stats.times.ranges_ms + stats.times.blend_ms;
+    stats.device_memory_bytes = working_bytes_;
+    stats.device_peak_bytes = peak_bytes_;
+    if (options.collect_tile_counts) {
+      download_tile_counts(stats.tile_pair_counts);
+      for (std::uint32_t v : stats.tile_pair_counts) stats.max_tile_pairs = std::max(stats.max_tile_pairs, v);
+    }
+    *stats_out = std::move(stats);
+  }
+
+  int device_ = 0;
+  std::string device_name_;
+  cudaStream_t stream_ = nullptr;
+  cudaEvent_t events_[kEventCount] = {};
+  cuda::FrameCounters* host_counters_ = nullptr;
+  std::shared_ptr<const Scene> scene_;
+  cuda::DeviceScene device_scene_;
+  std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;
+  std::uint64_t pair_capacity_ = 0;
+  std::size_t last_tiles_ = 0;
+  // Scene (not counted as working memory).
+  DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_;
+  // Working memory.
+  DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, image_,
+      cub_temp_;
+};
+
+}  // namespace
+
+std::unique_ptr<CudaRenderer> make_cuda_renderer() { return std::make_unique<CudaRendererImpl>(); }
+
+}  // namespace flashgs

@@ -1,0 +1,120 @@
+// Internal to the CUDA backend: the device-resident scene, the per-frame buffers and the
+// launch functions of each stage (one .cu per stage), shared by the host class and kernels.
+#pragma once
+
+#include <cuda_runtime_api.h>
+#include <vector_types.h>
+
+#include <cstddef>
+#include <cstdint>
+
+#include "flashgs/gaussian_math.h"
+
+namespace flashgs {
+namespace cuda {
+
+constexpr int kWarp = 32;
+// A Gaussian whose tile box holds more than this many tiles is emitted by a whole warp
+// (FlashGS section 4.3): below it one thread's loop is shorter than the warp's bookkeeping.
+constexpr int kLargeBoxTiles = 16;
+
+// The scene on the device, in a compact layout sized to its SH degree (56 bytes per Gaussian
+// for degree 0, plus 48/96/192 bytes of higher bands for degree 1/2/3).
+struct DeviceScene {
+  std::size_t count = 0;
+  int sh_degree = 0;
+  int rest_stride_vec4 = 0;           // float4s of higher-band SH per Gaussian (padded)
+  float4* position_opacity = nullptr;  // [count] world x, y, z; opacity in [0, 1]
+  float4* rotation = nullptr;          // [count] unit quaternion w, x, y, z
+  float4* scale_dc_r = nullptr;        // [count] linear scale x, y, z; SH DC red
+  float2* dc_gb = nullptr;             // [count] SH DC green, blue
+  float4* sh_rest = nullptr;           // [count][rest_stride_vec4] bands 1.., [k][channel], zero padded
+};
+
+// What the blend stage reads per Gaussian (48 bytes, three 16-byte loads). In exp2 mode the
+// conic is pre-scaled by -log2(e)/2 (b by -log2(e)) and the opacity is stored as log2(o), so
+// alpha = exp2(q' + log2 o) with no multiply; otherwise it is the CPU's raw conic and opacity.
+struct alignas(16) BlendGaussian {
+  float mean_x, mean_y, conic_a, conic_b;
+  float conic_c, opacity, red, green;
+  float blue, pad0, pad1, pad2;
+};
+
+// Counters one frame accumulates on the device; copied to the host once per frame.
+struct FrameCounters {
+  unsigned long long pairs;        // Gaussian-tile pairs wanted (may exceed capacity)
+  unsigned int visible;            // Gaussians with at least one pair
+  unsigned int culled_near;
+  unsigned int culled_offscreen;   // box or ellipse missed every tile
+  unsigned int culled_low_opacity;
+  unsigned int culled_degenerate;
+  unsigned int pad;
+};
+
+// Buffers of the frame pipeline; every size is a high-water mark (grown, never shrunk).
+struct FrameBuffers {
+  // Per Gaussian (sized to the scene at set_scene).
+  BlendGaussian* blend = nullptr;         // [gaussians]
+  gm::Footprint* footprints = nullptr;    // [gaussians] separate-emission path only
+  std::uint32_t* pair_counts = nullptr;   // [gaussians] pairs per Gaussian (separate path)
+  std::uint32_t* pair_offsets = nullptr;  // [gaussians] inclusive prefix sum of pair_counts
+  // Per pair: key = tile << 32 | depth bits, value = Gaussian id; two of each for the sort.
+  std::uint64_t* keys[2] = {nullptr, nullptr};    // [pair_capacity]
+  std::uint32_t* values[2] = {nullptr, nullptr};  // [pair_capacity]
+  std::uint64_t pair_capacity = 0;
+  // Per tile: [start, end) of its pairs in the sorted list.
+  uint2* tile_ranges = nullptr;  // [tile_capacity]
+  std::uint64_t tile_capacity = 0;
+  // Frame image, float RGB, row 0 at the top.
+  float* image_rgb = nullptr;  // [pixel_capacity * 3]
+  std::uint64_t pixel_capacity = 0;
+  void* cub_temp = nullptr;  // sort and scan scratch
+  std::size_t cub_temp_bytes = 0;
+  FrameCounters* counters = nullptr;       // [1] device
+  FrameCounters* host_counters = nullptr;  // [1] pinned host
+};
+
+struct PreprocessArgs {
+  gm::CameraParams camera;
+  gm::GeometryParams geometry;
+  bool exact_tile_test;
+  bool warp_cooperative;
+  bool exp2_alpha;
+  int sh_degree;  // bands evaluated (the scene's, capped)
+};
+
+// project (+ fused key emission when `fused`).
+void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
+                       bool fused, cudaStream_t stream);
+// Separate emission (3DGS duplicateWithKeys): writes the keys of every Gaussian at its offset.
+void launch_duplicate(std::size_t gaussians, const FrameBuffers& buffers, const gm::CameraParams& camera,
+                      bool exact_tile_test, cudaStream_t stream);
+// CUB scratch bytes needed by scan and sort for these sizes.
+std::size_t cub_temp_bytes_needed(std::size_t gaussians, std::uint64_t pairs);
+// Inclusive scan pair_counts -> pair_offsets.
+void launch_scan(std::size_t gaussians, const FrameBuffers& buffers, cudaStream_t stream);
+// Radix sort of `pairs` keys over bits [0, end_bit); returns which buffer (0/1) holds the result.
+int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, cudaStream_t stream);
+// Tile ranges from the sorted keys, and the equal-key runs put in Gaussian-id order.
+void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const std::uint64_t* keys, std::uint32_t* values,
+                   uint2* tile_ranges, cudaStream_t stream);
+
+enum class BlendKernel { per_pixel, warp_tile, warp_tile_pipelined };
+struct BlendArgs {
+  int width, height, tiles_x, tiles_y;
+  float background[3];
+  BlendKernel kernel;
+  bool exp2_alpha;
+  const std::uint32_t* values;   // sorted Gaussian ids
+  const uint2* tile_ranges;
+  const BlendGaussian* gaussians;
+  float* image_rgb;              // float output, or
+  unsigned long long surface;    // RGBA8 surface (when image_rgb is null)
+};
+void launch_blend(const BlendArgs& args, cudaStream_t stream);
+
+// Throws flashgs::Error naming `what` when `status` is not cudaSuccess.
+void check_cuda(cudaError_t status, const char* what);
+
+}  // namespace cuda
+}  // namespace flashgs

@@ -1,0 +1,225 @@
+// Stage `project` (+ fused `emit`): cull, 2D footprint, SH colour and, in the FlashGS path,
+// the Gaussian-tile keys, all in one pass over the scene.
+#include <math.h>
+
+#include "device_common.cuh"
+#include "flashgs/gaussian_math.h"
+#include "pipeline.h"
+
+namespace flashgs {
+namespace cuda {
+namespace {
+
+constexpr int kBlock = 256;
+constexpr float kLog2e = 1.4426950408889634f;
+
+// Higher SH bands of Gaussian i into registers: only the float4s that DEGREE needs are read,
+// whatever degree the scene was stored with.
+template <int DEGREE>
+__device__ __forceinline__ void colour(const DeviceScene& scene, unsigned i, const gm::CameraParams& cam,
+                                       const float pos[3], const float dc[3], float rgb[3]) {
+  if constexpr (DEGREE == 0) {
+    gm::sh_to_rgb<0>(cam.position, pos, dc, nullptr, rgb);
+  } else {
+    constexpr int kRest = ((DEGREE + 1) * (DEGREE + 1) - 1) * 3;
+    constexpr int kVec = (kRest + 3) / 4;
+    float rest[kVec * 4];
+    const float4* src = scene.sh_rest + static_cast<std::size_t>(i) * scene.rest_stride_vec4;
+#pragma unroll
+    for (int k = 0; k < kVec; ++k) {
+      const float4 v = __ldg(src + k);
+      rest[4 * k + 0] = v.x;
+      rest[4 * k + 1] = v.y;
+      rest[4 * k + 2] = v.z;
+      rest[4 * k + 3] = v.w;
+    }
+    gm::sh_to_rgb<DEGREE>(cam.position, pos, dc, rest, rgb);
+  }
+}
+
+__device__ __forceinline__ bool touches(const gm::Footprint& f, int tx, int ty, const gm::CameraParams& cam,
+                                        bool exact) {
+  return !exact || gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height);
+}
+
+// One thread per Gaussian. FUSED: keys are written here (FlashGS); otherwise the footprint
+// and the pair count are stored for the separate prefix sum + duplicate pass (3DGS).
+template <int DEGREE, bool FUSED>
+__global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, FrameBuffers buf,
+                                                            PreprocessArgs args) {
+  __shared__ unsigned block_counts[5];  // visible, near, offscreen, low opacity, degenerate
+  if (threadIdx.x < 5) block_counts[threadIdx.x] = 0;
+  __syncthreads();
+
+  const unsigned i = blockIdx.x * kBlock + threadIdx.x;
+  const unsigned lane = lane_id();
+  const bool valid = i < scene.count;
+  const gm::CameraParams& cam = args.camera;
+
+  gm::Footprint f{};
+  int reason = gm::kCulledDegenerate;
+  unsigned count = 0;          // pairs of this Gaussian (small path / separate path)
+  unsigned passed_mask = 0;    // tiles of a box of <= 32 tiles that passed the exact test
+  bool large = false;          // emitted by the whole warp below
+  if (valid) {
+    const float4 po = __ldg(scene.position_opacity + i);
+    const float4 q = __ldg(scene.rotation + i);
+    const float4 sd = __ldg(scene.scale_dc_r + i);
+    const float pos[3] = {po.x, po.y, po.z};
+    const float scale[3] = {sd.x, sd.y, sd.z};
+    const float quat[4] = {q.x, q.y, q.z, q.w};
+    reason = gm::project(cam, args.geometry, pos, scale, quat, po.w, f);
+    if (reason == gm::kVisible) {
+      const float2 gb = __ldg(scene.dc_gb + i);
+      const float dc[3] = {sd.w, gb.x, gb.y};
+      float rgb[3];
+      colour<DEGREE>(scene, i, cam, pos, dc, rgb);
+      float4* out = reinterpret_cast<float4*>(buf.blend + i);
+      if (args.exp2_alpha) {
+        // q' = -log2(e)/2 q, so o e^(-q/2) = exp2(q' + log2 o): one exp2, no multiply.
+        const float ha = -0.5f * kLog2e;
+        out[0] = make_float4(f.mean_x, f.mean_y, ha * f.conic_a, -kLog2e * f.conic_b);
+        out[1] = make_float4(ha * f.conic_c, log2f(po.w), rgb[0], rgb[1]);
+      } else {
+        out[0] = make_float4(f.mean_x, f.mean_y, f.conic_a, f.conic_b);
+        out[1] = make_float4(f.conic_c, po.w, rgb[0], rgb[1]);
+      }
+      out[2] = make_float4(rgb[2], 0.0f, 0.0f, 0.0f);
+
+      const int box_w = f.tile_x1 - f.tile_x0;
+      const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
+      if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kLargeBoxTiles)) {
+        large = true;
+      } else if (!args.exact_tile_test) {
+        count = box;
+      } else {
+        unsigned k = 0;
+        for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
+          for (int tx = f.tile_x0; tx < f.tile_x1; ++tx, ++k)
+            if (gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height)) {
+              ++count;
+              if (k < 32) passed_mask |= 1u << k;
+            }
+      }
+    }
+  }
+
+  if constexpr (FUSED) {
+    const std::uint32_t depth_bits = gm::depth_bits(f.depth);
+    // Thread-emitted Gaussians: one atomic per warp reserves all their pairs.
+    const unsigned inclusive = warp_inclusive_sum(count);
+    const unsigned warp_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
+    unsigned long long base = 0;
+    if (lane == kWarp - 1 && warp_total > 0) base = atomicAdd(&buf.counters->pairs, warp_total);
+    base = __shfl_sync(kFullMask, base, kWarp - 1);
+    if (count > 0) {
+      unsigned long long offset = base + inclusive - count;
+      const int box_w = f.tile_x1 - f.tile_x0;
+      const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
+      if (args.exact_tile_test && box <= 32) {
+        for (unsigned m = passed_mask; m; m &= m - 1) {
+          const unsigned k = __ffs(m) - 1;
+          const unsigned tile = (f.tile_y0 + k / box_w) * cam.tiles_x + f.tile_x0 + k % box_w;
+          store_pair(buf, offset++, tile, depth_bits, i);
+        }
+      } else {
+        for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
+          for (int tx = f.tile_x0; tx < f.tile_x1; ++tx)
+            if (touches(f, tx, ty, cam, args.exact_tile_test))
+              store_pair(buf, offset++, static_cast<unsigned>(ty) * cam.tiles_x + tx, depth_bits, i);
+      }
+    }
+    // Large Gaussians: the warp tests 32 tiles at a time, counts with a reduction, reserves
+    // with one atomic, then writes with ballot + popc offsets (FlashGS section 4.3).
+    unsigned pending = __ballot_sync(kFullMask, large);
+    while (pending) {
+      const int src = __ffs(pending) - 1;
+      pending &= pending - 1;
+      gm::Footprint g;
+      g.mean_x = __shfl_sync(kFullMask, f.mean_x, src);
+      g.mean_y = __shfl_sync(kFullMask, f.mean_y, src);
+      g.conic_a = __shfl_sync(kFullMask, f.conic_a, src);
+      g.conic_b = __shfl_sync(kFullMask, f.conic_b, src);
+      g.conic_c = __shfl_sync(kFullMask, f.conic_c, src);
+      g.threshold = __shfl_sync(kFullMask, f.threshold, src);
+      g.tile_x0 = __shfl_sync(kFullMask, f.tile_x0, src);
+      g.tile_y0 = __shfl_sync(kFullMask, f.tile_y0, src);
+      g.tile_x1 = __shfl_sync(kFullMask, f.tile_x1, src);
+      g.tile_y1 = __shfl_sync(kFullMask, f.tile_y1, src);
+      const std::uint32_t g_depth = __shfl_sync(kFullMask, depth_bits, src);
+      const unsigned g_id = __shfl_sync(kFullMask, i, src);
+      const unsigned box_w = static_cast<unsigned>(g.tile_x1 - g.tile_x0);
+      const unsigned box = box_w * static_cast<unsigned>(g.tile_y1 - g.tile_y0);
+      unsigned lane_count = 0;
+      if (args.exact_tile_test) {
+        for (unsigned t = lane; t < box; t += kWarp)
+          lane_count += touches(g, g.tile_x0 + t % box_w, g.tile_y0 + t / box_w, cam, true) ? 1u : 0u;
+      } else {
+        lane_count = lane == 0 ? box : 0u;
+      }
+      const unsigned total = __reduce_add_sync(kFullMask, lane_count);
+      unsigned long long g_base = 0;
+      if (lane == 0 && total > 0) g_base = atomicAdd(&buf.counters->pairs, total);
+      g_base = __shfl_sync(kFullMask, g_base, 0);
+      if (total > 0) {
+        const unsigned lanes_below = (1u << lane) - 1u;
+        for (unsigned t0 = 0; t0 < box; t0 += kWarp) {
+          const unsigned t = t0 + lane;
+          const unsigned tx = g.tile_x0 + t % box_w, ty = g.tile_y0 + t / box_w;
+          const bool pass = t < box && touches(g, tx, ty, cam, args.exact_tile_test);
+          const unsigned ballot = __ballot_sync(kFullMask, pass);
+          if (pass) store_pair(buf, g_base + __popc(ballot & lanes_below), ty * cam.tiles_x + tx, g_depth, g_id);
+          g_base += __popc(ballot);
+        }
+      }
+      if (static_cast<int>(lane) == src) count = total;
+    }
+  } else {
+    if (valid) {
+      buf.pair_counts[i] = count;
+      if (count > 0) buf.footprints[i] = f;
+    }
+    const unsigned warp_total = __reduce_add_sync(kFullMask, count);
+    if (lane == 0 && warp_total > 0) atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(warp_total));
+  }
+
+  if (valid) {
+    int slot;
+    if (reason == gm::kVisible) slot = count > 0 ? 0 : 2;  // box met the image, the ellipse did not
+    else if (reason == gm::kCulledNear) slot = 1;
+    else if (reason == gm::kCulledOffscreen) slot = 2;
+    else if (reason == gm::kCulledLowOpacity) slot = 3;
+    else slot = 4;
+    atomicAdd(&block_counts[slot], 1u);
+  }
+  __syncthreads();
+  if (threadIdx.x < 5 && block_counts[threadIdx.x] > 0) {
+    unsigned* dst = threadIdx.x == 0 ? &buf.counters->visible : &buf.counters->culled_near + (threadIdx.x - 1);
+    atomicAdd(dst, block_counts[threadIdx.x]);
+  }
+}
+
+template <bool FUSED>
+void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
+                       cudaStream_t stream) {
+  const unsigned blocks = static_cast<unsigned>((scene.count + kBlock - 1) / kBlock);
+  switch (args.sh_degree) {
+    case 0: preprocess_kernel<0, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
+    case 1: preprocess_kernel<1, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
+    case 2: preprocess_kernel<2, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
+    default: preprocess_kernel<3, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
+  }
+}
+
+}  // namespace
+
+void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
+                       bool fused, cudaStream_t stream) {
+  if (scene.count == 0) return;
+  if (fused) launch_for_degree<true>(scene, buffers, args, stream);
+  else launch_for_degree<false>(scene, buffers, args, stream);
+  check_cuda(cudaGetLastError(), "preprocess kernel launch");
+}
+
+}  // namespace cuda
+}  // namespace flashgs

@@ -1,0 +1,54 @@
+// Stage `sort` (CUB radix sort of the pair keys over only the bits the frame needs) and the
+// prefix sum of the separate emission path.
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_scan.cuh>
+
+#include <algorithm>
+#include <climits>
+#include <string>
+
+#include "flashgs/error.h"
+#include "pipeline.h"
+
+namespace flashgs {
+namespace cuda {
+
+std::size_t cub_temp_bytes_needed(std::size_t gaussians, std::uint64_t pairs) {
+  std::size_t scan_bytes = 0, sort_bytes = 0;
+  check_cuda(cub::DeviceScan::InclusiveSum(nullptr, scan_bytes, static_cast<const std::uint32_t*>(nullptr),
+                                           static_cast<std::uint32_t*>(nullptr), static_cast<int>(gaussians)),
+             "cub scan size query");
+  cub::DoubleBuffer<std::uint64_t> keys(nullptr, nullptr);
+  cub::DoubleBuffer<std::uint32_t> values(nullptr, nullptr);
+  check_cuda(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, keys, values, static_cast<int>(pairs), 0, 64),
+             "cub sort size query");
+  return std::max(scan_bytes, sort_bytes);
+}
+
+void launch_scan(std::size_t gaussians, const FrameBuffers& b, cudaStream_t stream) {
+  if (gaussians == 0) return;
+  std::size_t bytes = b.cub_temp_bytes;
+  check_cuda(cub::DeviceScan::InclusiveSum(b.cub_temp, bytes, b.pair_counts, b.pair_offsets,
+                                           static_cast<int>(gaussians), stream),
+             "cub inclusive scan");
+}
+
+int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& b, cudaStream_t stream) {
+  if (pairs == 0) return 0;
+  if (pairs > static_cast<std::uint64_t>(INT_MAX))
+    throw Error("cuda renderer: " + std::to_string(pairs) + " Gaussian-tile pairs exceed the sort's limit");
+  cub::DoubleBuffer<std::uint64_t> keys(b.keys[0], b.keys[1]);
+  cub::DoubleBuffer<std::uint32_t> values(b.values[0], b.values[1]);
+  std::size_t needed = 0;
+  check_cuda(cub::DeviceRadixSort::SortPairs(nullptr, needed, keys, values, static_cast<int>(pairs), 0, end_bit),
+             "cub sort size query");
+  if (needed > b.cub_temp_bytes) throw Error("cuda renderer: internal error, sort scratch too small");
+  std::size_t bytes = b.cub_temp_bytes;
+  check_cuda(cub::DeviceRadixSort::SortPairs(b.cub_temp, bytes, keys, values, static_cast<int>(pairs), 0, end_bit,
+                                             stream),
+             "cub radix sort");
+  return keys.selector;
+}
+
+}  // namespace cuda
+}  // namespace flashgs
