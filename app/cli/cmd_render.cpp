@@ -20,7 +20,7 @@ struct RenderCommand {
   void run() const {
     const std::string scene_path = scene.resolved_scene();
     auto loaded = load_scene_verbose(scene_path);
-    const Camera cam = camera.select(load_cameras(scene.resolved_cameras()));
+    const Camera cam = camera.select(scene.resolved_cameras());
     auto renderer = make_backend(render.backend);
     renderer->set_scene(loaded);
     const RenderOptions options = render.options();

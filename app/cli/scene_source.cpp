@@ -6,6 +6,7 @@
 
 #include "backend_factory.h"
 #include "flashgs/error.h"
+#include "flashgs/generators.h"
 #include "flashgs/io.h"
 
 namespace flashgs::cli {
@@ -75,6 +76,12 @@ RenderOptions RenderArgs::options() const {
 void CameraArgs::add_to(CLI::App* command) {
   command->add_option("--camera,-c", index, "camera index in cameras.json");
   command->add_option("--resolution,-r", resolution, "render size WxH (field of view kept)");
+  auto* eye_option = command->add_option("--eye", eye, "explicit camera: position x,y,z")->delimiter(',')->expected(3);
+  command->add_option("--look-at", look_at, "explicit camera: target x,y,z")->delimiter(',')->expected(3)->needs(eye_option);
+  eye_option->needs("--look-at");
+  command->add_option("--up", up, "explicit camera: world up x,y,z (default 0,-1,0: y down, as in most 3DGS scenes)")
+      ->delimiter(',')->expected(3);
+  command->add_option("--fov", fov_degrees, "explicit camera: horizontal field of view in degrees")->check(CLI::Range(1.0, 179.0));
 }
 
 void parse_resolution(const std::string& text, int* width, int* height) {
@@ -87,7 +94,15 @@ void parse_resolution(const std::string& text, int* width, int* height) {
   *height = h;
 }
 
-Camera CameraArgs::select(const std::vector<Camera>& cameras) const {
+Camera CameraArgs::select(const std::string& cameras_path) const {
+  if (is_explicit()) {
+    int w = 1920, h = 1080;
+    if (!resolution.empty()) parse_resolution(resolution, &w, &h);
+    Camera camera = look_at_camera(eye.data(), look_at.data(), up.data(), w, h, fov_degrees);
+    camera.name = "explicit";
+    return camera;
+  }
+  const std::vector<Camera> cameras = load_cameras(cameras_path);
   if (index < 0 || index >= static_cast<int>(cameras.size()))
     throw Error("camera " + std::to_string(index) + " does not exist (the file has " + std::to_string(cameras.size()) +
                 ": 0.." + std::to_string(cameras.size() - 1) + ")");

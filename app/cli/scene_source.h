@@ -44,8 +44,13 @@ struct RenderArgs {
 struct CameraArgs {
   int index = 0;
   std::string resolution;  // "WxH"; empty: the camera's own
+  // An explicit camera instead of cameras.json: eye and target given.
+  std::vector<float> eye, look_at, up = {0, -1, 0};
+  float fov_degrees = 60.0f;
   void add_to(CLI::App* command);
-  Camera select(const std::vector<Camera>& cameras) const;
+  bool is_explicit() const { return !eye.empty(); }
+  // The explicit camera, or camera `index` of the file at `cameras_path` (read only then).
+  Camera select(const std::string& cameras_path) const;
 };
 
 // "1920x1080" -> (1920, 1080); throws flashgs::Error on anything else.

@@ -21,6 +21,20 @@ void push_gaussian(Scene& s, const float p[3], const float scale[3], const float
   for (int k = 0; k < s.sh_rest_per_gaussian(); ++k) s.sh_rest.push_back(rest ? rest[k] : 0.0f);
 }
 
+void cross(const float a[3], const float b[3], float out[3]) {
+  out[0] = a[1] * b[2] - a[2] * b[1];
+  out[1] = a[2] * b[0] - a[0] * b[2];
+  out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+// Scales v to unit length; false (v unchanged) when it is (nearly) zero.
+bool normalize(float v[3]) {
+  const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!(len > 1e-12f)) return false;
+  for (int k = 0; k < 3; ++k) v[k] /= len;
+  return true;
+}
+
 // Quaternion (w, x, y, z) rotating +x onto the unit vector d.
 void quaternion_from_x_to(const float d[3], float q[4]) {
   const float dot = d[0];
@@ -87,40 +101,46 @@ Scene make_demo_scene(std::size_t count, std::uint32_t seed) {
   return s;
 }
 
+Camera look_at_camera(const float eye[3], const float target[3], const float up[3], int width, int height,
+                      float fov_degrees) {
+  float forward[3];
+  for (int k = 0; k < 3; ++k) forward[k] = target[k] - eye[k];
+  normalize(forward);
+  // OpenCV axes: x right, y down, z forward; right = forward x up.
+  float right[3];
+  cross(forward, up, right);
+  if (!normalize(right)) {  // looking along up: any perpendicular will do
+    const float other[3] = {up[1], up[2], up[0]};
+    cross(forward, other, right);
+    normalize(right);
+  }
+  float down[3];
+  cross(forward, right, down);
+  // camera-to-world: its columns are the camera axes in world space.
+  const float c2w[9] = {right[0], down[0], forward[0], right[1], down[1], forward[1], right[2], down[2], forward[2]};
+  const float fx = 0.5f * width / std::tan(0.5f * fov_degrees * static_cast<float>(M_PI) / 180.0f);
+  return Camera::from_pose(width, height, fx, fx, c2w, eye);
+}
+
 std::vector<Camera> make_orbit_cameras(const float target[3], const float up[3], float radius, float height,
                                        int count, int width, int height_px, float fov_degrees) {
   // An orthonormal frame (e1, e2) of the plane orthogonal to up.
   float u[3] = {up[0], up[1], up[2]};
-  const float ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-  for (float& v : u) v /= ul;
+  normalize(u);
   float e1[3] = {1, 0, 0};
   if (std::abs(u[0]) > 0.9f) { e1[0] = 0; e1[1] = 1; }
   const float d = e1[0] * u[0] + e1[1] * u[1] + e1[2] * u[2];
   for (int k = 0; k < 3; ++k) e1[k] -= d * u[k];
-  const float el = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
-  for (float& v : e1) v /= el;
-  const float e2[3] = {u[1] * e1[2] - u[2] * e1[1], u[2] * e1[0] - u[0] * e1[2], u[0] * e1[1] - u[1] * e1[0]};
-  const float fx = 0.5f * width / std::tan(0.5f * fov_degrees * static_cast<float>(M_PI) / 180.0f);
-
+  normalize(e1);
+  float e2[3];
+  cross(u, e1, e2);
   std::vector<Camera> cameras;
   for (int i = 0; i < count; ++i) {
     const float angle = 2.0f * static_cast<float>(M_PI) * i / count;
-    float centre[3], forward[3];
+    float eye[3];
     for (int k = 0; k < 3; ++k)
-      centre[k] = target[k] + radius * (std::cos(angle) * e1[k] + std::sin(angle) * e2[k]) + height * u[k];
-    for (int k = 0; k < 3; ++k) forward[k] = target[k] - centre[k];
-    const float fl = std::sqrt(forward[0] * forward[0] + forward[1] * forward[1] + forward[2] * forward[2]);
-    for (float& v : forward) v /= fl;
-    // OpenCV axes: x right, y down, z forward. right = forward x up_world (y down = -up).
-    float right[3] = {forward[1] * u[2] - forward[2] * u[1], forward[2] * u[0] - forward[0] * u[2],
-                      forward[0] * u[1] - forward[1] * u[0]};
-    const float rl = std::sqrt(right[0] * right[0] + right[1] * right[1] + right[2] * right[2]);
-    for (float& v : right) v /= rl;
-    const float down[3] = {forward[1] * right[2] - forward[2] * right[1], forward[2] * right[0] - forward[0] * right[2],
-                           forward[0] * right[1] - forward[1] * right[0]};
-    // camera-to-world: columns are the camera axes in world space.
-    const float c2w[9] = {right[0], down[0], forward[0], right[1], down[1], forward[1], right[2], down[2], forward[2]};
-    Camera cam = Camera::from_pose(width, height_px, fx, fx, c2w, centre);
+      eye[k] = target[k] + radius * (std::cos(angle) * e1[k] + std::sin(angle) * e2[k]) + height * u[k];
+    Camera cam = look_at_camera(eye, target, u, width, height_px, fov_degrees);
     cam.name = "orbit_" + std::to_string(i);
     cameras.push_back(cam);
   }

@@ -13,6 +13,11 @@ namespace flashgs {
 // Gaussians above a checkered floor; about `count` Gaussians, deterministic for a seed.
 Scene make_demo_scene(std::size_t count = 30000, std::uint32_t seed = 7);
 
+// A camera at `eye` looking at `target` with `up` pointing up in the image (OpenCV axes),
+// horizontal field of view `fov_degrees`.
+Camera look_at_camera(const float eye[3], const float target[3], const float up[3], int width, int height,
+                      float fov_degrees);
+
 // `count` cameras on a circle of `radius` around `target` at `height` above it along `up`,
 // looking at the target (OpenCV axes), horizontal field of view `fov_degrees`.
 std::vector<Camera> make_orbit_cameras(const float target[3], const float up[3], float radius,
