@@ -6,6 +6,7 @@
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
+#include "flashgs/stress_scenes.h"
 #include "scene_source.h"
 
 namespace flashgs::cli {
@@ -17,6 +18,8 @@ struct GenerateArgs {
   std::string input;  // tile: the scene to copy
   int copies = 4;
   std::size_t count = 30000;
+  std::string stress;  // stress: the case name
+  bool list = false;
 };
 
 void write_scene(const Scene& scene, const std::vector<Camera>& cameras, const std::string& dir) {
@@ -39,8 +42,31 @@ void run(const GenerateArgs& args) {
     // Keep the source's cameras, moved back so that the whole grid is in view.
     std::vector<Camera> cameras = load_cameras((std::filesystem::path(args.input).parent_path() / "cameras.json").string());
     write_scene(scene, cameras, args.output_dir);
+  } else if (args.kind == "stress") {
+    if (args.list || args.stress.empty()) {
+      for (const std::string& name : stress_case_names())
+        std::printf("%-16s %s\n", name.c_str(), make_stress_case(name).description.c_str());
+      if (args.stress.empty() && !args.list) throw Error("generate stress: name a case (listed above)");
+      return;
+    }
+    StressCase c = make_stress_case(args.stress);
+    if (!c.raw_ply.empty()) {
+      // The degenerate-file case is the file itself: written byte for byte, NaNs included.
+      std::filesystem::create_directories(args.output_dir);
+      const std::string ply = args.output_dir + "/point_cloud.ply";
+      std::FILE* f = std::fopen(ply.c_str(), "wb");
+      if (!f || std::fwrite(c.raw_ply.data(), 1, c.raw_ply.size(), f) != c.raw_ply.size())
+        throw Error(ply + ": cannot write");
+      std::fclose(f);
+      save_cameras(c.cameras, args.output_dir + "/cameras.json");
+      std::printf("wrote %s (raw, with NaN/Inf records) and %s/cameras.json\n", ply.c_str(), args.output_dir.c_str());
+    } else {
+      write_scene(c.scene, c.cameras, args.output_dir);
+    }
+    std::printf("%s: %s\nbound vs fp64 reference: flash %.3g, baseline %.3g (%s)\n", c.name.c_str(),
+                c.description.c_str(), c.bound_flash, c.bound_baseline, c.bound_reason.c_str());
   } else {
-    throw Error("generate: unknown kind \"" + args.kind + "\" (demo or tile)");
+    throw Error("generate: unknown kind \"" + args.kind + "\" (demo, tile or stress)");
   }
 }
 
@@ -49,7 +75,12 @@ void run(const GenerateArgs& args) {
 void register_generate(CLI::App& app) {
   auto args = std::make_shared<GenerateArgs>();
   CLI::App* sub = app.add_subcommand("generate", "write a procedural or tiled scene with cameras.json");
-  sub->add_option("kind", args->kind, "demo | tile");
+  sub->add_option("kind", args->kind, "demo | tile | stress");
+  sub->add_option("name", args->stress, "stress: the case (see --list)");
+  sub->add_option("--stress", args->stress, "same as `generate stress NAME`")->each([args](const std::string&) {
+    args->kind = "stress";
+  });
+  sub->add_flag("--list", args->list, "stress: list the cases");
   sub->add_option("--output,-o", args->output_dir, "output folder");
   sub->add_option("--input,-i", args->input, "tile: the scene to copy");
   sub->add_option("--copies,-n", args->copies, "tile: number of copies")->check(CLI::Range(1, 1024));

@@ -10,6 +10,8 @@ int main(int argc, char** argv) {
   flashgs::cli::register_render(app);
   flashgs::cli::register_info(app);
   flashgs::cli::register_generate(app);
+  flashgs::cli::register_check(app);
+  flashgs::cli::register_report(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
