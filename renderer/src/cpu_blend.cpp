@@ -30,11 +30,15 @@ void blend_tile(const Frame& frame, const std::uint64_t* keys, std::uint64_t cou
   for (std::uint64_t k = 0; k < count && active_count > 0; ++k) {
     const BlendGaussian& g = frame.blend_data[static_cast<std::uint32_t>(keys[k])];
     const float slope = -g.conic_b / g.conic_a;
-    for (int y = 0; y < tile_h; ++y) {
+    // Only the rows, and in each row the pixels, that can reach power_cut; the margins (0.5
+    // in q, one pixel each side) exceed the float rounding of the per-pixel power, so pruning
+    // never changes which pixels pass the exact test below.
+    const float reach_y = g.row_q_coeff > 0.0f ? std::sqrt((g.q_cut + 0.5f) / g.row_q_coeff) + 1.0f : 1e30f;
+    const float local_y = g.mean_y - static_cast<float>(y_begin);
+    const int y_first = static_cast<int>(std::max(0.0f, std::ceil(local_y - reach_y)));
+    const int y_last = static_cast<int>(std::min(static_cast<float>(tile_h - 1), std::floor(local_y + reach_y)));
+    for (int y = y_first; y <= y_last; ++y) {
       const float dy = static_cast<float>(y_begin + y) - g.mean_y;
-      // Only the pixels of this row that can reach power_cut; the margins (0.5 in q, one
-      // pixel each side) exceed the float rounding of the per-pixel power, so pruning never
-      // changes which pixels pass the exact test below.
       const float row_q = g.row_q_coeff * dy * dy;
       if (!(row_q <= g.q_cut + 0.5f)) continue;
       const float centre = g.mean_x + slope * dy - static_cast<float>(x_begin);
