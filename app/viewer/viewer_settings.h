@@ -18,8 +18,9 @@ struct ViewerSettings {
   float look_sensitivity = 0.004f;  // radians per window point of mouse motion
   bool heatmap = false;             // per-tile pair-count overlay (tile counts collected only then)
   bool heatmap_log = true;          // log scale for the overlay
-  float heatmap_opacity = 0.6f;
+  float heatmap_opacity = 0.45f;
   bool vsync = true;
+  bool continuous = true;           // re-render every frame (FPS); off: only when something changed
   bool show_ui = true;
   float path_seconds_per_camera = 2.0f;
 };

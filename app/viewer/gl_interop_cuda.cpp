@@ -1,0 +1,149 @@
+// The CUDA frame path: the backend writes RGBA8 straight into the GL texture through CUDA-GL interop (no host copy).
+#include "gl_headers_gl.h"  // before cuda_gl_interop.h, which includes GL/gl.h itself
+
+#include <cuda_gl_interop.h>
+#include <cuda_runtime.h>
+
+#include <cstdio>
+
+#include "flashgs/cuda_renderer.h"
+#include "flashgs/error.h"
+#include "frame_path.h"
+#include "image_presenter_gl.h"
+
+namespace flashgs::viewer {
+namespace {
+
+std::string cuda_error(const char* what, cudaError_t e) {
+  return std::string(what) + ": " + cudaGetErrorName(e) + " (" + cudaGetErrorString(e) + ")";
+}
+
+void check(cudaError_t e, const char* what) {
+  if (e != cudaSuccess) throw Error(cuda_error(what, e));
+}
+
+class InteropPath final : public FramePath {
+ public:
+  InteropPath(std::unique_ptr<CudaRenderer> renderer, std::string device)
+      : m_renderer(std::move(renderer)), m_device(std::move(device)) {}
+  ~InteropPath() override { release_texture(); }
+
+  std::string name() const override { return "CUDA-GL interop (" + m_device + ")"; }
+  void set_scene(std::shared_ptr<const Scene> scene) override { m_renderer->set_scene(std::move(scene)); }
+
+  void attach_texture(unsigned texture, int width, int height) override {
+    release_texture();
+    // Registered once per texture (registration is the expensive part); only map/unmap run
+    // every frame. WriteDiscard: the renderer overwrites every pixel, nothing is read back.
+    check(cudaGraphicsGLRegisterImage(&m_resource, texture, GL_TEXTURE_2D, cudaGraphicsRegisterFlagsSurfaceLoadStore),
+          "cudaGraphicsGLRegisterImage");
+    check(cudaGraphicsResourceSetMapFlags(m_resource, cudaGraphicsMapFlagsWriteDiscard),
+          "cudaGraphicsResourceSetMapFlags");
+    m_width = width;
+    m_height = height;
+  }
+
+  void release_texture() override {
+    if (m_resource) cudaGraphicsUnregisterResource(m_resource);
+    m_resource = nullptr;
+  }
+
+  void render_to_texture(const Camera& camera, const RenderOptions& options, FrameStats* stats) override {
+    if (!m_resource) throw Error("CUDA-GL interop: no texture attached");
+    auto stream = static_cast<cudaStream_t>(m_renderer->stream());
+    check(cudaGraphicsMapResources(1, &m_resource, stream), "cudaGraphicsMapResources");
+    cudaSurfaceObject_t surface = 0;
+    try {
+      cudaArray_t array = nullptr;
+      check(cudaGraphicsSubResourceGetMappedArray(&array, m_resource, 0, 0), "cudaGraphicsSubResourceGetMappedArray");
+      cudaResourceDesc desc{};
+      desc.resType = cudaResourceTypeArray;
+      desc.res.array.array = array;
+      check(cudaCreateSurfaceObject(&surface, &desc), "cudaCreateSurfaceObject");
+      m_renderer->render_to_surface(camera, options, static_cast<std::uint64_t>(surface), stats);
+    } catch (...) {
+      if (surface) cudaDestroySurfaceObject(surface);
+      cudaGraphicsUnmapResources(1, &m_resource, stream);
+      throw;
+    }
+    cudaDestroySurfaceObject(surface);
+    // Unmap orders GL's later use of the texture after the stream's work: no host sync here.
+    check(cudaGraphicsUnmapResources(1, &m_resource, stream), "cudaGraphicsUnmapResources");
+  }
+
+  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
+    m_renderer->render(camera, options, out, stats);
+  }
+
+  void tile_counts(const FrameStats& stats, std::vector<std::uint32_t>& out) override {
+    if (!stats.tile_pair_counts.empty()) out = stats.tile_pair_counts;
+    else m_renderer->download_tile_counts(out);
+  }
+
+ private:
+  std::unique_ptr<CudaRenderer> m_renderer;
+  std::string m_device;
+  cudaGraphicsResource_t m_resource = nullptr;
+  int m_width = 0, m_height = 0;
+};
+
+// The CUDA backend through host memory (interop refused): render to a float image, upload.
+class CudaHostCopyPath final : public FramePath {
+ public:
+  CudaHostCopyPath(std::unique_ptr<CudaRenderer> renderer, ImagePresenter* presenter, std::string device)
+      : m_renderer(std::move(renderer)), m_presenter(presenter), m_device(std::move(device)) {}
+  std::string name() const override { return "CUDA (" + m_device + ") + host copy, no interop"; }
+  void set_scene(std::shared_ptr<const Scene> scene) override { m_renderer->set_scene(std::move(scene)); }
+  void attach_texture(unsigned, int, int) override {}
+  void release_texture() override {}
+  void render_to_texture(const Camera& camera, const RenderOptions& options, FrameStats* stats) override {
+    m_renderer->render(camera, options, m_image, stats);
+    m_presenter->upload(m_image);
+  }
+  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
+    m_renderer->render(camera, options, out, stats);
+  }
+  void tile_counts(const FrameStats& stats, std::vector<std::uint32_t>& out) override {
+    if (!stats.tile_pair_counts.empty()) out = stats.tile_pair_counts;
+    else m_renderer->download_tile_counts(out);
+  }
+  const Image* last_image() const override { return &m_image; }
+
+ private:
+  std::unique_ptr<CudaRenderer> m_renderer;
+  ImagePresenter* m_presenter;
+  std::string m_device;
+  Image m_image;
+};
+
+}  // namespace
+
+std::unique_ptr<FramePath> make_cuda_path(ImagePresenter* presenter, std::string* why) {
+  std::string reason;
+  if (!cuda_available(&reason)) {
+    *why = "no usable CUDA device (" + reason + ")";
+    return nullptr;
+  }
+  int device = 0;
+  cudaGetDevice(&device);
+  cudaDeviceProp prop{};
+  cudaGetDeviceProperties(&prop, device);
+  const std::string device_name = prop.name;
+  auto renderer = make_cuda_renderer();
+  // Interop needs the GL context to live on a CUDA device; Mesa (llvmpipe) or a display driven
+  // by another GPU fails here rather than at the first frame.
+  unsigned count = 0;
+  int gl_devices[4] = {-1, -1, -1, -1};
+  const cudaError_t e = cudaGLGetDevices(&count, gl_devices, 4, cudaGLDeviceListAll);
+  bool on_our_device = false;
+  for (unsigned i = 0; i < count && i < 4; ++i) on_our_device |= gl_devices[i] == device;
+  if (e != cudaSuccess || !on_our_device) {
+    cudaGetLastError();  // clear the sticky-free error so later calls do not report it
+    *why = e != cudaSuccess ? "CUDA-GL interop refused (" + cuda_error("cudaGLGetDevices", e) + ")"
+                            : "CUDA-GL interop refused: the GL context is not on CUDA device " + std::to_string(device);
+    return std::make_unique<CudaHostCopyPath>(std::move(renderer), presenter, device_name);
+  }
+  return std::make_unique<InteropPath>(std::move(renderer), device_name);
+}
+
+}  // namespace flashgs::viewer

@@ -1,0 +1,126 @@
+// Frame texture management, the blit and heat-map passes, and texture read-back.
+#include "image_presenter_gl.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "viewer_shaders.h"  // generated from shaders/*.glsl by CMake
+
+namespace flashgs::viewer {
+
+ImagePresenter::~ImagePresenter() {
+  if (m_texture) glDeleteTextures(1, &m_texture);
+  if (m_counts) glDeleteTextures(1, &m_counts);
+  if (m_vao) glDeleteVertexArrays(1, &m_vao);
+}
+
+void ImagePresenter::init() {
+  m_blit.build("image_blit", shaders::kFullscreenVert, shaders::kImageBlitFrag);
+  m_heat.build("heatmap", shaders::kFullscreenVert, shaders::kHeatmapFrag);
+  // Core profiles require a bound VAO even for attribute-less draws.
+  glGenVertexArrays(1, &m_vao);
+  glGenTextures(1, &m_counts);
+  glBindTexture(GL_TEXTURE_2D, m_counts);
+  // Nearest: one flat colour per tile, no blending across tile borders.
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+void ImagePresenter::resize(int width, int height) {
+  if (m_texture) glDeleteTextures(1, &m_texture);
+  m_width = width;
+  m_height = height;
+  glGenTextures(1, &m_texture);
+  glBindTexture(GL_TEXTURE_2D, m_texture);
+  // Linear filtering: the frame may be rendered below the window size (render scale < 1).
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+}
+
+void ImagePresenter::upload(const Image& image) {
+  if (needs_resize(image.width, image.height)) resize(image.width, image.height);
+  const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
+  m_rgba.resize(pixels * 4);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const float v = image.rgb[i * 3 + c];
+      // Same rounding as write_image's 8-bit path, so a CPU-path screenshot equals the CLI's PNG.
+      m_rgba[i * 4 + c] = !(v > 0.0f) ? 0 : static_cast<std::uint8_t>(std::lround(std::min(v, 1.0f) * 255.0f));
+    }
+    m_rgba[i * 4 + 3] = 255;
+  }
+  glBindTexture(GL_TEXTURE_2D, m_texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE, m_rgba.data());
+}
+
+void ImagePresenter::set_tile_counts(const std::vector<std::uint32_t>& counts, int tiles_x, int tiles_y,
+                                     std::uint32_t max_count) {
+  if (tiles_x <= 0 || tiles_y <= 0 || counts.size() < static_cast<std::size_t>(tiles_x) * tiles_y) return;
+  m_count_floats.assign(counts.begin(), counts.begin() + static_cast<std::size_t>(tiles_x) * tiles_y);
+  m_max_count = std::max<std::uint32_t>(1, max_count);
+  glBindTexture(GL_TEXTURE_2D, m_counts);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  if (tiles_x != m_tiles_x || tiles_y != m_tiles_y) {
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, tiles_x, tiles_y, 0, GL_RED, GL_FLOAT, m_count_floats.data());
+    m_tiles_x = tiles_x;
+    m_tiles_y = tiles_y;
+  } else {
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, tiles_x, tiles_y, GL_RED, GL_FLOAT, m_count_floats.data());
+  }
+}
+
+void ImagePresenter::draw(int fb_width, int fb_height, const HeatmapView* heatmap) {
+  glViewport(0, 0, fb_width, fb_height);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_SCISSOR_TEST);
+  glDisable(GL_BLEND);
+  glBindVertexArray(m_vao);
+  if (m_texture) {
+    glUseProgram(m_blit.id());
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, m_texture);
+    glUniform1i(m_blit.uniform("u_image"), 0);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  if (heatmap && m_tiles_x > 0 && m_width > 0) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glUseProgram(m_heat.id());
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, m_counts);
+    glUniform1i(m_heat.uniform("u_counts"), 0);
+    glUniform2f(m_heat.uniform("u_tile_scale"), float(m_width) / float(16 * m_tiles_x),
+                float(m_height) / float(16 * m_tiles_y));
+    glUniform1f(m_heat.uniform("u_max_count"), float(m_max_count));
+    glUniform1i(m_heat.uniform("u_log_scale"), heatmap->log_scale ? 1 : 0);
+    glUniform1f(m_heat.uniform("u_opacity"), heatmap->opacity);
+    glUniform4f(m_heat.uniform("u_legend_rect"), heatmap->legend_rect[0], heatmap->legend_rect[1],
+                heatmap->legend_rect[2], heatmap->legend_rect[3]);
+    glUniform2f(m_heat.uniform("u_viewport"), float(fb_width), float(fb_height));
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisable(GL_BLEND);
+  }
+  glBindVertexArray(0);
+  glUseProgram(0);
+}
+
+Image ImagePresenter::read_back() const {
+  Image image;
+  if (!m_texture) return image;
+  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(m_width) * m_height * 4);
+  glBindTexture(GL_TEXTURE_2D, m_texture);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  image.resize(m_width, m_height);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(m_width) * m_height; ++i)
+    for (int c = 0; c < 3; ++c) image.rgb[i * 3 + c] = rgba[i * 4 + c] / 255.0f;
+  return image;
+}
+
+}  // namespace flashgs::viewer

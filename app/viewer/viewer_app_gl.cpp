@@ -1,0 +1,530 @@
+// The viewer's frame loop: input -> navigation -> render through the frame path -> present -> panels.
+#include "viewer_app_gl.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include "flashgs/error.h"
+#include "flashgs/image_io.h"
+#include "flashgs/renderer.h"
+#include "gl_headers_gl.h"
+#include "image_presenter_gl.h"
+#include "imgui_layer_ui.h"
+#include "viewer_panels_ui.h"
+#include "window_gl.h"
+
+namespace flashgs::viewer {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr float kScriptDt = 1.0f / 60.0f;  // simulated time per scripted frame: runs are repeatable
+
+bool same_camera(const Camera& a, const Camera& b) {
+  if (a.width != b.width || a.height != b.height || a.fx != b.fx || a.fy != b.fy || a.cx != b.cx || a.cy != b.cy)
+    return false;
+  return std::equal(a.rotation, a.rotation + 9, b.rotation) && std::equal(a.position, a.position + 3, b.position);
+}
+
+bool same_options(const RenderOptions& a, const RenderOptions& b) {
+  return a.algorithm == b.algorithm && a.opacity_aware_radius == b.opacity_aware_radius &&
+         a.tight_bbox == b.tight_bbox && a.exact_tile_test == b.exact_tile_test &&
+         a.warp_cooperative_emit == b.warp_cooperative_emit && a.fused_emit == b.fused_emit &&
+         a.minimal_sort_bits == b.minimal_sort_bits && a.pipelined_blend == b.pipelined_blend &&
+         a.exp2_alpha == b.exp2_alpha && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
+         a.collect_tile_counts == b.collect_tile_counts && std::equal(a.background, a.background + 3, b.background);
+}
+
+glm::vec3 axis_from_text(const std::string& t) {
+  glm::vec3 v(0.0f);
+  const int axis = t[1] == 'x' ? 0 : (t[1] == 'y' ? 1 : 2);
+  v[axis] = t[0] == '-' ? -1.0f : 1.0f;
+  return v;
+}
+
+std::string demo_scene_path() { return std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply"; }
+
+}  // namespace
+
+ViewerApp::ViewerApp(ViewerArgs args) : m_args(std::move(args)) {
+  RenderOptions& o = m_settings.options;
+  if (m_args.algorithm == "baseline") o = RenderOptions::baseline();
+  o.tau = m_args.tau;
+  o.sh_degree_cap = m_args.sh_degree;
+  for (int c = 0; c < 3; ++c) o.background[c] = m_args.background[c];
+  m_settings.render_scale = m_args.scale;
+  m_settings.forced_width = m_args.render_width;
+  m_settings.forced_height = m_args.render_height;
+  m_settings.heatmap = m_args.heatmap;
+  m_settings.mode = m_args.orbit ? NavigationMode::orbit : NavigationMode::fly;
+  m_settings.show_ui = !m_args.no_ui;
+  m_scripted = m_args.scripted();
+  m_settings.vsync = !(m_args.no_vsync || m_scripted);
+  if (!m_args.keys.empty()) m_script = KeyScript::parse(m_args.keys);
+  m_shot_buffer = "flashgs_screenshot.png";
+}
+
+ViewerApp::~ViewerApp() {
+  // GL objects and interop registrations go before the context (the window) does.
+  m_path.reset();
+  m_ui.reset();
+  m_presenter.reset();
+  m_window.reset();
+}
+
+void ViewerApp::use_cpu_path(const std::string& why) {
+  m_path = make_upload_path(make_cpu_renderer(), m_presenter.get(), "CPU renderer + texture upload");
+  m_path_is_cpu = true;
+  m_path_note = why;
+  std::fprintf(stderr, "flashgs-viewer: frame path: %s (%s)\n", m_path->name().c_str(), why.c_str());
+}
+
+void ViewerApp::select_frame_path() {
+  if (m_args.backend == "cpu") {
+    use_cpu_path("--backend cpu");
+    return;
+  }
+  std::string why;
+  std::unique_ptr<FramePath> cuda;
+  try {
+    cuda = make_cuda_path(m_presenter.get(), &why);
+  } catch (const std::exception& e) {
+    why = std::string("CUDA path failed: ") + e.what();
+  }
+  if (!cuda) {
+    use_cpu_path(why);
+    return;
+  }
+  m_path = std::move(cuda);
+  m_path_is_cpu = false;
+  m_path_note = why;  // empty when interop works; otherwise why the host copy is used
+  std::fprintf(stderr, "flashgs-viewer: frame path: %s%s%s%s\n", m_path->name().c_str(), why.empty() ? "" : " (",
+               why.c_str(), why.empty() ? "" : ")");
+}
+
+void ViewerApp::install_scene(LoadedScene scene) {
+  m_path->set_scene(scene.scene);  // throws on failure: the old scene stays
+  m_scene = std::move(scene);
+  m_camera_path = std::make_unique<CameraPath>(m_scene.cameras);
+  m_playing = false;
+  m_camera_index = -1;
+  m_compare = {};
+  m_settings.flip_up = m_args.flip_up;
+  apply_up_choice();
+  if (!m_scene.cameras.empty()) snap_to_camera(0);
+  m_have_frame = false;
+  std::string note;
+  if (m_scene.report.dropped_non_finite)
+    note += std::to_string(m_scene.report.dropped_non_finite) + " Gaussians with NaN/Inf dropped. ";
+  if (!m_scene.cameras_note.empty()) note += m_scene.cameras_note;
+  std::fprintf(stderr, "flashgs-viewer: %s: %zu Gaussians, SH degree %d, %zu cameras%s%s\n", m_scene.path.c_str(),
+               m_scene.scene->size(), m_scene.scene->sh_degree, m_scene.cameras.size(), note.empty() ? "" : "; ",
+               note.c_str());
+}
+
+void ViewerApp::apply_up_choice() {
+  glm::vec3 up = m_args.up == "auto" ? m_scene.up : axis_from_text(m_args.up);
+  m_controller.reset(m_scene.centre, m_scene.extent, up);
+  if (m_settings.flip_up) m_controller.flip_up();
+}
+
+bool ViewerApp::open_scene(const std::string& path) {
+  try {
+    install_scene(load_scene(path, path == m_args.scene ? m_args.cameras : ""));
+    m_load_error.clear();
+    m_path_buffer = path;
+    return true;
+  } catch (const std::exception& e) {
+    m_load_error = e.what();
+    std::fprintf(stderr, "flashgs-viewer: cannot open %s: %s\n", path.c_str(), e.what());
+    return false;
+  }
+}
+
+void ViewerApp::snap_to_camera(int index) {
+  if (m_scene.cameras.empty()) return;
+  const int n = static_cast<int>(m_scene.cameras.size());
+  index = ((index % n) + n) % n;
+  m_camera_index = index;
+  m_controller.snap_to(m_scene.cameras[index]);
+  m_settings.fov_x_degrees = m_scene.cameras[index].horizontal_fov_degrees();
+  m_playing = false;
+}
+
+void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions, float) {
+  double x = 0, y = 0;
+  m_window->cursor(&x, &y);
+  const float dx = float(x - m_last_cursor_x), dy = float(y - m_last_cursor_y);
+  m_last_cursor_x = x;
+  m_last_cursor_y = y;
+  const float scroll = m_window->take_scroll();
+  for (const std::string& p : m_window->take_drops())
+    if (actions.open_path.empty()) actions.open_path = p;
+
+  const bool mouse_free = !(m_ui && m_settings.show_ui && m_ui->wants_mouse());
+  const bool keys_free = !(m_ui && m_settings.show_ui && m_ui->wants_keyboard());
+  auto pressed = [&](int key) {  // edge-triggered
+    const bool down = keys_free && m_window->key_down(key);
+    const bool edge = down && !m_keys_before[key];
+    m_keys_before[key] = down;
+    return edge;
+  };
+  if (keys_free) {
+    nav.forward = m_window->key_down(GLFW_KEY_W);
+    nav.back = m_window->key_down(GLFW_KEY_S);
+    nav.left = m_window->key_down(GLFW_KEY_A);
+    nav.right = m_window->key_down(GLFW_KEY_D);
+    nav.down = m_window->key_down(GLFW_KEY_Q);
+    nav.up = m_window->key_down(GLFW_KEY_E);
+    nav.fast = m_window->key_down(GLFW_KEY_LEFT_SHIFT) || m_window->key_down(GLFW_KEY_RIGHT_SHIFT);
+  }
+  if (pressed(GLFW_KEY_N)) actions.next_camera = true;
+  if (pressed(GLFW_KEY_P)) actions.previous_camera = true;
+  if (pressed(GLFW_KEY_SPACE)) actions.toggle_play = true;
+  if (pressed(GLFW_KEY_C)) actions.compare = true;
+  if (pressed(GLFW_KEY_H)) m_settings.heatmap = !m_settings.heatmap;
+  if (pressed(GLFW_KEY_F1)) m_settings.show_ui = !m_settings.show_ui;
+  if (pressed(GLFW_KEY_F12)) actions.screenshot_path = m_shot_buffer;
+  if (pressed(GLFW_KEY_TAB))
+    m_settings.mode = m_settings.mode == NavigationMode::fly ? NavigationMode::orbit : NavigationMode::fly;
+  if (pressed(GLFW_KEY_B)) {
+    const bool to_flash = m_settings.options.is_baseline();
+    RenderOptions& o = m_settings.options;
+    RenderOptions fresh = to_flash ? RenderOptions{} : RenderOptions::baseline();
+    fresh.tau = o.tau;
+    fresh.sh_degree_cap = o.sh_degree_cap;
+    std::copy(o.background, o.background + 3, fresh.background);
+    o = fresh;
+  }
+  if (mouse_free) {
+    const bool left = m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT);
+    const bool right = m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT);
+    const bool middle = m_window->mouse_down(GLFW_MOUSE_BUTTON_MIDDLE);
+    if (m_settings.mode == NavigationMode::fly) {
+      if (right) nav.look_dx = dx, nav.look_dy = dy;
+    } else {
+      if (left && !nav.fast) nav.look_dx = dx, nav.look_dy = dy;
+      if (right || middle || (left && nav.fast)) nav.pan_dx = dx, nav.pan_dy = dy;
+    }
+    nav.scroll = scroll;
+  }
+}
+
+void ViewerApp::apply_actions(const UiActions& a) {
+  if (!a.open_path.empty()) open_scene(a.open_path);
+  if (a.snap_camera >= 0) snap_to_camera(a.snap_camera);
+  if (a.next_camera) snap_to_camera(m_camera_index + 1);
+  if (a.previous_camera) snap_to_camera(m_camera_index < 0 ? 0 : m_camera_index - 1);
+  if (a.toggle_play && m_camera_path && !m_camera_path->empty()) {
+    m_playing = !m_playing;
+    if (m_playing) m_path_t = m_camera_index >= 0 ? double(m_camera_index) / m_camera_path->size() : 0.0;
+  }
+  if (a.flip_up) m_controller.flip_up();
+  if (a.reset_view) {
+    m_settings.flip_up = m_args.flip_up;
+    apply_up_choice();
+    m_camera_index = -1;
+  }
+  if (!a.screenshot_path.empty()) save_screenshot(a.screenshot_path);
+  if (a.compare && m_have_frame) {
+    m_compare = run_compare(*m_path, m_last_camera, m_settings.options);
+    if (m_compare.valid)
+      std::fprintf(stderr, "flashgs-viewer: compare %s vs baseline at %dx%d: PSNR %.2f dB, max abs %.6f, %.3f ms vs %.3f ms\n",
+                   m_compare.current_label.c_str(), m_compare.width, m_compare.height, m_compare.difference.psnr_db,
+                   m_compare.difference.max_abs, m_compare.current_ms, m_compare.baseline_ms);
+  }
+}
+
+void ViewerApp::ensure_texture(int width, int height) {
+  if (!m_presenter->needs_resize(width, height)) return;
+  m_path->release_texture();
+  m_presenter->resize(width, height);
+  try {
+    m_path->attach_texture(m_presenter->texture(), width, height);
+  } catch (const std::exception& e) {
+    use_cpu_path(std::string("interop failed: ") + e.what());
+    m_path->set_scene(m_scene.scene);
+  }
+}
+
+void ViewerApp::render_frame(const Camera& camera) {
+  RenderOptions options = m_settings.options;
+  options.collect_tile_counts = m_settings.heatmap;  // counts cost a copy: only when shown
+  try {
+    m_path->render_to_texture(camera, options, &m_stats);
+  } catch (const std::exception& e) {
+    if (m_path_is_cpu) throw;
+    use_cpu_path(std::string("CUDA frame failed: ") + e.what());
+    m_path->set_scene(m_scene.scene);
+    m_path->render_to_texture(camera, options, &m_stats);
+  }
+  if (m_settings.heatmap) {
+    m_path->tile_counts(m_stats, m_tile_counts);
+    std::uint32_t max_count = m_stats.max_tile_pairs;
+    if (max_count == 0)
+      for (std::uint32_t c : m_tile_counts) max_count = std::max(max_count, c);
+    m_presenter->set_tile_counts(m_tile_counts, m_stats.tiles_x, m_stats.tiles_y, max_count);
+  }
+  m_last_camera = camera;
+  m_last_options = options;
+  m_have_frame = true;
+  if (m_compare.valid) m_compare.stale = true;
+}
+
+void ViewerApp::save_screenshot(const std::string& path) {
+  try {
+    Image image;
+    const Image* host = m_path->last_image();
+    const std::string ext = std::filesystem::path(path).extension().string();
+    if (host && host->width == m_presenter->width() && host->height == m_presenter->height()) {
+      image = *host;
+    } else if (ext == ".exr" || ext == ".EXR" || ext == ".pfm") {
+      // Float formats get the float frame, rendered again for the same view.
+      m_path->render_image(m_last_camera, m_last_options, image, nullptr);
+    } else {
+      image = m_presenter->read_back();  // what the window shows, byte for byte
+    }
+    write_image(image, path);
+    m_status = "saved " + path + " (" + std::to_string(image.width) + "x" + std::to_string(image.height) + ")";
+    std::fprintf(stderr, "flashgs-viewer: %s\n", m_status.c_str());
+  } catch (const std::exception& e) {
+    m_status = std::string("screenshot failed: ") + e.what();
+    std::fprintf(stderr, "flashgs-viewer: %s\n", m_status.c_str());
+    if (m_scripted) m_exit_code = 2;
+  }
+}
+
+void ViewerApp::save_window_screenshot(const std::string& path, int width, int height) {
+  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  Image image;
+  image.resize(width, height);
+  for (int y = 0; y < height; ++y)  // GL's row 0 is the bottom
+    for (int x = 0; x < width; ++x)
+      for (int c = 0; c < 3; ++c)
+        image.pixel(x, y)[c] = rgba[(static_cast<std::size_t>(height - 1 - y) * width + x) * 4 + c] / 255.0f;
+  try {
+    write_image(image, path);
+    std::fprintf(stderr, "flashgs-viewer: saved window %s (%dx%d)\n", path.c_str(), width, height);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "flashgs-viewer: window screenshot failed: %s\n", e.what());
+    m_exit_code = 2;
+  }
+  if (m_close_after_shot) m_window->request_close();
+}
+
+void ViewerApp::finish_script() {
+  if (!m_frame_ms.empty()) {
+    const FrameTimeSummary s = summarize_frame_times(m_frame_ms);
+    std::printf("viewer frames: %zu at %dx%d on %s | mean %.3f ms, median %.3f ms, p95 %.3f ms, min %.3f ms, max %.3f ms | %.1f FPS\n",
+                s.frames, m_presenter->width(), m_presenter->height(), m_path->name().c_str(), s.mean_ms, s.median_ms,
+                s.p95_ms, s.min_ms, s.max_ms, s.fps);
+    std::printf("viewer render: last frame kv pairs %llu, visible %llu of %llu, backend total %.3f ms (project %.3f, emit %.3f, sort %.3f, ranges %.3f, blend %.3f)\n",
+                static_cast<unsigned long long>(m_stats.kv_pairs), static_cast<unsigned long long>(m_stats.visible),
+                static_cast<unsigned long long>(m_stats.gaussians), m_stats.times.total_ms, m_stats.times.project_ms,
+                m_stats.times.emit_ms, m_stats.times.sort_ms, m_stats.times.ranges_ms, m_stats.times.blend_ms);
+    const glm::vec3 p = m_controller.pose().position;
+    std::printf("viewer camera: position %.6f %.6f %.6f\n", p.x, p.y, p.z);
+  }
+  if (m_args.compare && m_have_frame) {
+    UiActions a;
+    a.compare = true;
+    apply_actions(a);
+    if (m_compare.valid)
+      std::printf("viewer compare: %s vs baseline PSNR %.2f dB max abs %.6f\n", m_compare.current_label.c_str(),
+                  m_compare.difference.psnr_db, m_compare.difference.max_abs);
+  }
+  if (!m_args.screenshot.empty()) save_screenshot(m_args.screenshot);
+  std::fflush(stdout);
+  if (!m_args.window_screenshot.empty()) {
+    // Taken at the end of the next frame, once the panels show this frame's statistics.
+    m_pending_window_shot = m_args.window_screenshot;
+    m_close_after_shot = m_args.exit_after;
+  } else if (m_args.exit_after) {
+    m_window->request_close();
+  }
+  m_scripted = false;  // interactive from here on (unless closing)
+  m_settings.vsync = !m_args.no_vsync;
+}
+
+int ViewerApp::run() {
+  try {
+    m_window = std::make_unique<Window>(m_args.window_width, m_args.window_height, "flashgs-viewer");
+    m_presenter = std::make_unique<ImagePresenter>();
+    m_presenter->init();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "flashgs-viewer: %s\n", e.what());
+    return 1;
+  }
+  std::fprintf(stderr, "flashgs-viewer: OpenGL %s, %s\n", reinterpret_cast<const char*>(glGetString(GL_VERSION)),
+               reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
+  float xscale = 1.0f, yscale = 1.0f;
+  glfwGetWindowContentScale(m_window->handle(), &xscale, &yscale);
+  m_ui = std::make_unique<ImGuiLayer>(m_window->handle(), std::max(1.0f, xscale));
+  select_frame_path();
+
+  // The first scene: generated, the argument, or the demo; a failure leaves the generated demo.
+  bool loaded = false;
+  if (m_args.generate_demo > 0) {
+    try {
+      install_scene(generate_demo_scene(static_cast<std::size_t>(m_args.generate_demo)));
+      loaded = true;
+    } catch (const std::exception& e) {
+      m_load_error = e.what();
+    }
+  } else {
+    loaded = open_scene(m_args.scene.empty() ? demo_scene_path() : m_args.scene);
+  }
+  if (!loaded) {
+    if (m_scripted) {
+      std::fprintf(stderr, "flashgs-viewer: no scene to run the script on\n");
+      return 2;
+    }
+    install_scene(generate_demo_scene(30000));
+  }
+  if (m_args.tile > 1) {
+    install_scene(tile_loaded_scene(m_scene, m_args.tile));
+  }
+  if (m_args.camera >= 0) {
+    if (m_args.camera >= static_cast<int>(m_scene.cameras.size())) {
+      std::fprintf(stderr, "flashgs-viewer: camera %d does not exist (the scene has %zu)\n", m_args.camera,
+                   m_scene.cameras.size());
+      if (m_scripted) return 2;
+    } else {
+      snap_to_camera(m_args.camera);
+    }
+  }
+  if (m_args.fov > 0) m_settings.fov_x_degrees = m_args.fov;
+  if (m_args.path && m_args.frames <= 0) m_args.frames = 120;
+  m_window->cursor(&m_last_cursor_x, &m_last_cursor_y);
+
+  auto last = Clock::now();
+  auto last_swap = Clock::now();
+  auto fps_window_start = Clock::now();
+  int fps_frames = 0;
+  while (!m_window->should_close()) {
+    const bool idle = !m_scripted && !m_settings.continuous && !m_playing && m_have_frame;
+    m_window->poll(idle);
+    int fb_w = 0, fb_h = 0;
+    m_window->framebuffer_size(&fb_w, &fb_h);
+    const auto now = Clock::now();
+    float dt = std::min(0.1f, std::chrono::duration<float>(now - last).count());
+    last = now;
+    if (fb_w <= 0 || fb_h <= 0) {  // minimised: nothing to draw into
+      if (!m_scripted) glfwWaitEventsTimeout(0.1);
+      continue;
+    }
+    if (m_scripted) dt = kScriptDt;
+
+    UiActions actions;
+    NavigationInput nav;
+    gather_input(nav, actions, dt);
+    if (m_scripted && !m_script.done()) nav = m_script.next(dt);
+
+    UiModel model;
+    const float fb_scale = m_window->framebuffer_scale();
+    // Bottom right, clear of the main panel (top left) and the statistics (top right).
+    const float legend_px[4] = {float(fb_w) - 300.0f * fb_scale, float(fb_h) - 30.0f * fb_scale,
+                                float(fb_w) - 20.0f * fb_scale, float(fb_h) - 16.0f * fb_scale};
+    if (m_settings.show_ui) {
+      m_ui->begin_frame();
+      model.frame_path = m_path->name();
+      model.frame_path_note = m_path_note;
+      model.scene_path = m_scene.path;
+      model.gaussians = m_scene.scene ? m_scene.scene->size() : 0;
+      model.sh_degree = m_scene.scene ? m_scene.scene->sh_degree : 0;
+      model.camera_count = static_cast<int>(m_scene.cameras.size());
+      model.scene_note = m_scene.cameras_note;
+      model.load_error = m_load_error;
+      model.current_camera = m_camera_index;
+      model.on_scene_camera = m_controller.on_scene_camera();
+      model.playing = m_playing;
+      model.render_width = m_presenter->width();
+      model.render_height = m_presenter->height();
+      model.fps = m_fps;
+      model.stats = m_have_frame ? &m_stats : nullptr;
+      model.history = &m_history;
+      model.compare = &m_compare;
+      model.heatmap_max = m_presenter->heatmap_max();
+      for (int k = 0; k < 4; ++k) model.legend_rect_points[k] = legend_px[k] / fb_scale;
+      model.status = m_status;
+      const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
+      for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
+      draw_panels(model, m_settings, actions, m_path_buffer, m_shot_buffer);
+    }
+    apply_actions(actions);
+
+    if (m_playing && m_camera_path && !m_camera_path->empty()) {
+      m_path_t += dt / (m_settings.path_seconds_per_camera * double(m_camera_path->size()));
+      m_controller.set_pose(m_camera_path->pose_at(m_path_t), 0.0f);
+      m_settings.fov_x_degrees = m_camera_path->fov_at(m_path_t);
+    } else if (m_controller.update(nav, dt, m_settings)) {
+      m_playing = false;
+    }
+    if (m_scripted && m_args.path && m_camera_path && !m_camera_path->empty()) {
+      const int timed = std::max(0, m_frame - m_args.warmup);
+      const double t = double(timed) / std::max(1, m_args.frames);
+      m_controller.set_pose(m_camera_path->pose_at(t), 0.0f);
+      m_settings.fov_x_degrees = m_camera_path->fov_at(t);
+    }
+
+    const int rw = m_settings.forced_width > 0 ? m_settings.forced_width
+                                               : std::max(1, int(std::lround(fb_w * m_settings.render_scale)));
+    const int rh = m_settings.forced_height > 0 ? m_settings.forced_height
+                                                : std::max(1, int(std::lround(fb_h * m_settings.render_scale)));
+    ensure_texture(rw, rh);
+    const Camera camera = m_controller.render_camera(rw, rh, m_settings.fov_x_degrees);
+    RenderOptions wanted = m_settings.options;
+    wanted.collect_tile_counts = m_settings.heatmap;
+    const bool changed = !m_have_frame || !same_camera(camera, m_last_camera) || !same_options(wanted, m_last_options);
+    bool rendered = false;
+    if (changed || m_settings.continuous || m_scripted) {
+      render_frame(camera);
+      rendered = true;
+    }
+
+    HeatmapView heat;
+    heat.log_scale = m_settings.heatmap_log;
+    heat.opacity = m_settings.heatmap_opacity;
+    std::copy(legend_px, legend_px + 4, heat.legend_rect);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    m_presenter->draw(fb_w, fb_h, m_settings.heatmap ? &heat : nullptr);
+    if (m_settings.show_ui) m_ui->end_frame();
+    if (!m_pending_window_shot.empty()) {
+      save_window_screenshot(m_pending_window_shot, fb_w, fb_h);
+      m_pending_window_shot.clear();
+    }
+    m_window->swap(m_settings.vsync);
+
+    const auto swapped = Clock::now();
+    const double frame_ms = std::chrono::duration<double, std::milli>(swapped - last_swap).count();
+    last_swap = swapped;
+    if (rendered) m_history.push(frame_ms, m_stats);
+    ++fps_frames;
+    const double window_s = std::chrono::duration<double>(swapped - fps_window_start).count();
+    if (window_s >= 0.5) {
+      m_fps = fps_frames / window_s;
+      fps_frames = 0;
+      fps_window_start = swapped;
+    }
+    if (m_scripted) {
+      // Frame 0 includes setup; warm-up frames are not timed either.
+      if (m_frame >= (m_args.path ? std::max(1, m_args.warmup) : 1)) m_frame_ms.push_back(frame_ms);
+      ++m_frame;
+      const int needed = m_args.path ? m_args.frames + m_args.warmup : std::max(1, m_args.frames);
+      if (m_frame == 1 && !m_args.then_open.empty()) open_scene(m_args.then_open);  // must fail softly
+      if (m_frame >= needed && m_script.done()) finish_script();
+    }
+  }
+  return m_exit_code;
+}
+
+}  // namespace flashgs::viewer

@@ -1,0 +1,91 @@
+// ViewerApp: the viewer's frame loop tying together window, scene, navigation, frame path, presenter and panels.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "camera_controller.h"
+#include "camera_path.h"
+#include "compare_mode.h"
+#include "frame_path.h"
+#include "key_script.h"
+#include "scene_state.h"
+#include "stats_history.h"
+#include "viewer_args.h"
+#include "viewer_settings.h"
+
+namespace flashgs::viewer {
+
+class Window;
+class ImagePresenter;
+class ImGuiLayer;
+struct UiActions;
+
+class ViewerApp {
+ public:
+  explicit ViewerApp(ViewerArgs args);
+  ~ViewerApp();
+  // Runs until the window closes (or the script ends with --exit); returns the exit code.
+  int run();
+
+ private:
+  void select_frame_path();
+  void use_cpu_path(const std::string& why);
+  bool open_scene(const std::string& path);
+  void install_scene(LoadedScene scene);
+  void apply_up_choice();
+  void snap_to_camera(int index);
+  void gather_input(NavigationInput& nav, UiActions& actions, float dt);
+  void apply_actions(const UiActions& actions);
+  void ensure_texture(int width, int height);
+  void render_frame(const Camera& camera);
+  void save_screenshot(const std::string& path);
+  void save_window_screenshot(const std::string& path, int width, int height);
+  void finish_script();
+
+  ViewerArgs m_args;
+  ViewerSettings m_settings;
+  std::unique_ptr<Window> m_window;
+  std::unique_ptr<ImagePresenter> m_presenter;
+  std::unique_ptr<ImGuiLayer> m_ui;
+  std::unique_ptr<FramePath> m_path;
+  std::string m_path_note;
+  bool m_path_is_cpu = true;
+
+  LoadedScene m_scene;
+  std::string m_load_error;
+  CameraController m_controller;
+  std::unique_ptr<CameraPath> m_camera_path;
+  int m_camera_index = -1;
+  bool m_playing = false;
+  double m_path_t = 0;
+
+  // The last rendered frame, to re-render only when something changed.
+  Camera m_last_camera;
+  RenderOptions m_last_options;
+  bool m_have_frame = false;
+  FrameStats m_stats;
+  StatsHistory m_history;
+  std::vector<std::uint32_t> m_tile_counts;
+  CompareResult m_compare;
+  std::string m_status;
+  double m_fps = 0;
+
+  // Input state between frames.
+  double m_last_cursor_x = 0, m_last_cursor_y = 0;
+  bool m_keys_before[512] = {};
+  std::string m_path_buffer, m_shot_buffer;
+  int m_screenshot_count = 0;
+
+  // Scripted mode.
+  bool m_scripted = false;
+  KeyScript m_script;
+  int m_frame = 0;
+  std::vector<double> m_frame_ms;
+  int m_exit_code = 0;
+  std::string m_pending_window_shot;
+  bool m_close_after_shot = false;
+};
+
+}  // namespace flashgs::viewer

@@ -1,0 +1,75 @@
+// Command-line parsing for flashgs-viewer (CLI11).
+#include "viewer_args.h"
+
+#include <cstdio>
+
+#include <CLI/CLI.hpp>
+
+namespace flashgs::viewer {
+namespace {
+
+bool parse_size(const std::string& text, int* w, int* h) {
+  char x = 0, extra = 0;
+  int a = 0, b = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 || b < 1 ||
+      a > 32768 || b > 32768)
+    return false;
+  *w = a;
+  *h = b;
+  return true;
+}
+
+}  // namespace
+
+int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
+  CLI::App app{"flashgs-viewer: fly through a 3D Gaussian Splatting scene (FlashGS renderer, CUDA or CPU)"};
+  std::string size, render_size;
+  app.add_option("scene", a->scene, "PLY file or a folder holding point_cloud.ply (default: the bundled demo scene)");
+  app.add_option("--cameras", a->cameras, "cameras.json (default: the one beside the PLY)");
+  app.add_option("--generate-demo", a->generate_demo, "use a procedural demo scene of N Gaussians instead of a file")
+      ->check(CLI::Range(1L, 200000000L));
+  app.add_option("--tile", a->tile, "render K copies of the scene on a grid (large-scene benchmarks)")
+      ->check(CLI::Range(1, 1024));
+  app.add_option("--size", size, "window size WxH in screen points (default 1280x800)");
+  app.add_option("--render-size", render_size, "render at exactly WxH whatever the window size");
+  app.add_option("--scale", a->scale, "render resolution = framebuffer size * scale")->check(CLI::Range(0.05f, 4.0f));
+  app.add_option("--backend", a->backend, "auto, cpu or cuda")->check(CLI::IsMember({"auto", "cpu", "cuda"}));
+  app.add_option("--up", a->up, "world up axis: auto (from the cameras), +x, -x, +y, -y, +z, -z")
+      ->check(CLI::IsMember({"auto", "+x", "-x", "+y", "-y", "+z", "-z"}));
+  app.add_flag("--flip-up", a->flip_up, "invert the world up axis (scenes that load upside down)");
+  app.add_option("--camera,-c", a->camera, "start at this camera of cameras.json");
+  app.add_option("--fov", a->fov, "horizontal field of view in degrees")->check(CLI::Range(1.0f, 170.0f));
+  app.add_option("--algorithm,-a", a->algorithm, "flash or baseline")->check(CLI::IsMember({"flash", "baseline"}));
+  app.add_option("--tau", a->tau, "alpha threshold of the opacity-aware extent")->check(CLI::Range(1e-6f, 0.99f));
+  app.add_option("--sh-degree", a->sh_degree, "use at most this many SH bands")->check(CLI::Range(0, 3));
+  app.add_option("--background", a->background, "background colour r,g,b in [0, 1]")->delimiter(',')->expected(3);
+  app.add_flag("--heatmap", a->heatmap, "start with the per-tile pair-count overlay on");
+  app.add_flag("--orbit", a->orbit, "start in orbit mode (default: fly)");
+  app.add_flag("--no-ui", a->no_ui, "hide the panels (F1 toggles them)");
+  app.add_flag("--no-vsync", a->no_vsync, "present without waiting for vertical sync");
+  app.add_option("--frames", a->frames, "scripted: render this many frames")->check(CLI::Range(0, 10000000));
+  app.add_option("--keys", a->keys,
+                 "scripted: keys held for seconds of simulated time (60 frames per second), e.g. "
+                 "\"W:0.5,D+SHIFT:0.2,MOUSE:120:-40,WAIT:0.1\"");
+  app.add_flag("--path", a->path, "scripted: play a smooth path through the scene's cameras and report frame times");
+  app.add_option("--warmup", a->warmup, "scripted: untimed frames before the timed ones")->check(CLI::Range(0, 10000));
+  app.add_option("--screenshot", a->screenshot, "scripted: save the rendered image (no UI) after the last frame");
+  app.add_option("--window-screenshot", a->window_screenshot,
+                 "scripted: save the whole window, panels included, after the last frame");
+  app.add_flag("--exit", a->exit_after, "scripted: quit when done");
+  app.add_option("--then-open", a->then_open,
+                 "scripted: open this scene after the first frame (a failure must keep the current scene)");
+  app.add_flag("--compare", a->compare, "scripted: compare the last frame with the baseline and print PSNR");
+  try {
+    app.parse(argc, argv);
+    if (!size.empty() && !parse_size(size, &a->window_width, &a->window_height))
+      throw CLI::ValidationError("--size", "expected WxH, e.g. 1280x800");
+    if (!render_size.empty() && !parse_size(render_size, &a->render_width, &a->render_height))
+      throw CLI::ValidationError("--render-size", "expected WxH, e.g. 3840x2160");
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  return -1;
+}
+
+}  // namespace flashgs::viewer

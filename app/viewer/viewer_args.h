@@ -1,0 +1,49 @@
+// ViewerArgs: the viewer's command line (scene, window, backend, render options, and the scripted mode).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace flashgs::viewer {
+
+struct ViewerArgs {
+  std::string scene;          // PLY or a folder holding point_cloud.ply; empty: the demo scene
+  std::string cameras;        // cameras.json; empty: the one beside the PLY
+  long generate_demo = 0;     // > 0: a procedural demo scene of this many Gaussians instead of a file
+  int tile = 1;               // copies of the scene on a grid (large-scene benchmarks)
+  int window_width = 1280, window_height = 800;
+  int render_width = 0, render_height = 0;  // > 0: render at exactly this size
+  float scale = 1.0f;
+  std::string backend = "auto";  // auto | cpu | cuda
+  std::string up = "auto";       // auto | +x | -x | +y | -y | +z | -z
+  bool flip_up = false;
+  int camera = -1;               // snap to this camera at start
+  float fov = 0;                 // > 0: horizontal field of view in degrees
+  std::string algorithm = "flash";
+  float tau = 1.0f / 255.0f;
+  int sh_degree = 3;
+  std::vector<float> background = {0, 0, 0};
+  bool heatmap = false;
+  bool orbit = false;
+  bool no_ui = false;
+  bool no_vsync = false;
+
+  // Scripted mode.
+  int frames = 0;                // render this many frames (then --screenshot, --exit)
+  std::string keys;              // scripted key sequence, e.g. "W:0.5,D:0.2"
+  bool path = false;             // play the camera path; with --frames K, K frames over one loop
+  int warmup = 3;                // --path: frames rendered at the start before timing starts
+  std::string screenshot;        // after the last scripted frame (PNG, EXR, PPM, PFM)
+  std::string window_screenshot; // after the last scripted frame: the whole window, panels included
+  bool exit_after = false;       // quit when the script is done
+  std::string then_open;         // scripted: try to open this scene after the first frame (error-path test)
+  bool compare = false;          // run compare mode once on the last frame and print it
+
+  bool scripted() const { return frames > 0 || !keys.empty() || path || !screenshot.empty() ||
+                                  !window_screenshot.empty() || exit_after; }
+};
+
+// Parses argv; returns -1 to continue, or an exit code (help printed, or an error).
+int parse_viewer_args(int argc, char** argv, ViewerArgs* args);
+
+}  // namespace flashgs::viewer

@@ -1,0 +1,226 @@
+// ImGui panels: scene, view, rendering options, compare, statistics, heat-map legend.
+#include "viewer_panels_ui.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+namespace flashgs::viewer {
+namespace {
+
+std::string human_count(double v) {
+  char text[32];
+  if (v >= 1e6) std::snprintf(text, sizeof text, "%.2fM", v / 1e6);
+  else if (v >= 1e4) std::snprintf(text, sizeof text, "%.1fk", v / 1e3);
+  else std::snprintf(text, sizeof text, "%.0f", v);
+  return text;
+}
+
+void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer) {
+  if (!ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::TextWrapped("%s", m.scene_path.c_str());
+  ImGui::Text("%s Gaussians, SH degree %d, %d cameras", human_count(double(m.gaussians)).c_str(), m.sh_degree,
+              m.camera_count);
+  if (!m.scene_note.empty()) ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.scene_note.c_str());
+  ImGui::SetNextItemWidth(-60);
+  const bool enter = ImGui::InputTextWithHint("##open", "PLY path or folder (or drop a file)", &path_buffer,
+                                              ImGuiInputTextFlags_EnterReturnsTrue);
+  ImGui::SameLine();
+  if ((ImGui::Button("Open") || enter) && !path_buffer.empty()) a.open_path = path_buffer;
+  if (!m.load_error.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1));
+    ImGui::TextWrapped("Load failed, previous scene kept: %s", m.load_error.c_str());
+    ImGui::PopStyleColor();
+  }
+  (void)s;
+}
+
+void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
+  if (!ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  int mode = s.mode == NavigationMode::fly ? 0 : 1;
+  ImGui::RadioButton("Fly", &mode, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("Orbit", &mode, 1);
+  ImGui::SameLine();
+  ImGui::TextDisabled("(Tab)");
+  s.mode = mode == 0 ? NavigationMode::fly : NavigationMode::orbit;
+  if (m.camera_count > 0) {
+    if (ImGui::ArrowButton("##prev", ImGuiDir_Left)) a.previous_camera = true;
+    ImGui::SameLine();
+    int cam = std::max(m.current_camera, 0);
+    ImGui::SetNextItemWidth(110);
+    if (ImGui::SliderInt("##cam", &cam, 0, m.camera_count - 1, "camera %d")) a.snap_camera = cam;
+    ImGui::SameLine();
+    if (ImGui::ArrowButton("##next", ImGuiDir_Right)) a.next_camera = true;
+    ImGui::SameLine();
+    if (ImGui::Button(m.playing ? "Stop" : "Play path")) a.toggle_play = true;
+    ImGui::SetNextItemWidth(140);
+    ImGui::SliderFloat("s per camera", &s.path_seconds_per_camera, 0.2f, 10.0f, "%.1f");
+    ImGui::Text(m.on_scene_camera ? "on camera %d (exact)" : "free view (last camera %d)", m.current_camera);
+  } else {
+    ImGui::TextDisabled("no cameras.json: free navigation");
+  }
+  ImGui::SliderFloat("FOV (deg)", &s.fov_x_degrees, 10.0f, 140.0f, "%.1f");
+  ImGui::SliderFloat("Speed", &s.move_speed, 0.01f, 20.0f, "%.2f extents/s", ImGuiSliderFlags_Logarithmic);
+  ImGui::SliderFloat("Render scale", &s.render_scale, 0.1f, 2.0f, "%.2f");
+  if (ImGui::Checkbox("Flip world up", &s.flip_up)) a.flip_up = true;
+  ImGui::SameLine();
+  ImGui::TextDisabled("up = (%.2f, %.2f, %.2f)", m.world_up[0], m.world_up[1], m.world_up[2]);
+  if (ImGui::Button("Reset view")) a.reset_view = true;
+  ImGui::SameLine();
+  ImGui::TextDisabled("pos (%.2f, %.2f, %.2f)", m.position[0], m.position[1], m.position[2]);
+}
+
+void render_panel(ViewerSettings& s) {
+  if (!ImGui::CollapsingHeader("Rendering", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  RenderOptions& o = s.options;
+  int algo = o.is_baseline() ? 0 : 1;
+  ImGui::RadioButton("Baseline (3DGS)", &algo, 0);
+  ImGui::SameLine();
+  ImGui::RadioButton("Flash", &algo, 1);
+  ImGui::SameLine();
+  ImGui::TextDisabled("(B)");
+  o.algorithm = algo == 0 ? Algorithm::baseline : Algorithm::flash;
+  ImGui::BeginDisabled(o.is_baseline());
+  ImGui::Checkbox("Opacity-aware radius", &o.opacity_aware_radius);
+  ImGui::Checkbox("Tight bounding box", &o.tight_bbox);
+  ImGui::Checkbox("Exact ellipse-tile test", &o.exact_tile_test);
+  ImGui::TextDisabled("GPU kernels (the CPU backend ignores these):");
+  ImGui::Checkbox("Warp-cooperative emit", &o.warp_cooperative_emit);
+  ImGui::Checkbox("Fused preprocess + emit", &o.fused_emit);
+  ImGui::Checkbox("Minimal sort bits", &o.minimal_sort_bits);
+  ImGui::Checkbox("Pipelined blend", &o.pipelined_blend);
+  ImGui::Checkbox("exp2 alpha", &o.exp2_alpha);
+  ImGui::EndDisabled();
+  float inv_tau = 1.0f / o.tau;
+  if (ImGui::SliderFloat("1 / tau", &inv_tau, 2.0f, 4096.0f, "%.0f", ImGuiSliderFlags_Logarithmic))
+    o.tau = 1.0f / inv_tau;
+  ImGui::SameLine();
+  ImGui::TextDisabled("tau %.5f", o.tau);
+  ImGui::SliderInt("SH degree cap", &o.sh_degree_cap, 0, 3);
+  ImGui::ColorEdit3("Background", o.background, ImGuiColorEditFlags_NoInputs);
+  ImGui::Checkbox("Render every frame", &s.continuous);
+  ImGui::SameLine();
+  ImGui::Checkbox("VSync", &s.vsync);
+}
+
+void compare_panel(const UiModel& m, UiActions& a) {
+  if (!ImGui::CollapsingHeader("Compare with baseline", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (ImGui::Button("Compare this view (C)")) a.compare = true;
+  const CompareResult* c = m.compare;
+  if (!c || (!c->valid && c->error.empty())) return;
+  if (!c->error.empty()) {
+    ImGui::TextColored(ImVec4(1, 0.45f, 0.4f, 1), "%s", c->error.c_str());
+    return;
+  }
+  if (c->stale) {
+    ImGui::SameLine();
+    ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "(stale: view changed)");
+  }
+  ImGui::Text("%s vs baseline at %dx%d", c->current_label.c_str(), c->width, c->height);
+  if (std::isinf(c->difference.psnr_db)) ImGui::Text("PSNR: identical   max abs: 0");
+  else ImGui::Text("PSNR %.2f dB   max abs %.5f (%.2f/255)", c->difference.psnr_db, c->difference.max_abs,
+                   c->difference.max_abs * 255.0);
+  ImGui::Text("pixels off by > 1/255: %.4f%%", 100.0 * c->difference.fraction_over_1_255);
+  if (ImGui::BeginTable("cmp", 3, ImGuiTableFlags_BordersInnerH)) {
+    ImGui::TableSetupColumn("");
+    ImGui::TableSetupColumn("current");
+    ImGui::TableSetupColumn("baseline");
+    ImGui::TableHeadersRow();
+    ImGui::TableNextRow();
+    ImGui::TableNextColumn(); ImGui::Text("frame ms");
+    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->current_ms);
+    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->baseline_ms);
+    ImGui::TableNextRow();
+    ImGui::TableNextColumn(); ImGui::Text("wall ms");
+    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->current_wall_ms);
+    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->baseline_wall_ms);
+    ImGui::TableNextRow();
+    ImGui::TableNextColumn(); ImGui::Text("kv pairs");
+    ImGui::TableNextColumn(); ImGui::Text("%s", human_count(double(c->current_kv)).c_str());
+    ImGui::TableNextColumn(); ImGui::Text("%s", human_count(double(c->baseline_kv)).c_str());
+    ImGui::EndTable();
+  }
+}
+
+void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& shot) {
+  if (!ImGui::CollapsingHeader("Overlay and screenshots", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::Checkbox("Tile heat map (H)", &s.heatmap);
+  ImGui::SameLine();
+  ImGui::Checkbox("log", &s.heatmap_log);
+  ImGui::SetNextItemWidth(120);
+  ImGui::SliderFloat("opacity", &s.heatmap_opacity, 0.1f, 1.0f);
+  ImGui::SetNextItemWidth(-70);
+  ImGui::InputText("##shot", &shot);
+  ImGui::SameLine();
+  if (ImGui::Button("Save") && !shot.empty()) a.screenshot_path = shot;
+  if (!m.status.empty()) ImGui::TextWrapped("%s", m.status.c_str());
+}
+
+void stats_window(const UiModel& m) {
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x - 10, vp->WorkPos.y + 10), ImGuiCond_Always,
+                          ImVec2(1, 0));
+  ImGui::SetNextWindowBgAlpha(0.75f);
+  ImGui::Begin("Statistics", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
+  ImGui::TextColored(ImVec4(0.5f, 0.9f, 0.6f, 1), "%s", m.frame_path.c_str());
+  if (!m.frame_path_note.empty()) ImGui::TextDisabled("%s", m.frame_path_note.c_str());
+  ImGui::Text("%.1f FPS   render %dx%d", m.fps, m.render_width, m.render_height);
+  if (const FrameStats* st = m.stats) {
+    ImGui::Text("kv pairs %s   visible %s / %s", human_count(double(st->kv_pairs)).c_str(),
+                human_count(double(st->visible)).c_str(), human_count(double(st->gaussians)).c_str());
+    ImGui::Text("culled: near %s  off-screen %s  low-opacity %s  degenerate %s",
+                human_count(double(st->culled_near)).c_str(), human_count(double(st->culled_offscreen)).c_str(),
+                human_count(double(st->culled_low_opacity)).c_str(), human_count(double(st->culled_degenerate)).c_str());
+    ImGui::Text("device memory %.1f MB (peak %.1f MB)", st->device_memory_bytes / 1e6, st->device_peak_bytes / 1e6);
+    ImGui::Text("project %.2f  emit %.2f  sort %.2f  ranges %.2f  blend %.2f ms", st->times.project_ms,
+                st->times.emit_ms, st->times.sort_ms, st->times.ranges_ms, st->times.blend_ms);
+  }
+  if (const StatsHistory* h = m.history) {
+    const StatsHistory::Series shown[] = {StatsHistory::kFrame, StatsHistory::kRender, StatsHistory::kProject,
+                                          StatsHistory::kEmit, StatsHistory::kSort, StatsHistory::kBlend};
+    for (StatsHistory::Series s : shown) {
+      int count = 0, offset = 0;
+      const float* values = h->series(s, &count, &offset);
+      char overlay[64];
+      std::snprintf(overlay, sizeof overlay, "%s %.2f ms (max %.2f)", StatsHistory::name(s), h->mean(s), h->max(s));
+      ImGui::PlotLines("##h", values, count, offset, overlay, 0.0f, float(h->max(s) * 1.1 + 1e-3),
+                       ImVec2(300, s == StatsHistory::kFrame ? 40 : 26));
+    }
+  }
+  ImGui::End();
+}
+
+void legend_labels(const UiModel& m) {
+  ImDrawList* draw = ImGui::GetForegroundDrawList();
+  const float* r = m.legend_rect_points;
+  const ImU32 white = IM_COL32(255, 255, 255, 255);
+  draw->AddRectFilled(ImVec2(r[0] - 6, r[1] - 22), ImVec2(r[2] + 6, r[1] - 1), IM_COL32(0, 0, 0, 150), 3.0f);
+  char text[64];
+  std::snprintf(text, sizeof text, "pairs per tile: 0 .. %u", m.heatmap_max);
+  draw->AddText(ImVec2(r[0], r[1] - 19), white, text);
+}
+
+}  // namespace
+
+void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer, std::string& shot) {
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowBgAlpha(0.85f);
+  ImGui::Begin("flashgs-viewer");
+  scene_panel(m, s, a, path_buffer);
+  view_panel(m, s, a);
+  render_panel(s);
+  compare_panel(m, a);
+  overlay_panel(m, s, a, shot);
+  ImGui::TextDisabled("WASD/QE move, right-drag look, wheel speed, Shift fast; orbit: left-drag rotate, "
+                      "right-drag pan, wheel zoom. N/P camera, Space path, F1 panels, F12 screenshot.");
+  ImGui::End();
+  stats_window(m);
+  if (s.heatmap) legend_labels(m);
+}
+
+}  // namespace flashgs::viewer

@@ -1,0 +1,53 @@
+// The viewer's ImGui panels: what they show (UiModel), what they change (ViewerSettings) and what they ask for (UiActions).
+#pragma once
+
+#include <string>
+
+#include "compare_mode.h"
+#include "flashgs/stats.h"
+#include "stats_history.h"
+#include "viewer_settings.h"
+
+namespace flashgs::viewer {
+
+struct UiModel {
+  std::string frame_path;         // the active presentation path
+  std::string frame_path_note;    // why a faster path is not used, if so
+  std::string scene_path;
+  std::size_t gaussians = 0;
+  int sh_degree = 0;
+  int camera_count = 0;
+  std::string scene_note;         // loader report / cameras problem
+  std::string load_error;         // the last failed load (the scene shown is the previous one)
+  int current_camera = -1;        // the scene camera the view sits on, -1 when moved
+  bool on_scene_camera = false;
+  bool playing = false;
+  int render_width = 0, render_height = 0;
+  double fps = 0;
+  const FrameStats* stats = nullptr;
+  const StatsHistory* history = nullptr;
+  const CompareResult* compare = nullptr;
+  std::uint32_t heatmap_max = 0;
+  float legend_rect_points[4] = {0, 0, 0, 0};  // where the legend bar is drawn, window points
+  std::string status;             // last screenshot / action message
+  float world_up[3] = {0, -1, 0};
+  float position[3] = {0, 0, 0};
+};
+
+struct UiActions {
+  std::string open_path;          // non-empty: load this scene
+  int snap_camera = -1;           // >= 0: go to this camera
+  bool next_camera = false, previous_camera = false;
+  bool toggle_play = false;
+  bool flip_up = false;
+  bool reset_view = false;
+  bool compare = false;
+  std::string screenshot_path;    // non-empty: save the rendered image here
+};
+
+// Draws every panel for this frame. `path_buffer` and `screenshot_buffer` hold the text fields'
+// contents between frames.
+void draw_panels(const UiModel& model, ViewerSettings& settings, UiActions& actions, std::string& path_buffer,
+                 std::string& screenshot_buffer);
+
+}  // namespace flashgs::viewer

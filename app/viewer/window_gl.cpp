@@ -1,0 +1,96 @@
+// GLFW window creation and event collection.
+#include "window_gl.h"
+
+#include <cstdio>
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include "flashgs/error.h"
+#include "gl_headers_gl.h"
+
+namespace flashgs::viewer {
+namespace {
+
+void on_glfw_error(int code, const char* text) { std::fprintf(stderr, "flashgs-viewer: GLFW error %d: %s\n", code, text); }
+
+}  // namespace
+
+Window::Window(int width, int height, const std::string& title) {
+  glfwSetErrorCallback(on_glfw_error);
+  if (!glfwInit()) throw Error("GLFW cannot initialise (no display? set DISPLAY or run under xvfb-run)");
+  // GLFW's default context (compatibility profile, highest version): both NVIDIA's GLX and
+  // Mesa's llvmpipe give 4.5+ this way; the shaders need only GLSL 3.30.
+  glfwWindowHint(GLFW_SCALE_TO_MONITOR, GLFW_TRUE);
+  m_window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  if (!m_window) {
+    glfwTerminate();
+    throw Error("GLFW cannot create a " + std::to_string(width) + "x" + std::to_string(height) + " window with an OpenGL context");
+  }
+  glfwMakeContextCurrent(m_window);
+  int major = 0, minor = 0;
+  const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  if (!version || std::sscanf(version, "%d.%d", &major, &minor) != 2 || major * 10 + minor < 33) {
+    const std::string v = version ? version : "unknown";
+    glfwDestroyWindow(m_window);
+    glfwTerminate();
+    throw Error("OpenGL 3.3 or newer is needed; the context offers " + v);
+  }
+  glfwSetWindowUserPointer(m_window, this);
+  glfwSetScrollCallback(m_window, on_scroll);
+  glfwSetDropCallback(m_window, on_drop);
+}
+
+Window::~Window() {
+  if (m_window) glfwDestroyWindow(m_window);
+  glfwTerminate();
+}
+
+bool Window::should_close() const { return glfwWindowShouldClose(m_window); }
+void Window::request_close() { glfwSetWindowShouldClose(m_window, GLFW_TRUE); }
+
+void Window::swap(bool vsync) {
+  const int interval = vsync ? 1 : 0;
+  if (interval != m_swap_interval) {
+    glfwSwapInterval(interval);
+    m_swap_interval = interval;
+  }
+  glfwSwapBuffers(m_window);
+}
+
+void Window::poll(bool wait_for_events) {
+  if (wait_for_events) glfwWaitEventsTimeout(0.25);
+  else glfwPollEvents();
+}
+
+void Window::framebuffer_size(int* width, int* height) const { glfwGetFramebufferSize(m_window, width, height); }
+
+float Window::framebuffer_scale() const {
+  int fw = 0, fh = 0, ww = 0, wh = 0;
+  glfwGetFramebufferSize(m_window, &fw, &fh);
+  glfwGetWindowSize(m_window, &ww, &wh);
+  return ww > 0 ? float(fw) / float(ww) : 1.0f;
+}
+
+float Window::take_scroll() {
+  const float s = m_scroll;
+  m_scroll = 0;
+  return s;
+}
+
+std::vector<std::string> Window::take_drops() { return std::move(m_drops); }
+
+bool Window::key_down(int key) const { return glfwGetKey(m_window, key) == GLFW_PRESS; }
+bool Window::mouse_down(int button) const { return glfwGetMouseButton(m_window, button) == GLFW_PRESS; }
+void Window::cursor(double* x, double* y) const { glfwGetCursorPos(m_window, x, y); }
+
+void Window::on_scroll(GLFWwindow* w, double, double dy) {
+  static_cast<Window*>(glfwGetWindowUserPointer(w))->m_scroll += static_cast<float>(dy);
+}
+
+void Window::on_drop(GLFWwindow* w, int count, const char** paths) {
+  auto* self = static_cast<Window*>(glfwGetWindowUserPointer(w));
+  for (int i = 0; i < count; ++i) self->m_drops.emplace_back(paths[i]);
+}
+
+}  // namespace flashgs::viewer

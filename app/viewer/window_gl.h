@@ -1,0 +1,47 @@
+// Window: the GLFW window and GL context, with the events the viewer polls (scroll, dropped files, size).
+#pragma once
+
+#include <string>
+#include <vector>
+
+struct GLFWwindow;
+
+namespace flashgs::viewer {
+
+class Window {
+ public:
+  // Creates a window of width x height screen points with a GL 3.3+ context, current on this
+  // thread. Throws flashgs::Error when GLFW or the context cannot be created.
+  Window(int width, int height, const std::string& title);
+  ~Window();
+  Window(const Window&) = delete;
+  Window& operator=(const Window&) = delete;
+
+  GLFWwindow* handle() const { return m_window; }
+  bool should_close() const;
+  void request_close();
+  void swap(bool vsync);
+  void poll(bool wait_for_events);
+  // Framebuffer size in pixels (zero while minimised) and its ratio to window points (high DPI).
+  void framebuffer_size(int* width, int* height) const;
+  float framebuffer_scale() const;
+
+  // Events gathered since the last take_*() call.
+  float take_scroll();
+  std::vector<std::string> take_drops();
+
+  bool key_down(int glfw_key) const;
+  bool mouse_down(int glfw_button) const;
+  void cursor(double* x, double* y) const;
+
+ private:
+  static void on_scroll(GLFWwindow* w, double dx, double dy);
+  static void on_drop(GLFWwindow* w, int count, const char** paths);
+
+  GLFWwindow* m_window = nullptr;
+  float m_scroll = 0;
+  std::vector<std::string> m_drops;
+  int m_swap_interval = -1;
+};
+
+}  // namespace flashgs::viewer
