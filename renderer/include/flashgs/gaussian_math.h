@@ -62,6 +62,15 @@ struct Footprint {
   float threshold;                 // the ellipse is q <= threshold
   int tile_x0, tile_y0;            // first tile of the box
   int tile_x1, tile_y1;            // one past the last tile of the box
+  // The same q in whitened form, q = (w0 dx + w1 dy)^2 + (w2 dx + w3 dy)^2: rows are the
+  // principal axes divided by their standard deviations. Evaluate q with this, not the
+  // conic: for a needle (scale ratio >= 1e4 seen side-on) the conic is so ill-conditioned
+  // (a c - b^2 ~ 1e-9 a c) that its float rounding alone puts q off by ~1e-7 a d^2, i.e. by
+  // whole units 1000 px from the centre, and a dx^2 + 2 b dx dy + c dy^2 cancels there too.
+  // The whitened form has no cancellation beyond the perpendicular distance itself, and
+  // q >= 0 by construction (the conic form goes slightly negative on a needle's axis, where
+  // 3DGS's "skip power > 0" then drops the Gaussian at its most opaque pixels).
+  float whiten[4];
 };
 
 FLASHGS_HD float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
@@ -181,7 +190,28 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
   if (!is_finite(mean_x) || !is_finite(mean_y) || !is_finite(ad) || !is_finite(cd) ||
       !is_finite(b) || !is_finite(det_d) || !(det_d > 0.0f))
     return kCulledDegenerate;
-  const float inv_det = 1.0f / det_d;
+  // Eigen-decomposition of the dilated covariance [ad b; b cd], each step free of
+  // cancellation: the largest eigenvalue as mid + root (a sum of non-negative terms), the
+  // smallest as det / lambda_max (Vieta) rather than mid - root, which for a needle is the
+  // difference of two numbers equal to every float digit; the major axis from whichever of
+  // (lambda_max - cd, b) and (b, lambda_max - ad) adds, not subtracts.
+  const float half_diff = 0.5f * (ad - cd);
+  const float root = sqrtf(half_diff * half_diff + b * b);
+  const float lambda_max = 0.5f * (ad + cd) + root;
+  const float lambda_min = det_d / lambda_max;
+  float ux = half_diff >= 0.0f ? half_diff + root : b;
+  float uy = half_diff >= 0.0f ? b : root - half_diff;
+  const float u_len = sqrtf(ux * ux + uy * uy);
+  if (!is_finite(lambda_max) || !is_finite(u_len) || !(lambda_min > 0.0f)) return kCulledDegenerate;
+  if (u_len > 0.0f) {
+    ux = ux / u_len;
+    uy = uy / u_len;
+  } else {  // isotropic: any axis
+    ux = 1.0f;
+    uy = 0.0f;
+  }
+  const float s_major = 1.0f / sqrtf(lambda_max), s_minor = 1.0f / sqrtf(lambda_min);
+  const float w0 = ux * s_major, w1 = uy * s_major, w2 = -uy * s_minor, w3 = ux * s_minor;
 
   float half_x, half_y;
   if (geo.tight_bbox) {
@@ -189,9 +219,6 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
     half_x = sqrtf(threshold * ad);
     half_y = sqrtf(threshold * cd);
   } else {
-    // largest eigenvalue without cancellation: mid + sqrt(((a - c) / 2)^2 + b^2)
-    const float half_diff = 0.5f * (ad - cd);
-    const float lambda_max = 0.5f * (ad + cd) + sqrtf(half_diff * half_diff + b * b);
     const float radius = sqrtf(threshold * lambda_max);
     half_x = half_y = geo.baseline ? ceilf(radius) : radius;
   }
@@ -223,9 +250,15 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
   out.mean_x = mean_x;
   out.mean_y = mean_y;
   out.depth = v[2];
-  out.conic_a = cd * inv_det;
-  out.conic_b = -b * inv_det;
-  out.conic_c = ad * inv_det;
+  // The conic from the whitened rows (W^T W): consistent with them, and free of det_d,
+  // which overflows (sigma^4) long before the entries do.
+  out.conic_a = w0 * w0 + w2 * w2;
+  out.conic_b = w0 * w1 + w2 * w3;
+  out.conic_c = w1 * w1 + w3 * w3;
+  out.whiten[0] = w0;
+  out.whiten[1] = w1;
+  out.whiten[2] = w2;
+  out.whiten[3] = w3;
   out.threshold = threshold;
   return kVisible;
 }
@@ -252,6 +285,38 @@ FLASHGS_HD bool ellipse_meets_rect(float a, float b, float c, float t, float dx0
   return false;
 }
 
+// q at offset (dx, dy) from the whitened rows w (see Footprint::whiten).
+FLASHGS_HD float whitened_q(const float w[4], float dx, float dy) {
+  const float u = w[0] * dx + w[1] * dy;
+  const float v = w[2] * dx + w[3] * dy;
+  return u * u + v * v;
+}
+
+// ellipse_meets_rect for the whitened form: the same edge minimisation (the minimiser along
+// an edge comes from the conic W^T W, where a small error only moves it along a flat
+// valley), but q itself evaluated without cancellation, so that tiles thousands of pixels
+// along a needle are decided correctly.
+FLASHGS_HD bool whitened_ellipse_meets_rect(const float w[4], float t, float dx0, float dx1, float dy0,
+                                            float dy1) {
+  const bool inside_x = dx0 <= 0.0f && dx1 >= 0.0f;
+  const bool inside_y = dy0 <= 0.0f && dy1 >= 0.0f;
+  if (inside_x && inside_y) return true;
+  const float a = w[0] * w[0] + w[2] * w[2];
+  const float b = w[0] * w[1] + w[2] * w[3];
+  const float c = w[1] * w[1] + w[3] * w[3];
+  if (!inside_x) {
+    const float dx = dx0 > 0.0f ? dx0 : dx1;
+    const float dy = clampf(-b * dx / c, dy0, dy1);
+    if (whitened_q(w, dx, dy) <= t) return true;
+  }
+  if (!inside_y) {
+    const float dy = dy0 > 0.0f ? dy0 : dy1;
+    const float dx = clampf(-b * dy / a, dx0, dx1);
+    if (whitened_q(w, dx, dy) <= t) return true;
+  }
+  return false;
+}
+
 // The exact test for tile (tx, ty): the rectangle spanned by its pixel centres, clipped to
 // the image.
 FLASHGS_HD bool footprint_touches_tile(const Footprint& f, int tx, int ty, int width, int height) {
@@ -259,8 +324,8 @@ FLASHGS_HD bool footprint_touches_tile(const Footprint& f, int tx, int ty, int w
   const float y0 = static_cast<float>(ty * kTileSize);
   const float x1 = minf(x0 + (kTileSize - 1), static_cast<float>(width - 1));
   const float y1 = minf(y0 + (kTileSize - 1), static_cast<float>(height - 1));
-  return ellipse_meets_rect(f.conic_a, f.conic_b, f.conic_c, f.threshold, x0 - f.mean_x,
-                            x1 - f.mean_x, y0 - f.mean_y, y1 - f.mean_y);
+  return whitened_ellipse_meets_rect(f.whiten, f.threshold, x0 - f.mean_x, x1 - f.mean_x, y0 - f.mean_y,
+                                     y1 - f.mean_y);
 }
 
 // Real spherical harmonics constants (degree 0..3) of the 3DGS colour model.
