@@ -10,8 +10,8 @@ namespace {
 constexpr int kTilePixels = gm::kTileSize * gm::kTileSize;
 
 // Composites one tile. Gaussian-outer, pixel-inner: each Gaussian is read once per tile and
-// the pixel loop runs over contiguous arrays. Per pixel the rules are those of 3DGS: skip
-// power > 0, alpha = min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4.
+// the pixel loop runs over contiguous arrays. Per pixel the rules are those of 3DGS:
+// alpha = min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4.
 void blend_tile(const Frame& frame, const std::uint64_t* keys, std::uint64_t count, int tile_x,
                 int tile_y, const float background[3], float* rgb) {
   const int width = frame.camera.width, height = frame.camera.height;
@@ -29,7 +29,6 @@ void blend_tile(const Frame& frame, const std::uint64_t* keys, std::uint64_t cou
   }
   for (std::uint64_t k = 0; k < count && active_count > 0; ++k) {
     const BlendGaussian& g = frame.blend_data[static_cast<std::uint32_t>(keys[k])];
-    const float slope = -g.conic_b / g.conic_a;
     // Only the rows, and in each row the pixels, that can reach power_cut; the margins (0.5
     // in q, one pixel each side) exceed the float rounding of the per-pixel power, so pruning
     // never changes which pixels pass the exact test below.
@@ -41,16 +40,21 @@ void blend_tile(const Frame& frame, const std::uint64_t* keys, std::uint64_t cou
       const float dy = static_cast<float>(y_begin + y) - g.mean_y;
       const float row_q = g.row_q_coeff * dy * dy;
       if (!(row_q <= g.q_cut + 0.5f)) continue;
-      const float centre = g.mean_x + slope * dy - static_cast<float>(x_begin);
-      const float half = std::sqrt(std::max(0.0f, g.q_cut + 0.5f - row_q) / g.conic_a) + 1.0f;
+      const float centre = g.mean_x + g.row_slope * dy - static_cast<float>(x_begin);
+      const float half = std::sqrt(std::max(0.0f, g.q_cut + 0.5f - row_q) * g.inv_conic_a) + 1.0f;
+      const float u_row = g.whiten[1] * dy, v_row = g.whiten[3] * dy;
       const int x0 = static_cast<int>(std::max(0.0f, std::ceil(centre - half)));
       const int x1 = static_cast<int>(std::min(static_cast<float>(tile_w - 1), std::floor(centre + half)));
       for (int x = x0; x <= x1; ++x) {
         const int p = y * gm::kTileSize + x;
         if (!active[p]) continue;
         const float dx = static_cast<float>(x_begin + x) - g.mean_x;
-        const float power = -0.5f * (g.conic_a * dx * dx + g.conic_c * dy * dy) - g.conic_b * dx * dy;
-        if (power > 0.0f || power < g.power_cut) continue;
+        // Whitened form (gm::Footprint::whiten): q >= 0 by construction and accurate far
+        // along a needle, so 3DGS's "skip power > 0" (which only rounding could trigger, on a
+        // needle's axis, dropping its most opaque pixels) is gone.
+        const float u = g.whiten[0] * dx + u_row, v = g.whiten[2] * dx + v_row;
+        const float power = -0.5f * (u * u + v * v);
+        if (power < g.power_cut) continue;
         const float alpha = std::min(gm::kAlphaMax, g.opacity * std::exp(power));
         if (alpha < gm::kAlphaMin) continue;
         const float next_t = transmittance[p] * (1.0f - alpha);

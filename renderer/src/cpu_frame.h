@@ -15,16 +15,18 @@ namespace cpu {
 // What the blend stage reads per Gaussian, packed so one cache line serves one Gaussian.
 struct BlendGaussian {
   float mean_x, mean_y;
-  float conic_a, conic_b, conic_c;
+  float whiten[4];  // q = (w0 dx + w1 dy)^2 + (w2 dx + w3 dy)^2 (gm::Footprint::whiten)
   float opacity;
   float rgb[3];
   // Below this power, alpha < 1/255 for certain (a margin keeps the exact test authoritative).
   float power_cut;
   // Row pruning: over a row at offset dy the smallest q is row_q_coeff * dy^2, reached at
-  // dx = -conic_b / conic_a * dy; pixels farther than sqrt((q_cut - q) / conic_a) from it
-  // cannot pass power_cut.
+  // dx = row_slope * dy (= -conic_b / conic_a * dy); pixels farther than
+  // sqrt((q_cut - q) * inv_conic_a) from it cannot pass power_cut.
   float row_q_coeff;
   float q_cut;
+  float row_slope;
+  float inv_conic_a;
 };
 
 // Reused from frame to frame; vectors only grow (high-water mark), nothing is freed.
