@@ -6,8 +6,22 @@
 #include <limits>
 #include <vector>
 
+#include "flashgs/gaussian_math.h"
+
 namespace flashgs {
 namespace {
+
+// The rule's constants are the float values every backend compares against (0.2f, 0.3f,
+// 0.99f, 1/255.f, 1e-4f), held exactly in double: the reference differs from a backend only
+// in arithmetic, not in where a threshold sits. With decimal doubles instead, a Gaussian at
+// z = 0.2f (= 0.2000000030) was culled by the backends and drawn by the reference, and two
+// alpha = 0.99 layers ((1 - 0.99)^2 = 1e-4, the stop threshold) stopped on opposite sides.
+constexpr double kNearZ = gm::kNearZ;
+constexpr double kDilation = gm::kDilation;
+constexpr double kAlphaMax = gm::kAlphaMax;
+constexpr double kAlphaMin = gm::kAlphaMin;
+constexpr double kTransmittanceMin = gm::kTransmittanceMin;
+constexpr double kFloatMax = 3.4028234663852886e38;
 
 struct RefGaussian {
   double mean_x, mean_y, depth;
@@ -86,9 +100,9 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
     double d[3], v[3];
     for (int k = 0; k < 3; ++k) d[k] = static_cast<double>(scene.positions[i * 3 + k]) - centre[k];
     for (int r = 0; r < 3; ++r) v[r] = rot[r * 3] * d[0] + rot[r * 3 + 1] * d[1] + rot[r * 3 + 2] * d[2];
-    if (!(v[2] > 0.2)) continue;
+    if (!(v[2] > kNearZ)) continue;
     const double opacity = scene.opacities[i];
-    if (!(opacity >= 1.0 / 255.0)) continue;  // alpha <= opacity can never reach 1/255
+    if (!(opacity >= kAlphaMin)) continue;  // alpha <= opacity can never reach 1/255
     // Sigma_2D = M M^T, M = J W R S (double precision throughout).
     const double qw = scene.rotations[i * 4], qx = scene.rotations[i * 4 + 1],
                  qy = scene.rotations[i * 4 + 2], qz = scene.rotations[i * 4 + 3];
@@ -109,13 +123,18 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
       m0[k] = t0[0] * ax + t0[1] * ay + t0[2] * az;
       m1[k] = t1[0] * ax + t1[1] * ay + t1[2] * az;
     }
-    const double a = m0[0] * m0[0] + m0[1] * m0[1] + m0[2] * m0[2] + 0.3;
+    const double a = m0[0] * m0[0] + m0[1] * m0[1] + m0[2] * m0[2] + kDilation;
     const double b = m0[0] * m1[0] + m0[1] * m1[1] + m0[2] * m1[2];
-    const double c = m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2] + 0.3;
+    const double c = m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2] + kDilation;
     const double n01 = m0[0] * m1[1] - m0[1] * m1[0], n02 = m0[0] * m1[2] - m0[2] * m1[0],
                  n12 = m0[1] * m1[2] - m0[2] * m1[1];
-    const double det = n01 * n01 + n02 * n02 + n12 * n12 + 0.3 * (a + c - 0.6) + 0.09;
+    const double det = n01 * n01 + n02 * n02 + n12 * n12 + kDilation * (a + c - 2 * kDilation) + kDilation * kDilation;
     if (!std::isfinite(det) || !(det > 0) || !std::isfinite(a) || !std::isfinite(c)) continue;
+    // The backends cull (FrameStats::culled_degenerate) a footprint whose covariance squared
+    // leaves float range (screen sigma above ~4e9 px, e.g. a log-scale of 50 in a file): it
+    // is not representable there. The reference applies the same documented rule, so that it
+    // judges what the backends draw; `flashgs check` reports how many were culled.
+    if (det > kFloatMax || (a + c) * (a + c) > kFloatMax) continue;
     RefGaussian g;
     g.mean_x = fx * v[0] / z + camera.cx;
     g.mean_y = fy * v[1] / z + camera.cy;
@@ -129,7 +148,7 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
     // Skip exactly the Gaussians whose alpha stays below 1/255 over the whole window.
     const double q_min = min_q_over_rect(g, window.x0 - g.mean_x, window.x0 + window.width - 1 - g.mean_x,
                                          window.y0 - g.mean_y, window.y0 + window.height - 1 - g.mean_y);
-    if (std::min(0.99, opacity * std::exp(-0.5 * q_min)) < 1.0 / 255.0) continue;
+    if (std::min(kAlphaMax, opacity * std::exp(-0.5 * q_min)) < kAlphaMin) continue;
     double dir[3];
     const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     for (int k = 0; k < 3; ++k) dir[k] = len > 0 ? d[k] / len : 0.0;
@@ -153,10 +172,10 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
         const double dx = px - g.mean_x, dy = py - g.mean_y;
         const double power = -0.5 * (g.a * dx * dx + g.c * dy * dy) - g.b * dx * dy;
         if (power > 0) continue;
-        const double alpha = std::min(0.99, g.opacity * std::exp(power));
-        if (alpha < 1.0 / 255.0) continue;
+        const double alpha = std::min(kAlphaMax, g.opacity * std::exp(power));
+        if (alpha < kAlphaMin) continue;
         const double next_t = t * (1 - alpha);
-        if (next_t < 1e-4) break;
+        if (next_t < kTransmittanceMin) break;
         for (int ch = 0; ch < 3; ++ch) rgb[ch] += g.rgb[ch] * alpha * t;
         t = next_t;
       }
