@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   flashgs::cli::register_render(app);
   flashgs::cli::register_info(app);
   flashgs::cli::register_generate(app);
+  flashgs::cli::register_bench(app);
   flashgs::cli::register_check(app);
   flashgs::cli::register_report(app);
   try {

@@ -297,7 +297,8 @@ class CudaRendererImpl final : public CudaRenderer {
       pair_counts_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair counts");
       pair_offsets_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair offsets");
     }
-    if (!cub_temp_.bytes()) grow_cub_temp();
+    blend_.reserve(std::max<std::size_t>(n, 1) * sizeof(cuda::BlendGaussian), "per-Gaussian blend data");
+    grow_cub_temp();  // host-side size query; allocates only when the scene or pairs grew
 
     cuda::PreprocessArgs args{};
     args.camera = cam;

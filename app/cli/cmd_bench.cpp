@@ -1,0 +1,254 @@
+// `flashgs bench`: per-stage timings, pairs, memory and image error of every configuration
+// over a camera set and resolutions; prints a table and writes JSON.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "flashgs/error.h"
+#include "flashgs/io.h"
+#include "scene_source.h"
+
+namespace flashgs::cli {
+namespace {
+
+struct BenchArgs {
+  SceneArgs scene;
+  std::string backend = "auto";
+  std::vector<std::string> resolutions = {"1920x1080", "3840x2160"};
+  std::vector<std::string> configs = {"all"};
+  std::vector<int> cameras;  // empty: 0, 2, ..., 34 (the 18 views of ANCHORS.md)
+  int warmup = 3;
+  int repeat = 10;
+  std::string json_path = "bench.json";
+};
+
+// The configurations by name: baseline, flash, and flash with one switch off.
+std::vector<std::pair<std::string, RenderOptions>> known_configs() {
+  std::vector<std::pair<std::string, RenderOptions>> out;
+  out.emplace_back("baseline", RenderOptions::baseline());
+  out.emplace_back("flash", RenderOptions{});
+  for (int k = 0; k < 8; ++k) {
+    RenderOptions o;
+    bool* switches[] = {&o.opacity_aware_radius, &o.tight_bbox,        &o.exact_tile_test, &o.warp_cooperative_emit,
+                        &o.fused_emit,           &o.minimal_sort_bits, &o.pipelined_blend, &o.exp2_alpha};
+    *switches[k] = false;
+    out.emplace_back(o.label(), o);
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, RenderOptions>> select_configs(const std::vector<std::string>& wanted,
+                                                                  bool cpu) {
+  const auto known = known_configs();
+  std::vector<std::pair<std::string, RenderOptions>> out;
+  for (const std::string& w : wanted) {
+    if (w == "all") {
+      for (const auto& c : known) {
+        // The CPU ignores the scheduling switches: their rows would repeat "flash".
+        const RenderOptions& o = c.second;
+        const bool scheduling_only = !o.is_baseline() && o.opacity_aware_radius && o.tight_bbox && o.exact_tile_test &&
+                                     c.first != "flash";
+        if (!(cpu && scheduling_only)) out.push_back(c);
+      }
+      continue;
+    }
+    auto it = std::find_if(known.begin(), known.end(), [&](const auto& c) { return c.first == w; });
+    if (it == known.end()) {
+      std::string names;
+      for (const auto& c : known) names += " " + c.first;
+      throw Error("bench: unknown config \"" + w + "\" (all" + names + ")");
+    }
+    out.push_back(*it);
+  }
+  // The baseline is rendered anyway (it is the reference image); list it first, once.
+  out.erase(std::remove_if(out.begin(), out.end(), [](const auto& c) { return c.first == "baseline"; }), out.end());
+  out.insert(out.begin(), known.front());
+  return out;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = p * (v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (v[hi] - v[lo]) * (pos - lo);
+}
+
+double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
+
+const char* kStages[] = {"project", "emit", "sort", "ranges", "blend", "total"};
+
+double stage_ms(const StageTimes& t, int s) {
+  switch (s) {
+    case 0: return t.project_ms;
+    case 1: return t.emit_ms;
+    case 2: return t.sort_ms;
+    case 3: return t.ranges_ms;
+    case 4: return t.blend_ms;
+    default: return t.total_ms;
+  }
+}
+
+// What one config collected at one resolution: per camera, the median of its repeats.
+struct ConfigRun {
+  std::string name;
+  RenderOptions options;
+  std::unique_ptr<Renderer> renderer;
+  std::vector<double> stage[6];  // per camera
+  std::vector<double> kv, visible, psnr, max_abs;
+  std::uint64_t memory_max = 0, peak_max = 0;
+  nlohmann::json per_camera = nlohmann::json::array();
+};
+
+nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+void run(const BenchArgs& args) {
+  const std::string scene_path = args.scene.resolved_scene();
+  auto scene = load_scene_verbose(scene_path);
+  const std::vector<Camera> all_cameras = load_cameras(args.scene.resolved_cameras());
+  std::vector<int> camera_ids = args.cameras;
+  if (camera_ids.empty())
+    for (int i = 0; i <= 34; i += 2) camera_ids.push_back(i);
+  for (int id : camera_ids)
+    if (id < 0 || id >= static_cast<int>(all_cameras.size()))
+      throw Error("bench: camera " + std::to_string(id) + " does not exist (" + std::to_string(all_cameras.size()) +
+                  " in the file)");
+  auto probe = make_backend(args.backend);
+  const bool cpu = probe->name().rfind("cpu", 0) == 0;
+  const std::string backend_name = probe->name();
+  probe.reset();
+  const auto configs = select_configs(args.configs, cpu);
+
+  nlohmann::json out;
+  out["scene"] = scene_path;
+  out["gaussians"] = scene->size();
+  out["sh_degree"] = scene->sh_degree;
+  out["scene_bytes_host_layout"] = scene->byte_size();
+  out["backend"] = backend_name;
+  out["timing"] = cpu ? "wall clock per stage (CPU)" : "GPU time per stage from CUDA events; total = sum of stages";
+  out["cameras"] = camera_ids;
+  out["warmup"] = args.warmup;
+  out["repeat"] = args.repeat;
+  out["results"] = nlohmann::json::array();
+
+  std::printf("%s: %zu Gaussians (SH degree %d) on %s; cameras", scene_path.c_str(), scene->size(), scene->sh_degree,
+              backend_name.c_str());
+  for (int id : camera_ids) std::printf(" %d", id);
+  std::printf("; %d warm-up + %d timed frames each; per-camera medians, then median (p95) over cameras\n",
+              args.warmup, args.repeat);
+
+  std::string table;
+  for (const std::string& resolution : args.resolutions) {
+    int width = 0, height = 0;
+    parse_resolution(resolution, &width, &height);
+    // One renderer per config, so each one's memory is its own high-water mark.
+    std::vector<ConfigRun> runs;
+    for (const auto& [name, options] : configs) {
+      ConfigRun r;
+      r.name = name;
+      r.options = options;
+      r.renderer = make_backend(args.backend);
+      r.renderer->set_scene(scene);
+      runs.push_back(std::move(r));
+    }
+    for (int id : camera_ids) {
+      const Camera camera = all_cameras[id].resized(width, height);
+      Image reference;
+      for (ConfigRun& r : runs) {
+        Image image;
+        FrameStats stats;
+        for (int w = 0; w < args.warmup; ++w) r.renderer->render(camera, r.options, image, &stats);
+        std::vector<double> samples[6];
+        for (int k = 0; k < std::max(1, args.repeat); ++k) {
+          r.renderer->render(camera, r.options, image, &stats);
+          for (int s = 0; s < 6; ++s) samples[s].push_back(stage_ms(stats.times, s));
+        }
+        nlohmann::json cam;
+        cam["camera"] = id;
+        for (int s = 0; s < 6; ++s) {
+          const double m = median(samples[s]);
+          r.stage[s].push_back(m);
+          cam[std::string(kStages[s]) + "_ms"] = m;
+        }
+        r.kv.push_back(static_cast<double>(stats.kv_pairs));
+        r.visible.push_back(static_cast<double>(stats.visible));
+        r.memory_max = std::max<std::uint64_t>(r.memory_max, stats.device_memory_bytes);
+        r.peak_max = std::max<std::uint64_t>(r.peak_max, stats.device_peak_bytes);
+        cam["kv_pairs"] = stats.kv_pairs;
+        cam["visible"] = stats.visible;
+        if (r.name == "baseline") reference = image;
+        const ImageDifference d = compare_images(reference, image);
+        r.psnr.push_back(d.psnr_db);
+        r.max_abs.push_back(d.max_abs);
+        cam["psnr_db_vs_baseline"] = finite_or_null(d.psnr_db);
+        cam["max_abs_vs_baseline"] = d.max_abs;
+        cam["non_finite"] = d.non_finite;
+        r.per_camera.push_back(cam);
+      }
+      std::fprintf(stderr, "  %s camera %d done\n", resolution.c_str(), id);
+    }
+    for (ConfigRun& r : runs) {
+      nlohmann::json j;
+      j["resolution"] = resolution;
+      j["config"] = r.name;
+      j["label"] = r.options.label();
+      for (int s = 0; s < 6; ++s)
+        j["ms"][kStages[s]] = {{"median", median(r.stage[s])}, {"p95", percentile(r.stage[s], 0.95)}};
+      j["kv_pairs"] = {{"median", median(r.kv)}, {"max", *std::max_element(r.kv.begin(), r.kv.end())}};
+      j["visible_median"] = median(r.visible);
+      j["memory_bytes"] = {{"working_max", r.memory_max}, {"peak", r.peak_max}};
+      const double psnr_min = *std::min_element(r.psnr.begin(), r.psnr.end());
+      j["psnr_db_vs_baseline"] = {{"min", finite_or_null(psnr_min)}, {"median", finite_or_null(median(r.psnr))}};
+      j["max_abs_vs_baseline"] = *std::max_element(r.max_abs.begin(), r.max_abs.end());
+      j["per_camera"] = r.per_camera;
+      out["results"].push_back(j);
+
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "%-10s %-28s %7.3f %7.3f %7.3f %7.3f %7.3f %8.3f (%7.3f) %9.0f %8.1f %7s %9.2e\n",
+                    resolution.c_str(), r.name.c_str(), median(r.stage[0]), median(r.stage[1]), median(r.stage[2]),
+                    median(r.stage[3]), median(r.stage[4]), median(r.stage[5]), percentile(r.stage[5], 0.95),
+                    median(r.kv), r.peak_max / 1e6,
+                    std::isfinite(psnr_min) ? std::to_string(psnr_min).substr(0, 6).c_str() : "inf",
+                    *std::max_element(r.max_abs.begin(), r.max_abs.end()));
+      table += line;
+    }
+  }
+  std::printf("%-10s %-28s %7s %7s %7s %7s %7s %8s %9s %9s %8s %7s %9s\n", "resolution", "config", "project", "emit",
+              "sort", "ranges", "blend", "total", "(p95)", "kv", "peak MB", "PSNRmin", "max abs");
+  std::printf("%s", table.c_str());
+  std::ofstream file(args.json_path);
+  if (!file) throw Error("bench: cannot write " + args.json_path);
+  file << out.dump(2) << "\n";
+  std::printf("wrote %s\n", args.json_path.c_str());
+}
+
+}  // namespace
+
+void register_bench(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* sub = app.add_subcommand("bench", "time every configuration over a camera set; table + JSON");
+  args->scene.add_to(sub);
+  sub->add_option("--backend", args->backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+  sub->add_option("--resolutions,-r", args->resolutions, "WxH list (comma separated)")->delimiter(',');
+  sub->add_option("--configs", args->configs,
+                  "all, or names: baseline flash flash-no_opacity_radius flash-no_tight_bbox flash-no_exact_tile_test "
+                  "flash-no_warp_emit flash-no_fused_emit flash-no_sort_bits flash-no_pipelined_blend "
+                  "flash-no_exp2_alpha")
+      ->delimiter(',');
+  sub->add_option("--camera-list", args->cameras, "camera indices (default 0,2,...,34)")->delimiter(',');
+  sub->add_option("--warmup", args->warmup, "untimed frames per camera and config")->check(CLI::NonNegativeNumber);
+  sub->add_option("--repeat", args->repeat, "timed frames per camera and config")->check(CLI::PositiveNumber);
+  sub->add_option("--json,-o", args->json_path, "JSON output file");
+  sub->callback([args] { run(*args); });
+}
+
+}  // namespace flashgs::cli

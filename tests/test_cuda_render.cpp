@@ -1,0 +1,339 @@
+// The CUDA backend against the CPU backend: identical pair counts, images within a bound,
+// deterministic bytes, odd sizes, a camera inside the scene, surfaces and tile counts.
+// Every test skips itself when no CUDA device is present (ctest label "gpu").
+#include <gtest/gtest.h>
+
+#include <cuda_runtime_api.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numeric>
+
+#include "flashgs/cuda_renderer.h"
+#include "flashgs/error.h"
+#include "flashgs/generators.h"
+#include "flashgs/renderer.h"
+#include "test_support.h"
+
+namespace flashgs {
+namespace {
+
+#define FLASHGS_REQUIRE_CUDA()                                                  \
+  do {                                                                          \
+    std::string why;                                                            \
+    if (!::flashgs::cuda_available(&why)) GTEST_SKIP() << "no CUDA device: " << why; \
+  } while (0)
+
+// Image bound CUDA vs CPU. Both run the same operations in the same order (the kernels are
+// built with -fmad=false), except exp: glibc's expf vs CUDA's (2 ulp) in the exact path,
+// exp2 of a pre-scaled form in the exp2 path (a few ulp of alpha). Such an ulp can move an
+// alpha across the 1/255 cut or a transmittance across 1e-4, which changes that pixel by at
+// most alpha * T * colour <= 0.99 * 1e-2 for the T cut and 1/255 * colour for the alpha cut;
+// colours reach ~1.3 on these scenes. Those flips are rare (a few pixels per frame), so the
+// test bounds the max by 1/64 and asks nearly all pixels (99.99%) to be within 1e-3.
+constexpr double kMaxAbs = 1.0 / 64.0;
+constexpr double kTypicalAbs = 1e-3;
+constexpr double kTypicalFraction = 1e-4;
+
+struct Result {
+  Image image;
+  FrameStats stats;
+};
+
+Result render(Renderer& r, const Camera& camera, const RenderOptions& options) {
+  Result out;
+  r.render(camera, options, out.image, &out.stats);
+  return out;
+}
+
+// Fraction of values off by more than `tol`.
+double fraction_over(const Image& a, const Image& b, double tol) {
+  std::size_t over = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) over += std::abs(double(a.rgb[i]) - b.rgb[i]) > tol;
+  return a.rgb.empty() ? 0.0 : double(over) / double(a.rgb.size());
+}
+
+std::vector<RenderOptions> all_configs() {
+  std::vector<RenderOptions> configs = {RenderOptions::baseline(), RenderOptions{}};
+  for (int k = 0; k < 8; ++k) {
+    RenderOptions o;
+    bool* switches[] = {&o.opacity_aware_radius, &o.tight_bbox,        &o.exact_tile_test, &o.warp_cooperative_emit,
+                        &o.fused_emit,           &o.minimal_sort_bits, &o.pipelined_blend, &o.exp2_alpha};
+    *switches[k] = false;
+    configs.push_back(o);
+  }
+  return configs;
+}
+
+// The CPU ignores the scheduling switches: its image for a config depends on the geometry only.
+std::string cpu_key(const RenderOptions& o) {
+  if (o.is_baseline()) return "baseline";
+  return std::to_string(o.opacity_aware_radius) + std::to_string(o.tight_bbox) + std::to_string(o.exact_tile_test);
+}
+
+void expect_match(const std::string& what, const Result& cpu, const Result& gpu) {
+  EXPECT_EQ(gpu.stats.kv_pairs, cpu.stats.kv_pairs) << what;
+  EXPECT_EQ(gpu.stats.visible, cpu.stats.visible) << what;
+  EXPECT_EQ(gpu.stats.culled_near, cpu.stats.culled_near) << what;
+  EXPECT_EQ(gpu.stats.culled_offscreen, cpu.stats.culled_offscreen) << what;
+  EXPECT_EQ(gpu.stats.culled_low_opacity, cpu.stats.culled_low_opacity) << what;
+  EXPECT_EQ(gpu.stats.culled_degenerate, cpu.stats.culled_degenerate) << what;
+  const ImageDifference d = compare_images(cpu.image, gpu.image);
+  const double typical = fraction_over(cpu.image, gpu.image, kTypicalAbs);
+  std::printf("%-58s kv %10llu  max abs %.2e  PSNR %6.1f dB  >1e-3: %.2e\n", what.c_str(),
+              static_cast<unsigned long long>(gpu.stats.kv_pairs), d.max_abs, d.psnr_db, typical);
+  EXPECT_EQ(d.non_finite, 0u) << what;
+  EXPECT_LE(d.max_abs, kMaxAbs) << what;
+  EXPECT_LE(typical, kTypicalFraction) << what;
+  if (d.max_abs > kMaxAbs || typical > kTypicalFraction) {
+    std::string stem = what;
+    std::replace_if(stem.begin(), stem.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
+    test::dump_images("cuda_" + stem, cpu.image, gpu.image);
+  }
+}
+
+// Every config on the GPU against the CPU, for one scene and a set of cameras.
+void compare_scene(const std::string& name, std::shared_ptr<const Scene> scene, const std::vector<Camera>& cameras) {
+  auto cpu = make_cpu_renderer();
+  auto gpu = make_cuda_renderer();
+  cpu->set_scene(scene);
+  gpu->set_scene(scene);
+  for (const Camera& camera : cameras) {
+    std::map<std::string, Result> cpu_results;
+    for (const RenderOptions& o : all_configs()) {
+      const std::string key = cpu_key(o);
+      if (!cpu_results.count(key)) cpu_results[key] = render(*cpu, camera, o);
+      const Result g = render(*gpu, camera, o);
+      expect_match(name + " " + camera.name + " " + std::to_string(camera.width) + "x" +
+                       std::to_string(camera.height) + " " + o.label(),
+                   cpu_results[key], g);
+    }
+  }
+}
+
+TEST(CudaVsCpu, RealScenesEveryConfig) {
+  FLASHGS_REQUIRE_CUDA();
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  for (const std::string& name : test::shared_scene_names()) {
+    const auto cameras = test::load_shared_cameras(name);
+    std::vector<Camera> picked = {cameras[0], cameras[20], cameras[40 % cameras.size()]};
+    compare_scene(name, test::load_shared_scene(name), picked);
+  }
+}
+
+TEST(CudaVsCpu, DemoSceneEveryConfig) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto cameras = test::load_demo_cameras();
+  compare_scene("demo", test::load_demo_scene(), {cameras[0], cameras[5].resized(1001, 563)});
+}
+
+// A camera at the centre of the scene's bounds, looking along +z: Gaussians behind, beside
+// and straddling the near plane, and huge screen-space footprints.
+Camera inside_camera(const Scene& scene, int width, int height) {
+  float lo[3], hi[3];
+  scene_bounds(scene, lo, hi);
+  const float centre[3] = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+  const float identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  Camera c = Camera::from_pose(width, height, 0.6f * width, 0.6f * width, identity, centre);
+  c.name = "inside";
+  return c;
+}
+
+// The frames the sanitizer run uses (tools/device/gpu_check.sh runs this test under
+// compute-sanitizer memcheck and racecheck): odd sizes, 4K, a camera inside the scene.
+std::vector<Camera> sanitizer_cameras(const Scene& scene, const std::vector<Camera>& cameras) {
+  std::vector<Camera> out = {cameras[0].resized(1001, 563), cameras[2].resized(17, 9),
+                             cameras[4].resized(3840, 2160), inside_camera(scene, 1001, 563)};
+  out[0].name = "1001x563";
+  out[1].name = "17x9";
+  out[2].name = "4K";
+  return out;
+}
+
+TEST(CudaVsCpu, OddSizesAndInsideCamera) {
+  FLASHGS_REQUIRE_CUDA();
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  const std::string name = test::shared_scene_names().front();
+  const auto scene = test::load_shared_scene(name);
+  compare_scene(name, scene, sanitizer_cameras(*scene, test::load_shared_cameras(name)));
+}
+
+// Runs the sanitizer frames for every config, with surfaces and tile counts, but without the
+// CPU comparison (memcheck makes each kernel 10-100x slower). Set FLASHGS_SANITIZER_SCENE.
+TEST(CudaSanitizer, Frames) {
+  FLASHGS_REQUIRE_CUDA();
+  const char* name = std::getenv("FLASHGS_SANITIZER_SCENE");
+  std::shared_ptr<const Scene> scene;
+  std::vector<Camera> cameras;
+  if (name && *name && !test::shared_scene_dir(name).empty()) {
+    scene = test::load_shared_scene(name);
+    cameras = test::load_shared_cameras(name);
+  } else {
+    scene = test::load_demo_scene();
+    cameras = test::load_demo_cameras();
+  }
+  auto gpu = make_cuda_renderer();
+  gpu->set_scene(scene);
+  for (const Camera& camera : sanitizer_cameras(*scene, cameras))
+    for (RenderOptions o : all_configs()) {
+      o.collect_tile_counts = true;
+      const Result r = render(*gpu, camera, o);
+      EXPECT_EQ(count_non_finite(r.image), 0u);
+      const std::uint64_t sum =
+          std::accumulate(r.stats.tile_pair_counts.begin(), r.stats.tile_pair_counts.end(), std::uint64_t{0});
+      EXPECT_EQ(sum, r.stats.kv_pairs) << camera.name << " " << o.label();
+    }
+}
+
+TEST(CudaDeterminism, SameFrameTwiceGivesTheSameBytes) {
+  FLASHGS_REQUIRE_CUDA();
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  for (const std::string& name : test::shared_scene_names()) {
+    const auto scene = test::load_shared_scene(name);
+    const Camera camera = test::load_shared_cameras(name)[20];
+    auto gpu = make_cuda_renderer();
+    gpu->set_scene(scene);
+    for (const RenderOptions& o : all_configs()) {
+      const Result a = render(*gpu, camera, o);
+      const Result other = render(*gpu, camera.resized(640, 360), RenderOptions::baseline());
+      const Result b = render(*gpu, camera, o);
+      auto fresh = make_cuda_renderer();
+      fresh->set_scene(scene);
+      const Result c = render(*fresh, camera, o);
+      EXPECT_EQ(a.image.rgb, b.image.rgb) << name << " " << o.label();
+      EXPECT_EQ(a.image.rgb, c.image.rgb) << name << " " << o.label();
+      EXPECT_EQ(a.stats.kv_pairs, b.stats.kv_pairs);
+      (void)other;
+    }
+  }
+}
+
+// Same tile counts as the CPU, tile by tile.
+TEST(CudaStats, TileCountsMatchTheCpu) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = test::load_demo_scene();
+  const Camera camera = test::load_demo_cameras()[3].resized(800, 450);
+  auto cpu = make_cpu_renderer();
+  auto gpu = make_cuda_renderer();
+  cpu->set_scene(scene);
+  gpu->set_scene(scene);
+  for (RenderOptions o : {RenderOptions{}, RenderOptions::baseline()}) {
+    o.collect_tile_counts = true;
+    const Result c = render(*cpu, camera, o);
+    const Result g = render(*gpu, camera, o);
+    EXPECT_EQ(c.stats.tile_pair_counts, g.stats.tile_pair_counts) << o.label();
+    EXPECT_EQ(c.stats.max_tile_pairs, g.stats.max_tile_pairs) << o.label();
+    std::vector<std::uint32_t> again;
+    gpu->download_tile_counts(again);
+    EXPECT_EQ(again, g.stats.tile_pair_counts);
+    EXPECT_GT(g.stats.device_memory_bytes, 0u);
+    EXPECT_GE(g.stats.device_peak_bytes, g.stats.device_memory_bytes);
+    EXPECT_GT(g.stats.times.total_ms, 0.0);
+  }
+}
+
+// An empty frame (camera looking away) is the background, with no pairs.
+TEST(CudaEdgeCases, EmptyFrameAndEmptyScene) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = test::load_demo_scene();
+  Camera camera = test::load_demo_cameras()[0].resized(64, 48);
+  for (int k = 0; k < 9; ++k) camera.rotation[k] = -camera.rotation[k];  // looks the other way
+  for (int k : {0, 1, 2}) camera.rotation[3 + k] = -camera.rotation[3 + k];  // keep det = +1
+  auto gpu = make_cuda_renderer();
+  gpu->set_scene(scene);
+  RenderOptions o;
+  o.background[0] = 0.25f;
+  o.background[1] = 0.5f;
+  o.background[2] = 1.0f;
+  Result r = render(*gpu, camera, o);
+  EXPECT_EQ(r.stats.kv_pairs, 0u);
+  for (std::size_t i = 0; i < r.image.rgb.size(); i += 3) {
+    ASSERT_EQ(r.image.rgb[i], 0.25f);
+    ASSERT_EQ(r.image.rgb[i + 2], 1.0f);
+  }
+  gpu->set_scene(std::make_shared<Scene>());
+  r = render(*gpu, camera, o);
+  EXPECT_EQ(r.stats.kv_pairs, 0u);
+  EXPECT_EQ(r.image.rgb[1], 0.5f);
+}
+
+// render_to_surface writes the same pixels, as RGBA8, as render() gives as floats.
+TEST(CudaSurface, MatchesTheFloatImage) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = test::load_demo_scene();
+  const Camera camera = test::load_demo_cameras()[1].resized(333, 187);
+  auto gpu = make_cuda_renderer();
+  gpu->set_scene(scene);
+  const Result f = render(*gpu, camera, RenderOptions{});
+  cudaChannelFormatDesc desc = cudaCreateChannelDesc(8, 8, 8, 8, cudaChannelFormatKindUnsigned);
+  cudaArray_t array = nullptr;
+  ASSERT_EQ(cudaMallocArray(&array, &desc, camera.width, camera.height, cudaArraySurfaceLoadStore), cudaSuccess);
+  cudaResourceDesc res{};
+  res.resType = cudaResourceTypeArray;
+  res.res.array.array = array;
+  cudaSurfaceObject_t surface = 0;
+  ASSERT_EQ(cudaCreateSurfaceObject(&surface, &res), cudaSuccess);
+  FrameStats stats;
+  gpu->render_to_surface(camera, RenderOptions{}, surface, &stats);
+  ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(gpu->stream())), cudaSuccess);
+  std::vector<unsigned char> rgba(std::size_t(camera.width) * camera.height * 4);
+  ASSERT_EQ(cudaMemcpy2DFromArray(rgba.data(), camera.width * 4, array, 0, 0, camera.width * 4, camera.height,
+                                  cudaMemcpyDeviceToHost),
+            cudaSuccess);
+  EXPECT_EQ(stats.kv_pairs, f.stats.kv_pairs);
+  int worst = 0;
+  for (std::size_t p = 0; p < std::size_t(camera.width) * camera.height; ++p) {
+    for (int ch = 0; ch < 3; ++ch) {
+      const float v = std::min(1.0f, std::max(0.0f, f.image.rgb[p * 3 + ch]));
+      const int expected = static_cast<int>(v * 255.0f + 0.5f);
+      worst = std::max(worst, std::abs(expected - rgba[p * 4 + ch]));
+    }
+    EXPECT_EQ(rgba[p * 4 + 3], 255);
+  }
+  EXPECT_LE(worst, 0);
+  cudaDestroySurfaceObject(surface);
+  cudaFreeArray(array);
+}
+
+// A scene that cannot fit in GPU memory is a flashgs::Error, not a crash, and the old scene
+// stays usable. The GPU is first filled with ballast so that a 2M-Gaussian scene cannot fit.
+TEST(CudaEdgeCases, SceneTooLargeIsAnError) {
+  FLASHGS_REQUIRE_CUDA();
+  auto gpu = make_cuda_renderer();
+  const auto demo = test::load_demo_scene();
+  gpu->set_scene(demo);
+  const Camera camera = test::load_demo_cameras()[0].resized(320, 180);
+  render(*gpu, camera, RenderOptions{});  // frame buffers exist before the ballast
+  std::vector<void*> ballast;
+  for (std::size_t chunk = std::size_t{1} << 30; chunk >= (std::size_t{1} << 20);) {
+    void* p = nullptr;
+    if (cudaMalloc(&p, chunk) == cudaSuccess) ballast.push_back(p);
+    else {
+      cudaGetLastError();
+      chunk /= 2;
+    }
+  }
+  const std::size_t n = 2000000;  // 2M x 56 B = 112 MB, more than the ballast left
+  auto big = std::make_shared<Scene>();
+  big->positions.assign(n * 3, 0.0f);
+  big->scales.assign(n * 3, 0.01f);
+  big->rotations.assign(n * 4, 0.0f);
+  for (std::size_t i = 0; i < n; ++i) big->rotations[i * 4] = 1.0f;
+  big->opacities.assign(n, 0.5f);
+  big->sh_dc.assign(n * 3, 0.0f);
+  try {
+    gpu->set_scene(big);
+    ADD_FAILURE() << "set_scene of 2M Gaussians succeeded with the GPU full";
+  } catch (const Error& e) {
+    std::printf("expected error: %s\n", e.what());
+    EXPECT_NE(std::string(e.what()).find("out of GPU memory"), std::string::npos);
+  }
+  for (void* p : ballast) cudaFree(p);
+  const Result r = render(*gpu, camera, RenderOptions{});
+  EXPECT_GT(r.stats.kv_pairs, 0u);
+}
+
+}  // namespace
+}  // namespace flashgs

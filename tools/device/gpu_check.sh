@@ -1,0 +1,118 @@
+#!/usr/bin/env bash
+# GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
+# Usage (from the repository root, through the device `run` tool, carrying .deps):
+#   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench
+#                                       bench-cpu profile
+# .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
+# cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
+# there; `build` builds everything on the machine instead, into build-dev).
+set -u
+ROOT=$(pwd)
+OUT=${OUT:-$ROOT/out}
+mkdir -p "$OUT"
+BIN=$ROOT/.deps/bin
+SCENES=$ROOT/.deps/scenes
+log() { echo "== $(date +%T) $*" | tee -a "$OUT/summary.txt"; }
+
+setup() {
+  nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv | tee "$OUT/device.txt"
+  for f in "$SCENES"/*/point_cloud.ply.xz; do
+    [ -f "${f%.xz}" ] || xz -d -k -T0 "$f"
+  done
+  # The carried binaries name the scene and asset folders of the machine they were built on.
+  if [ ! -e /work/shared/scenes ] && [ ! -e /work/main ]; then
+    mkdir -p /work/shared /work/main
+    ln -sfn "$SCENES" /work/shared/scenes
+    ln -sfn "$ROOT/assets" /work/main/assets
+  fi
+  if "$BIN/flashgs" --help > /dev/null 2>&1; then
+    FLASHGS=$BIN/flashgs
+    TESTS=$BIN/test_cuda_render
+    log "using carried binaries"
+  else
+    log "carried binaries do not run here; building"
+    build
+  fi
+}
+
+build() {
+  cmake -S . -B build-dev -G Ninja -DCMAKE_BUILD_TYPE=Release -DFLASHGS_HEADER_DEPS_DIR="$ROOT/.deps/include" \
+    -DCMAKE_CUDA_ARCHITECTURES=90 -DFLASHGS_BUILD_APP=OFF -DFLASHGS_SHARED_SCENES="$SCENES" \
+    -DFLASHGS_GTEST_SOURCE_DIR="$ROOT/.deps/googletest" > "$OUT/build.log" 2>&1 &&
+    ninja -C build-dev flashgs test_cuda_render >> "$OUT/build.log" 2>&1
+  local rc=$?
+  log "device build rc=$rc"
+  if [ $rc -eq 0 ]; then
+    FLASHGS=$ROOT/build-dev/app/flashgs
+    TESTS=$ROOT/build-dev/tests/test_cuda_render
+  fi
+  tail -5 "$OUT/build.log"
+}
+
+tests() {
+  log "gpu tests"
+  "$TESTS" --gtest_filter=-CudaSanitizer.* 2>&1 | tee "$OUT/gpu_tests.log" | grep -E "^\[  (FAILED|PASSED|SKIPPED) |Failure|expected error" | head -40
+  log "gpu tests rc=${PIPESTATUS[0]}"
+}
+
+sanitize() {
+  export FLASHGS_SANITIZER_SCENE=pc_biker
+  for tool in memcheck racecheck; do
+    log "compute-sanitizer $tool"
+    timeout 300 compute-sanitizer --tool $tool --error-exitcode 9 --print-limit 20 \
+      "$TESTS" --gtest_filter=CudaSanitizer.* > "$OUT/sanitizer_$tool.log" 2>&1
+    log "sanitizer $tool rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$OUT/sanitizer_$tool.log" | tail -1)"
+  done
+}
+
+bench_scene() {  # scene-folder json-name extra-args...
+  local dir=$1 name=$2
+  shift 2
+  "$FLASHGS" bench "$dir/point_cloud.ply" -o "$OUT/$name.json" "$@" 2> "$OUT/$name.err" | tee "$OUT/$name.txt" | tail -14
+}
+
+bench_quick() {
+  log "bench quick"
+  bench_scene "$SCENES/pc_biker" bench_biker_quick --backend cuda -r 1920x1080 --configs baseline,flash --warmup 2 --repeat 5
+}
+
+bench() {
+  log "bench pc_biker"
+  bench_scene "$SCENES/pc_biker" bench_biker --backend cuda -r 1920x1080,3840x2160
+  log "bench pc_playbot"
+  bench_scene "$SCENES/pc_playbot" bench_playbot --backend cuda -r 1920x1080,3840x2160
+  log "generate 7 x pc_playbot"
+  [ -f /tmp/tile7/point_cloud.ply ] || "$FLASHGS" generate tile -i "$SCENES/pc_playbot/point_cloud.ply" -n 7 -o /tmp/tile7 | tail -1
+  bench_scene /tmp/tile7 bench_tile7 --backend cuda -r 1920x1080,3840x2160 --configs baseline,flash --warmup 2 --repeat 5
+}
+
+bench_cpu() {
+  log "bench cpu pc_playbot 1080p"
+  bench_scene "$SCENES/pc_playbot" bench_playbot_cpu --backend cpu -r 1920x1080 --warmup 1 --repeat 3
+}
+
+profile() {
+  log "ncu"
+  timeout 240 ncu --set basic -k regex:'preprocess|blend|ranges|duplicate' --launch-skip 20 --launch-count 8 \
+    "$FLASHGS" render "$SCENES/pc_playbot/point_cloud.ply" --backend cuda -c 10 -r 3840x2160 --repeat 6 -o /tmp/p.ppm \
+    > "$OUT/ncu.txt" 2>&1
+  log "ncu rc=$?"
+  grep -E "^  [a-z_].*\(|Duration|Memory Throughput|Compute \(SM\) Throughput|Registers Per|Achieved Occupancy" "$OUT/ncu.txt" | head -60
+}
+
+FLASHGS=$BIN/flashgs
+TESTS=$BIN/test_cuda_render
+for step in "$@"; do
+  case $step in
+    setup) setup ;;
+    build) build ;;
+    tests) tests ;;
+    sanitize) sanitize ;;
+    bench-quick) bench_quick ;;
+    bench) bench ;;
+    bench-cpu) bench_cpu ;;
+    profile) profile ;;
+    *) echo "unknown step $step" ;;
+  esac
+done
+log "done"
