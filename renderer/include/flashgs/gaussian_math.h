@@ -152,8 +152,10 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
 
   float threshold = kBaselineSigmas * kBaselineSigmas;
   if (geo.opacity_radius) {
-    // alpha = o exp(-q / 2) >= tau  <=>  q <= 2 ln(o / tau)
-    if (!(opacity > geo.tau)) return kCulledLowOpacity;
+    // alpha = o exp(-q / 2) >= tau  <=>  q <= 2 ln(o / tau). Culled only when o < tau: the
+    // blend keeps alpha == 1/255 (it skips alpha < 1/255), so o == tau still draws its centre
+    // pixel (threshold 0); culling it too dropped 1/255 of colour there (stress opacity_edges).
+    if (!(opacity >= geo.tau)) return kCulledLowOpacity;
     threshold = 2.0f * portable_log(opacity / geo.tau);
   }
 
