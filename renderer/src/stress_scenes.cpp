@@ -397,8 +397,11 @@ StressCase opacity_edges_case() {
   }
   // Stacks of opaque layers on the centre: after two alpha = 0.99 layers T = 1e-4 exactly
   // in decimal, the stop rule's threshold.
-  for (int j = 0; j < 3; ++j)
-    add(s, world(40.0f), world(36.0f), 1.0f + j * 0.5f, 0.3f, 0.3f, 0.3f, kIdentity, 1.0f, 0.3f * j, 0.5f, 1.0f - 0.3f * j);
+  for (int j = 0; j < 3; ++j) {  // all three centred on pixel (40, 36)
+    const float zj = 1.0f + j * 0.5f;
+    add(s, (40.0f - 31.5f) * zj / f, (36.0f - 31.5f) * zj / f, zj, 0.3f * zj, 0.3f * zj, 0.3f * zj, kIdentity, 1.0f,
+        0.3f * j, 0.5f, 1.0f - 0.3f * j);
+  }
   c.cameras.push_back(axis_camera(64, 64, 90.0));
   set_bounds(c, kRounding + kOneFlip, kRounding + 2 * kThreeSigmaCut,
              "rounding + one threshold flip: the thresholds are compared against the same float constants");
