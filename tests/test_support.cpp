@@ -5,7 +5,7 @@
 #include <map>
 #include <mutex>
 
-#include "flashgs/image_io.h"
+#include "flashgs/netpbm.h"
 #include "flashgs/io.h"
 
 namespace flashgs::test {
@@ -48,12 +48,12 @@ std::vector<Camera> load_demo_cameras() {
 void dump_images(const std::string& stem, const Image& expected, const Image& actual) {
   std::filesystem::create_directories(FLASHGS_TEST_OUTPUT_DIR);
   const std::string base = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/" + stem;
-  write_image(expected, base + "_expected.pfm");
-  write_image(actual, base + "_actual.pfm");
+  write_pfm(expected, base + "_expected.pfm");
+  write_pfm(actual, base + "_actual.pfm");
   Image diff = expected;
   for (std::size_t i = 0; i < diff.rgb.size() && i < actual.rgb.size(); ++i)
     diff.rgb[i] = std::abs(expected.rgb[i] - actual.rgb[i]) * 10.0f;
-  write_image(diff, base + "_diff_x10.pfm");
+  write_pfm(diff, base + "_diff_x10.pfm");
 }
 
 }  // namespace flashgs::test

@@ -1,4 +1,4 @@
-// Image file IO: OpenImageIO when available, plus built-in PPM (8-bit) and PFM (float).
+// Image file IO: OpenImageIO when available, with the built-in PPM/PFM formats always.
 #include "flashgs/image_io.h"
 
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "flashgs/error.h"
+#include "flashgs/netpbm.h"
 
 #ifdef FLASHGS_HAVE_OIIO
 #include <OpenImageIO/imageio.h>
@@ -23,54 +24,6 @@ std::string extension_of(const std::string& path) {
   std::string ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext;
-}
-
-unsigned char to_byte(float v) {
-  if (!(v > 0.0f)) return 0;  // NaN -> 0
-  return static_cast<unsigned char>(std::lround(std::min(v, 1.0f) * 255.0f));
-}
-
-void write_ppm(const Image& image, const std::string& path) {
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw Error(path + ": cannot open for writing");
-  file << "P6\n" << image.width << " " << image.height << "\n255\n";
-  std::vector<unsigned char> bytes(image.rgb.size());
-  std::transform(image.rgb.begin(), image.rgb.end(), bytes.begin(), to_byte);
-  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (!file) throw Error(path + ": write error");
-}
-
-void write_pfm(const Image& image, const std::string& path) {
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw Error(path + ": cannot open for writing");
-  file << "PF\n" << image.width << " " << image.height << "\n-1.0\n";  // little endian
-  for (int y = image.height - 1; y >= 0; --y)  // PFM stores the bottom row first
-    file.write(reinterpret_cast<const char*>(image.pixel(0, y)), static_cast<std::streamsize>(image.width * 3 * 4));
-  if (!file) throw Error(path + ": write error");
-}
-
-Image read_netpbm(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw Error(path + ": cannot open");
-  std::string magic;
-  int w = 0, h = 0;
-  double scale = 0;
-  file >> magic >> w >> h >> scale;
-  file.get();
-  if ((magic != "P6" && magic != "PF") || w <= 0 || h <= 0 || w > 65536 || h > 65536)
-    throw Error(path + ": not a binary PPM/PFM image");
-  Image image;
-  image.resize(w, h);
-  if (magic == "P6") {
-    std::vector<unsigned char> bytes(image.rgb.size());
-    file.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    for (std::size_t i = 0; i < bytes.size(); ++i) image.rgb[i] = bytes[i] / 255.0f;
-  } else {
-    for (int y = h - 1; y >= 0; --y)
-      file.read(reinterpret_cast<char*>(image.pixel(0, y)), static_cast<std::streamsize>(w * 3 * 4));
-  }
-  if (!file) throw Error(path + ": truncated image");
-  return image;
 }
 
 }  // namespace
