@@ -1,4 +1,5 @@
 // `flashgs generate`: the demo scene, and large scenes made by tiling a real one.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -39,8 +40,17 @@ void run(const GenerateArgs& args) {
     if (args.input.empty()) throw Error("generate tile: give the scene to copy with --input");
     const Scene source = load_ply(args.input);
     const Scene scene = tile_scene(source, args.copies);
-    // Keep the source's cameras, moved back so that the whole grid is in view.
+    // The source's cameras, pushed back from the grid centre so that the whole grid is in
+    // view and every copy costs work (the grid is centred where the source was).
     std::vector<Camera> cameras = load_cameras((std::filesystem::path(args.input).parent_path() / "cameras.json").string());
+    float lo[3], hi[3];
+    scene_bounds(source, lo, hi);
+    const float side = std::ceil(std::sqrt(static_cast<float>(args.copies)));
+    for (Camera& camera : cameras)
+      for (int k = 0; k < 3; ++k) {
+        const float centre = 0.5f * (lo[k] + hi[k]);
+        camera.position[k] = centre + (camera.position[k] - centre) * side;
+      }
     write_scene(scene, cameras, args.output_dir);
   } else if (args.kind == "stress") {
     if (args.list || args.stress.empty()) {
