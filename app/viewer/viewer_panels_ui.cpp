@@ -85,24 +85,32 @@ void render_panel(ViewerSettings& s) {
   ImGui::TextDisabled("(B)");
   o.algorithm = algo == 0 ? Algorithm::baseline : Algorithm::flash;
   ImGui::BeginDisabled(o.is_baseline());
-  ImGui::Checkbox("Opacity-aware radius", &o.opacity_aware_radius);
-  ImGui::Checkbox("Tight bounding box", &o.tight_bbox);
-  ImGui::Checkbox("Exact ellipse-tile test", &o.exact_tile_test);
-  ImGui::TextDisabled("GPU kernels (the CPU backend ignores these):");
-  ImGui::Checkbox("Warp-cooperative emit", &o.warp_cooperative_emit);
-  ImGui::Checkbox("Fused preprocess + emit", &o.fused_emit);
-  ImGui::Checkbox("Minimal sort bits", &o.minimal_sort_bits);
-  ImGui::Checkbox("Pipelined blend", &o.pipelined_blend);
-  ImGui::Checkbox("exp2 alpha", &o.exp2_alpha);
+  // Two columns: the geometry switches (every backend) and the GPU kernel switches (CUDA only).
+  if (ImGui::BeginTable("opts", 2, ImGuiTableFlags_SizingStretchSame)) {
+    ImGui::TableNextColumn();
+    ImGui::TextDisabled("geometry");
+    ImGui::Checkbox("Opacity radius", &o.opacity_aware_radius);
+    ImGui::Checkbox("Tight box", &o.tight_bbox);
+    ImGui::Checkbox("Exact tile test", &o.exact_tile_test);
+    ImGui::TableNextColumn();
+    ImGui::TextDisabled("GPU kernels");
+    ImGui::Checkbox("Warp emit", &o.warp_cooperative_emit);
+    ImGui::Checkbox("Fused emit", &o.fused_emit);
+    ImGui::Checkbox("Sort bits", &o.minimal_sort_bits);
+    ImGui::Checkbox("Pipelined blend", &o.pipelined_blend);
+    ImGui::Checkbox("exp2 alpha", &o.exp2_alpha);
+    ImGui::EndTable();
+  }
   ImGui::EndDisabled();
   float inv_tau = 1.0f / o.tau;
-  if (ImGui::SliderFloat("1 / tau", &inv_tau, 2.0f, 4096.0f, "%.0f", ImGuiSliderFlags_Logarithmic))
-    o.tau = 1.0f / inv_tau;
-  ImGui::SameLine();
-  ImGui::TextDisabled("tau %.5f", o.tau);
+  char tau_label[64];
+  std::snprintf(tau_label, sizeof tau_label, "1/tau (tau %.5f)###tau", o.tau);
+  if (ImGui::SliderFloat(tau_label, &inv_tau, 2.0f, 4096.0f, "%.0f", ImGuiSliderFlags_Logarithmic)) o.tau = 1.0f / inv_tau;
   ImGui::SliderInt("SH degree cap", &o.sh_degree_cap, 0, 3);
   ImGui::ColorEdit3("Background", o.background, ImGuiColorEditFlags_NoInputs);
-  ImGui::Checkbox("Render every frame", &s.continuous);
+  ImGui::SameLine();
+  ImGui::Checkbox("Every frame", &s.continuous);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("re-render every frame (off: only when the view or an option changes)");
   ImGui::SameLine();
   ImGui::Checkbox("VSync", &s.vsync);
 }
@@ -208,16 +216,24 @@ void legend_labels(const UiModel& m) {
 
 void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer, std::string& shot) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowSizeConstraints(ImVec2(300, 100), ImVec2(600, std::max(120.0f, vp->WorkSize.y - 20)));
   ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("flashgs-viewer");
+  ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels
   scene_panel(m, s, a, path_buffer);
   view_panel(m, s, a);
   render_panel(s);
   compare_panel(m, a);
   overlay_panel(m, s, a, shot);
-  ImGui::TextDisabled("WASD/QE move, right-drag look, wheel speed, Shift fast; orbit: left-drag rotate, "
-                      "right-drag pan, wheel zoom. N/P camera, Space path, F1 panels, F12 screenshot.");
+  if (ImGui::CollapsingHeader("Keys")) {
+    ImGui::TextWrapped("Fly: WASD move, Q/E down/up, right-drag look, wheel speed, Shift fast. "
+                       "Orbit: left-drag rotate, right-drag (or Shift+left) pan, wheel or W/S zoom. "
+                       "N/P next/previous camera, Space play path, Tab fly/orbit, B baseline/flash, "
+                       "H heat map, C compare, F12 screenshot, F1 hide panels. Drop a PLY to open it.");
+  }
+  ImGui::PopItemWidth();
   ImGui::End();
   stats_window(m);
   if (s.heatmap) legend_labels(m);

@@ -1,0 +1,146 @@
+// The viewer run headless (Xvfb + Mesa, CPU path): scripted screenshots match the CLI's render, keys move the camera.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "flashgs/image.h"
+#include "flashgs/image_io.h"
+#include "test_support.h"
+
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+RunResult run(const std::string& command) {
+  RunResult r;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) r.output += buffer.data();
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string out_dir() {
+  const std::string dir = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/viewer";
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// The viewer needs an X display: the one we have, or a private Xvfb through xvfb-run.
+// Returns the command prefix, or empty when neither exists.
+std::string display_prefix() {
+  if (run("command -v xvfb-run").exit_code == 0) return "xvfb-run -a -s \"-screen 0 1920x1080x24\" ";
+  if (std::getenv("DISPLAY")) return " ";
+  return "";
+}
+
+#define REQUIRE_DISPLAY(prefix)                                                                 \
+  const std::string prefix = display_prefix();                                                  \
+  if (prefix.empty()) GTEST_SKIP() << "no X display and no xvfb-run (install xvfb): viewer test skipped"
+
+std::string viewer() { return FLASHGS_VIEWER; }
+std::string cli() { return FLASHGS_CLI; }
+
+// The viewer's screenshot of `camera` vs `flashgs render` of the same camera at the same size.
+void expect_matches_cli(const std::string& prefix, const std::string& scene, int camera, const std::string& stem) {
+  const std::string dir = out_dir();
+  const std::string shot = dir + "/" + stem + "_viewer.png", ref = dir + "/" + stem + "_cli.png";
+  std::filesystem::remove(shot);
+  const std::string scene_arg = scene.empty() ? "" : "\"" + scene + "\" ";
+  const RunResult v = run(prefix + viewer() + " " + scene_arg + "--backend cpu --size 640x360 --camera " +
+                          std::to_string(camera) + " --frames 2 --screenshot " + shot + " --exit");
+  ASSERT_EQ(v.exit_code, 0) << v.output;
+  EXPECT_NE(v.output.find("frame path: CPU"), std::string::npos) << v.output;
+  const RunResult c = run(cli() + " render " + scene_arg + "--backend cpu -c " + std::to_string(camera) +
+                          " -r 640x360 -o " + ref);
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  const flashgs::Image a = flashgs::read_image(shot), b = flashgs::read_image(ref);
+  ASSERT_EQ(a.width, 640);
+  ASSERT_EQ(a.height, 360);
+  const flashgs::ImageDifference d = flashgs::compare_images(a, b);
+  std::printf("%s: viewer vs CLI PSNR %.2f dB, max abs %.4f\n", stem.c_str(), d.psnr_db, d.max_abs);
+  if (!(d.psnr_db >= 40.0)) flashgs::test::dump_images("viewer_" + stem, b, a);
+  EXPECT_GE(d.psnr_db, 40.0);
+}
+
+TEST(Viewer, DemoSceneScreenshotMatchesCliRender) {
+  REQUIRE_DISPLAY(prefix);
+  expect_matches_cli(prefix, "", 3, "demo_cam3");
+}
+
+TEST(Viewer, BikerCameraZeroMatchesCliRender) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = flashgs::test::shared_scene_dir("pc_biker");
+  if (dir.empty()) GTEST_SKIP() << "../shared/scenes/pc_biker is absent: skipped";
+  expect_matches_cli(prefix, dir + "/point_cloud.ply", 0, "pc_biker_cam0");
+}
+
+TEST(Viewer, ScriptedKeysMoveTheCamera) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string still = dir + "/keys_still.png", moved = dir + "/keys_moved.png";
+  const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --camera 0 ";
+  const RunResult a = run(common + "--frames 1 --screenshot " + still + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const RunResult b = run(common + "--keys \"W:0.5,D:0.2,MOUSE:40:0\" --screenshot " + moved + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const auto position = [](const std::string& out) {
+    const auto at = out.find("viewer camera: position");
+    return at == std::string::npos ? std::string() : out.substr(at, out.find('\n', at) - at);
+  };
+  EXPECT_FALSE(position(b.output).empty()) << b.output;
+  EXPECT_NE(position(a.output), position(b.output));
+  const flashgs::ImageDifference d = flashgs::compare_images(flashgs::read_image(still), flashgs::read_image(moved));
+  std::printf("still vs moved: PSNR %.2f dB, max abs %.3f\n", d.psnr_db, d.max_abs);
+  EXPECT_LT(d.psnr_db, 30.0) << "the key sequence did not change the picture";
+}
+
+TEST(Viewer, FailedLoadKeepsTheCurrentScene) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string bad = dir + "/not_a_scene.ply";
+  { FILE* f = std::fopen(bad.c_str(), "wb"); ASSERT_TRUE(f); std::fputs("ply\nformat ascii 9.9\n", f); std::fclose(f); }
+  const std::string shot = dir + "/after_failed_load.png", ref = dir + "/before_failed_load.png";
+  const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --camera 2 --frames 3 ";
+  const RunResult a = run(common + "--then-open " + bad + " --screenshot " + shot + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  EXPECT_NE(a.output.find("cannot open " + bad), std::string::npos) << a.output;
+  const RunResult b = run(common + "--screenshot " + ref + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const flashgs::ImageDifference d = flashgs::compare_images(flashgs::read_image(shot), flashgs::read_image(ref));
+  EXPECT_TRUE(std::isinf(d.psnr_db)) << "the picture changed after a failed load (PSNR " << d.psnr_db << ")";
+}
+
+TEST(Viewer, CameraPathReportsFrameTimes) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 320x180 --path --frames 4 --warmup 1 --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("viewer frames: 4 at 320x180"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("FPS"), std::string::npos) << r.output;
+}
+
+TEST(Viewer, HeatmapAndCompareRun) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string shot = out_dir() + "/heatmap_window.png";
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 480x270 --camera 1 --frames 2 --heatmap --compare "
+                          "--window-screenshot " + shot + " --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // flash vs baseline at tau = 1/255 on the demo scene: equal within rounding.
+  const auto at = r.output.find("viewer compare: flash vs baseline PSNR ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const double psnr = std::atof(r.output.c_str() + at + std::string("viewer compare: flash vs baseline PSNR ").size());
+  EXPECT_GE(psnr, 50.0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(shot));
+}
+
+}  // namespace
