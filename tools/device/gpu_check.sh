@@ -2,7 +2,7 @@
 # GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench
-#                                       bench-cpu profile
+#                                       bench-cpu profile build-bg wait-build
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
 # cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
 # there; `build` builds everything on the machine instead, into build-dev).
@@ -25,6 +25,7 @@ setup() {
     ln -sfn "$SCENES" /work/shared/scenes
     ln -sfn "$ROOT/assets" /work/main/assets
   fi
+  ldconfig -p | grep -q libgomp.so.1 || export LD_LIBRARY_PATH=$ROOT/.deps/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
   if "$BIN/flashgs" --help > /dev/null 2>&1; then
     FLASHGS=$BIN/flashgs
     TESTS=$BIN/test_cuda_render
@@ -106,6 +107,8 @@ for step in "$@"; do
   case $step in
     setup) setup ;;
     build) build ;;
+    build-bg) (build > /dev/null 2>&1) & BUILD_PID=$! ;;  # checks the build on the machine, in parallel
+    wait-build) [ -n "${BUILD_PID:-}" ] && wait "$BUILD_PID"; log "$(tail -2 "$OUT/build.log" | tr '\n' ' ')" ;;
     tests) tests ;;
     sanitize) sanitize ;;
     bench-quick) bench_quick ;;
