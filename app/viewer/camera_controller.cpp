@@ -87,7 +87,10 @@ void CameraController::flip_up() {
 
 void CameraController::rotate_view(float yaw, float pitch) {
   // Yaw about the world-up axis (right-hand rule; negative turns toward the camera's right).
-  glm::mat3 r = axis_rotation(m_up, yaw) * m_pose.rotation;
+  // The axis takes the sign of the camera's own up (-y), so that dragging right turns right
+  // even when the view is upside down relative to the chosen world up.
+  const glm::vec3 yaw_axis = glm::dot(m_up, -m_pose.rotation[1]) >= 0.0f ? m_up : -m_up;
+  glm::mat3 r = axis_rotation(yaw_axis, yaw) * m_pose.rotation;
   // Pitch about the camera's right axis, refused where it would pass over the pole (the view
   // would flip upside down).
   const glm::mat3 pitched = axis_rotation(r[0], pitch) * r;
