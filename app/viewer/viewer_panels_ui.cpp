@@ -183,7 +183,10 @@ void stats_window(const UiModel& m) {
     ImGui::Text("culled: near %s  off-screen %s  low-opacity %s  degenerate %s",
                 human_count(double(st->culled_near)).c_str(), human_count(double(st->culled_offscreen)).c_str(),
                 human_count(double(st->culled_low_opacity)).c_str(), human_count(double(st->culled_degenerate)).c_str());
-    ImGui::Text("device memory %.1f MB (peak %.1f MB)", st->device_memory_bytes / 1e6, st->device_peak_bytes / 1e6);
+    if (st->device_peak_bytes > 0)
+      ImGui::Text("device memory %.1f MB (peak %.1f MB)", st->device_memory_bytes / 1e6, st->device_peak_bytes / 1e6);
+    else
+      ImGui::TextDisabled("device memory: none (CPU backend)");
     ImGui::Text("project %.2f  emit %.2f  sort %.2f  ranges %.2f  blend %.2f ms", st->times.project_ms,
                 st->times.emit_ms, st->times.sort_ms, st->times.ranges_ms, st->times.blend_ms);
   }
