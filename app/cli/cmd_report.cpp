@@ -1,5 +1,245 @@
-// `flashgs report`: (being written)
+// `flashgs report`: sweeps the configurations (baseline, flash, each optimisation alone and left
+// out, tau up to 1/16, the GPU switches on CUDA) on every backend present, and writes a CSV, a
+// Markdown table and an SVG plot of error against run time with the Pareto front marked.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "backend_factory.h"
 #include "commands.h"
+#include "flashgs/error.h"
+#include "flashgs/io.h"
+#include "flashgs/reference_renderer.h"
+#include "report_plot.h"
+#include "report_sweep.h"
+#include "scene_source.h"
+
 namespace flashgs::cli {
-void register_report(CLI::App& app) { (void)app; }
+namespace {
+
+struct ReportArgs {
+  SceneArgs scene;
+  std::string camera_list;  // "0,2,4"; empty: 0, 2, ..., 34 (as in ANCHORS.md)
+  int max_cameras = 0;      // 0: all of the list
+  std::string resolution;
+  int repeat = 3;
+  std::string backend = "all";
+  int ref_window = 64;
+  int ref_cameras = 3;
+  std::string output_dir = "report";
+  std::string title;
+};
+
+std::vector<int> parse_list(const std::string& text) {
+  std::vector<int> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(std::stoi(item));
+  return out;
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown CPU";
+}
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+std::string psnr_text(double db) { return std::isfinite(db) ? fmt("%.1f", db) : "inf"; }
+
+void run(const ReportArgs& args) {
+  const std::string scene_path = args.scene.resolved_scene();
+  auto scene = load_scene_verbose(scene_path);
+  const std::vector<Camera> all_cameras = load_cameras(args.scene.resolved_cameras());
+  std::vector<int> indices = parse_list(args.camera_list);
+  if (indices.empty())
+    for (int i = 0; i <= 34; i += 2) indices.push_back(i);
+  std::vector<int> kept;
+  for (int i : indices)
+    if (i >= 0 && i < static_cast<int>(all_cameras.size())) kept.push_back(i);
+  if (args.max_cameras > 0 && static_cast<int>(kept.size()) > args.max_cameras) kept.resize(args.max_cameras);
+  if (kept.empty()) throw Error("report: no camera of the list exists in " + args.scene.resolved_cameras());
+
+  SweepFrames frames;
+  for (int i : kept) {
+    Camera c = all_cameras[i];
+    if (!args.resolution.empty()) {
+      int w, h;
+      parse_resolution(args.resolution, &w, &h);
+      c = c.resized(w, h);
+    }
+    frames.cameras.push_back(c);
+  }
+  const int width = frames.cameras[0].width, height = frames.cameras[0].height;
+  // fp64 reference windows: the centre and two off-centre squares. The reference costs
+  // pixels x Gaussians, so it is evaluated on these windows of the first few cameras only.
+  const int s = std::min({args.ref_window, width, height});
+  auto window_at = [&](double fx, double fy) {
+    PixelWindow w;
+    w.width = w.height = s;
+    w.x0 = std::clamp(static_cast<int>(fx * width) - s / 2, 0, width - s);
+    w.y0 = std::clamp(static_cast<int>(fy * height) - s / 2, 0, height - s);
+    return w;
+  };
+  frames.windows = {window_at(0.5, 0.5), window_at(0.35, 0.6), window_at(0.65, 0.4)};
+  const std::size_t ref_cameras = std::min<std::size_t>(std::max(0, args.ref_cameras), frames.cameras.size());
+  const auto ref_start = std::chrono::steady_clock::now();
+  RenderOptions ref_options;
+  for (std::size_t c = 0; c < ref_cameras; ++c) {
+    std::vector<Image> per_window;
+    for (const PixelWindow& w : frames.windows)
+      per_window.push_back(render_reference(*scene, frames.cameras[c], ref_options, w));
+    frames.reference.push_back(std::move(per_window));
+  }
+  const double ref_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ref_start).count();
+  std::fprintf(stderr, "fp64 reference: %zu cameras x %zu windows of %dx%d in %.1f s\n", ref_cameras,
+               frames.windows.size(), s, s, ref_seconds);
+
+  std::vector<std::pair<std::string, std::unique_ptr<Renderer>>> backends;
+  for (const char* name : {"cpu", "cuda"}) {
+    if (args.backend != "all" && args.backend != name) continue;
+    try {
+      backends.emplace_back(name, create_backend(name));
+    } catch (const Error& e) {
+      if (args.backend == name) throw;
+      std::fprintf(stderr, "note: backend %s not measured: %s\n", name, e.what());
+    }
+  }
+  std::vector<SweepResult> results;
+  std::vector<std::string> backend_names;
+  for (auto& [name, renderer] : backends) {
+    renderer->set_scene(scene);
+    backend_names.push_back(name + ": " + renderer->name());
+    const bool gpu = name == "cuda";
+    for (const SweepConfig& config : sweep_configs()) {
+      if (config.gpu_only && !gpu) continue;  // the CPU ignores these switches
+      const auto start = std::chrono::steady_clock::now();
+      SweepResult r = measure_config(*renderer, name, config, frames, args.repeat);
+      std::fprintf(stderr, "%-5s %-22s median %9.3f ms  p95 %9.3f ms  kv %11.0f  vs baseline %6s dB  vs fp64 %6s dB (%.0f s)\n",
+                   name.c_str(), config.name.c_str(), r.median_ms, r.p95_ms, r.kv_pairs,
+                   psnr_text(r.vs_baseline.psnr_db).c_str(), psnr_text(r.vs_reference.psnr_db).c_str(),
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      results.push_back(std::move(r));
+    }
+  }
+
+  std::filesystem::create_directories(args.output_dir);
+  const std::string stem = args.output_dir + "/report";
+  // CSV: one row per (backend, configuration).
+  {
+    std::ofstream csv(stem + ".csv");
+    csv << "backend,config,group,algorithm,opacity_radius,tight_bbox,exact_tile_test,warp_emit,fused_emit,sort_bits,"
+           "pipelined_blend,exp2_alpha,tau,median_ms,p95_ms,frames,kv_pairs,peak_memory_mb,psnr_vs_baseline_db,"
+           "max_abs_vs_baseline,frac_over_1_255_vs_baseline,psnr_vs_fp64_db,max_abs_vs_fp64,frac_over_1_255_vs_fp64,"
+           "non_finite,pareto\n";
+    for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
+      std::vector<SweepResult> subset;
+      for (const SweepResult& r : results)
+        if (r.backend == bname) subset.push_back(r);
+      const std::vector<std::size_t> front = pareto_front(subset);
+      for (std::size_t i = 0; i < subset.size(); ++i) {
+        const SweepResult& r = subset[i];
+        const RenderOptions& o = r.config.options;
+        csv << r.backend << ',' << r.config.name << ',' << r.config.group << ',' << algorithm_name(o.algorithm) << ','
+            << o.uses_opacity_radius() << ',' << o.uses_tight_bbox() << ',' << o.uses_exact_tile_test() << ','
+            << o.warp_cooperative_emit << ',' << o.fused_emit << ',' << o.minimal_sort_bits << ',' << o.pipelined_blend
+            << ',' << o.exp2_alpha << ',' << fmt("%.6g", o.tau) << ',' << fmt("%.4f", r.median_ms) << ','
+            << fmt("%.4f", r.p95_ms) << ',' << r.frame_ms.size() << ',' << fmt("%.0f", r.kv_pairs) << ','
+            << (r.peak_memory_mb >= 0 ? fmt("%.1f", r.peak_memory_mb) : "") << ','
+            << psnr_text(r.vs_baseline.psnr_db) << ',' << fmt("%.3e", r.vs_baseline.max_abs) << ','
+            << fmt("%.3e", r.vs_baseline.fraction_over) << ',' << psnr_text(r.vs_reference.psnr_db) << ','
+            << fmt("%.3e", r.vs_reference.max_abs) << ',' << fmt("%.3e", r.vs_reference.fraction_over) << ','
+            << (r.vs_baseline.non_finite + r.vs_reference.non_finite) << ','
+            << (std::find(front.begin(), front.end(), i) != front.end()) << '\n';
+      }
+    }
+  }
+  // Markdown and one plot per backend.
+  std::ofstream md(stem + ".md");
+  const std::string title = args.title.empty() ? std::filesystem::path(scene_path).parent_path().filename().string()
+                                               : args.title;
+  std::string camera_text;
+  for (int i : kept) camera_text += (camera_text.empty() ? "" : ", ") + std::to_string(i);
+  md << "# flashgs report: " << title << "\n\n";
+  md << "- scene: `" << scene_path << "`, " << scene->size() << " Gaussians, SH degree " << scene->sh_degree << "\n";
+  md << "- cameras " << camera_text << " at " << width << "x" << height << "; per camera one warm-up frame, then "
+     << args.repeat << " timed frames; time is the backend's FrameStats total (CPU: wall time of the stages)\n";
+  md << "- host: " << cpu_model() << ", " << std::thread::hardware_concurrency() << " hardware threads\n";
+  for (const std::string& b : backend_names) md << "- backend " << b << "\n";
+  md << "- error vs baseline: whole frames against the same backend's baseline render; error vs fp64: the fp64 "
+        "brute-force reference (cost pixels x Gaussians) on "
+     << frames.windows.size() << " windows of " << s << "x" << s << " px (centre, (0.35, 0.6), (0.65, 0.4) of the "
+     << "frame) of the first " << ref_cameras << " camera(s), " << fmt("%.0f", ref_seconds) << " s\n";
+  md << "- PSNR with peak 1.0 on float images; \"> 1/255\": fraction of pixels with a channel off by more than 1/255; "
+        "kv: Gaussian-tile pairs per frame\n\n";
+  md << "| backend | configuration | median ms | p95 ms | kv pairs | peak MB | PSNR vs baseline | max abs vs baseline | "
+        "> 1/255 vs baseline | PSNR vs fp64 | max abs vs fp64 | > 1/255 vs fp64 | Pareto |\n";
+  md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
+    std::vector<SweepResult> subset;
+    for (const SweepResult& r : results)
+      if (r.backend == bname) subset.push_back(r);
+    if (subset.empty()) continue;
+    const std::vector<std::size_t> front = pareto_front(subset);
+    for (std::size_t i = 0; i < subset.size(); ++i) {
+      const SweepResult& r = subset[i];
+      md << "| " << r.backend << " | " << r.config.name << " | " << fmt("%.3f", r.median_ms) << " | "
+         << fmt("%.3f", r.p95_ms) << " | " << fmt("%.0f", r.kv_pairs) << " | "
+         << (r.peak_memory_mb >= 0 ? fmt("%.1f", r.peak_memory_mb) : "-") << " | "
+         << psnr_text(r.vs_baseline.psnr_db) << " | " << fmt("%.2e", r.vs_baseline.max_abs) << " | "
+         << fmt("%.4f%%", 100 * r.vs_baseline.fraction_over) << " | " << psnr_text(r.vs_reference.psnr_db) << " | "
+         << fmt("%.2e", r.vs_reference.max_abs) << " | " << fmt("%.4f%%", 100 * r.vs_reference.fraction_over) << " | "
+         << (std::find(front.begin(), front.end(), i) != front.end() ? "yes" : "") << " |\n";
+    }
+    std::string device;
+    for (const auto& b : backend_names)
+      if (b.rfind(bname + ":", 0) == 0) device = b.substr(bname.size() + 2);
+    const std::string subtitle = std::to_string(scene->size()) + " Gaussians, " + std::to_string(width) + "x" +
+                                 std::to_string(height) + ", cameras " + camera_text + ", " + device +
+                                 (bname == "cpu" ? " on " + cpu_model() : "");
+    const std::string svg_path = stem + "_" + bname + ".svg";
+    std::ofstream(svg_path) << plot_svg(subset, "Error vs run time: " + title + " (" + bname + ")", subtitle);
+    md << "\n";
+    std::printf("wrote %s\n", svg_path.c_str());
+  }
+  md << "\nPlots: " << "`report_cpu.svg`" << (backends.size() > 1 ? ", `report_cuda.svg`" : "") << "\n";
+  std::printf("wrote %s.csv and %s.md\n", stem.c_str(), stem.c_str());
+}
+
+}  // namespace
+
+void register_report(CLI::App& app) {
+  auto args = std::make_shared<ReportArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "report", "sweep configurations (error vs run time): CSV, Markdown table and SVG plot with the Pareto front");
+  args->scene.add_to(sub);
+  sub->add_option("--camera-list", args->camera_list, "camera indices, e.g. 0,2,4 (default 0,2,...,34)");
+  sub->add_option("--max-cameras", args->max_cameras, "use only the first N cameras of the list");
+  sub->add_option("--resolution,-r", args->resolution, "render size WxH (field of view kept)");
+  sub->add_option("--repeat", args->repeat, "timed frames per camera (after one warm-up)")->check(CLI::Range(1, 1000));
+  sub->add_option("--backend", args->backend, "all (every backend present), cpu or cuda")
+      ->check(CLI::IsMember({"all", "cpu", "cuda"}));
+  sub->add_option("--ref-window", args->ref_window, "side of the fp64 reference windows (px)")->check(CLI::Range(1, 4096));
+  sub->add_option("--ref-cameras", args->ref_cameras, "cameras on which the fp64 reference is evaluated")
+      ->check(CLI::Range(0, 1000));
+  sub->add_option("--output-dir,-o", args->output_dir, "folder for report.csv, report.md, report_<backend>.svg");
+  sub->add_option("--title", args->title, "title of the table and plots (default: the scene's folder name)");
+  sub->callback([args] { run(*args); });
+}
+
 }  // namespace flashgs::cli

@@ -1,1 +1,121 @@
-// report sweep (being written)
+// Sweep configurations and their measurement (see report_sweep.h).
+#include "report_sweep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace flashgs::cli {
+
+std::vector<SweepConfig> sweep_configs() {
+  std::vector<SweepConfig> out;
+  out.push_back({"baseline", "baseline", RenderOptions::baseline(), false});
+  out.push_back({"flash", "flash", RenderOptions{}, false});
+  struct Switch {
+    const char* name;
+    bool RenderOptions::*member;
+  };
+  const Switch geometry[] = {{"opacity_radius", &RenderOptions::opacity_aware_radius},
+                             {"tight_bbox", &RenderOptions::tight_bbox},
+                             {"exact_tile_test", &RenderOptions::exact_tile_test}};
+  for (const Switch& s : geometry) {
+    RenderOptions o;
+    for (const Switch& other : geometry) o.*(other.member) = false;
+    o.*(s.member) = true;
+    out.push_back({std::string("only-") + s.name, "alone", o, false});
+  }
+  for (const Switch& s : geometry) {
+    RenderOptions o;
+    o.*(s.member) = false;
+    out.push_back({std::string("no-") + s.name, "left out", o, false});
+  }
+  for (int denominator : {128, 64, 32, 16}) {
+    RenderOptions o;
+    o.tau = 1.0f / static_cast<float>(denominator);
+    out.push_back({"tau=1/" + std::to_string(denominator), "tau", o, false});
+  }
+  const Switch gpu[] = {{"warp_emit", &RenderOptions::warp_cooperative_emit},
+                        {"fused_emit", &RenderOptions::fused_emit},
+                        {"sort_bits", &RenderOptions::minimal_sort_bits},
+                        {"pipelined_blend", &RenderOptions::pipelined_blend},
+                        {"exp2_alpha", &RenderOptions::exp2_alpha}};
+  for (const Switch& s : gpu) {
+    RenderOptions o;
+    for (const Switch& other : gpu) o.*(other.member) = false;
+    o.*(s.member) = true;
+    out.push_back({std::string("gpu-only-") + s.name, "gpu alone", o, true});
+  }
+  for (const Switch& s : gpu) {
+    RenderOptions o;
+    o.*(s.member) = false;
+    out.push_back({std::string("no-") + s.name, "gpu left out", o, true});
+  }
+  return out;
+}
+
+void ErrorSummary::add(const ImageDifference& d, std::size_t pixels) {
+  sum_sq_ += d.mse * 3.0 * static_cast<double>(pixels);
+  over_ += d.fraction_over_1_255 * static_cast<double>(pixels);
+  pixels_ += pixels;
+  max_abs = std::max(max_abs, d.max_abs);
+  non_finite += d.non_finite;
+}
+
+void ErrorSummary::finish() {
+  const double mse = pixels_ ? sum_sq_ / (3.0 * static_cast<double>(pixels_)) : 0.0;
+  psnr_db = mse > 0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
+  fraction_over = pixels_ ? over_ / static_cast<double>(pixels_) : 0.0;
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  // Nearest rank: the smallest value with at least p of the samples at or below it.
+  const double rank = std::ceil(p * static_cast<double>(values.size()));
+  const std::size_t index = static_cast<std::size_t>(std::max(1.0, rank)) - 1;
+  return values[std::min(index, values.size() - 1)];
+}
+
+SweepResult measure_config(Renderer& renderer, const std::string& backend, const SweepConfig& config,
+                           SweepFrames& frames, int repeat) {
+  SweepResult r;
+  r.backend = backend;
+  r.config = config;
+  const bool is_baseline = config.options.is_baseline();
+  if (is_baseline) frames.baseline.assign(frames.cameras.size(), Image());
+  double kv_sum = 0;
+  std::uint64_t peak = 0;
+  bool memory_reported = false;
+  for (std::size_t c = 0; c < frames.cameras.size(); ++c) {
+    Image image;
+    FrameStats stats;
+    renderer.render(frames.cameras[c], config.options, image, &stats);  // warm-up; also the image judged
+    for (int k = 0; k < repeat; ++k) {
+      Image timed;
+      renderer.render(frames.cameras[c], config.options, timed, &stats);
+      r.frame_ms.push_back(stats.times.total_ms);
+      kv_sum += static_cast<double>(stats.kv_pairs);
+      if (stats.device_peak_bytes) memory_reported = true;
+      peak = std::max<std::uint64_t>(peak, stats.device_peak_bytes);
+    }
+    const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
+    if (is_baseline) frames.baseline[c] = image;
+    if (c < frames.baseline.size() && frames.baseline[c].width == image.width)
+      r.vs_baseline.add(compare_images(image, frames.baseline[c]), pixels);
+    if (c < frames.reference.size())
+      for (std::size_t w = 0; w < frames.windows.size(); ++w) {
+        const PixelWindow& window = frames.windows[w];
+        r.vs_reference.add(compare_images(crop_image(image, window), frames.reference[c][w]),
+                           static_cast<std::size_t>(window.width) * window.height);
+      }
+  }
+  r.vs_baseline.finish();
+  r.vs_reference.finish();
+  r.median_ms = percentile(r.frame_ms, 0.5);
+  r.p95_ms = percentile(r.frame_ms, 0.95);
+  r.kv_pairs = r.frame_ms.empty() ? 0 : kv_sum / static_cast<double>(r.frame_ms.size());
+  if (memory_reported) r.peak_memory_mb = static_cast<double>(peak) / 1e6;
+  return r;
+}
+
+}  // namespace flashgs::cli
