@@ -168,11 +168,9 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions, float) {
 
   const bool mouse_free = !(m_ui && m_settings.show_ui && m_ui->wants_mouse());
   const bool keys_free = !(m_ui && m_settings.show_ui && m_ui->wants_keyboard());
-  auto pressed = [&](int key) {  // edge-triggered
-    const bool down = keys_free && m_window->key_down(key);
-    const bool edge = down && !m_keys_before[key];
-    m_keys_before[key] = down;
-    return edge;
+  const std::vector<int> presses = m_window->take_key_presses();
+  auto pressed = [&](int key) {  // a press event since the last frame
+    return keys_free && std::find(presses.begin(), presses.end(), key) != presses.end();
   };
   if (keys_free) {
     nav.forward = m_window->key_down(GLFW_KEY_W);
@@ -415,7 +413,8 @@ int ViewerApp::run() {
     int fb_w = 0, fb_h = 0;
     m_window->framebuffer_size(&fb_w, &fb_h);
     const auto now = Clock::now();
-    float dt = std::min(0.1f, std::chrono::duration<float>(now - last).count());
+    // Clamped so that a stall (a scene load) does not turn into one huge step.
+    float dt = std::min(0.5f, std::chrono::duration<float>(now - last).count());
     last = now;
     if (fb_w <= 0 || fb_h <= 0) {  // minimised: nothing to draw into
       if (!m_scripted) glfwWaitEventsTimeout(0.1);

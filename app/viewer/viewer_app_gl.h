@@ -74,7 +74,6 @@ class ViewerApp {
 
   // Input state between frames.
   double m_last_cursor_x = 0, m_last_cursor_y = 0;
-  bool m_keys_before[512] = {};
   std::string m_path_buffer, m_shot_buffer;
   int m_screenshot_count = 0;
 

@@ -39,6 +39,7 @@ Window::Window(int width, int height, const std::string& title) {
   glfwSetWindowUserPointer(m_window, this);
   glfwSetScrollCallback(m_window, on_scroll);
   glfwSetDropCallback(m_window, on_drop);
+  glfwSetKeyCallback(m_window, on_key);
 }
 
 Window::~Window() {
@@ -79,6 +80,12 @@ float Window::take_scroll() {
 }
 
 std::vector<std::string> Window::take_drops() { return std::move(m_drops); }
+
+std::vector<int> Window::take_key_presses() { return std::move(m_key_presses); }
+
+void Window::on_key(GLFWwindow* w, int key, int, int action, int) {
+  if (action == GLFW_PRESS && key >= 0) static_cast<Window*>(glfwGetWindowUserPointer(w))->m_key_presses.push_back(key);
+}
 
 bool Window::key_down(int key) const { return glfwGetKey(m_window, key) == GLFW_PRESS; }
 bool Window::mouse_down(int button) const { return glfwGetMouseButton(m_window, button) == GLFW_PRESS; }

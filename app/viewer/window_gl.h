@@ -29,6 +29,9 @@ class Window {
   // Events gathered since the last take_*() call.
   float take_scroll();
   std::vector<std::string> take_drops();
+  // Keys pressed since the last call (GLFW key codes), so that a tap shorter than a slow
+  // frame is not lost the way polling glfwGetKey would lose it.
+  std::vector<int> take_key_presses();
 
   bool key_down(int glfw_key) const;
   bool mouse_down(int glfw_button) const;
@@ -37,10 +40,12 @@ class Window {
  private:
   static void on_scroll(GLFWwindow* w, double dx, double dy);
   static void on_drop(GLFWwindow* w, int count, const char** paths);
+  static void on_key(GLFWwindow* w, int key, int scancode, int action, int mods);
 
   GLFWwindow* m_window = nullptr;
   float m_scroll = 0;
   std::vector<std::string> m_drops;
+  std::vector<int> m_key_presses;
   int m_swap_interval = -1;
 };
 
