@@ -103,6 +103,17 @@ LoadedScene tile_loaded_scene(const LoadedScene& source, int copies) {
   LoadedScene s = source;
   s.scene = std::make_shared<const Scene>(tile_scene(*source.scene, copies));
   s.path = source.path + " x" + std::to_string(copies);
+  // The cameras pushed back from the grid centre as `flashgs generate tile` does, so that the
+  // whole grid is in view and every copy costs work.
+  float lo[3], hi[3];
+  scene_bounds(*source.scene, lo, hi);
+  const float side = std::ceil(std::sqrt(static_cast<float>(copies)));
+  for (Camera& camera : s.cameras)
+    for (int k = 0; k < 3; ++k) {
+      const float centre = 0.5f * (lo[k] + hi[k]);
+      camera.position[k] = centre + (camera.position[k] - centre) * side;
+    }
+  frame_from_points(*s.scene, &s.centre, &s.extent);
   return s;
 }
 
