@@ -328,6 +328,9 @@ void ViewerApp::finish_script() {
                 static_cast<unsigned long long>(m_stats.kv_pairs), static_cast<unsigned long long>(m_stats.visible),
                 static_cast<unsigned long long>(m_stats.gaussians), m_stats.times.total_ms, m_stats.times.project_ms,
                 m_stats.times.emit_ms, m_stats.times.sort_ms, m_stats.times.ranges_ms, m_stats.times.blend_ms);
+    const double n = static_cast<double>(m_frame_ms.size());
+    std::printf("viewer split (mean wall ms): render call %.3f, draw + panels %.3f, swap %.3f\n", m_split_ms[0] / n,
+                m_split_ms[1] / n, m_split_ms[2] / n);
     const glm::vec3 p = m_controller.pose().position;
     std::printf("viewer camera: position %.6f %.6f %.6f\n", p.x, p.y, p.z);
   }
@@ -484,8 +487,11 @@ int ViewerApp::run() {
     wanted.collect_tile_counts = m_settings.heatmap;
     const bool changed = !m_have_frame || !same_camera(camera, m_last_camera) || !same_options(wanted, m_last_options);
     bool rendered = false;
+    double render_call_ms = 0;
     if (changed || m_settings.continuous || m_scripted) {
+      const auto t0 = Clock::now();
       render_frame(camera);
+      render_call_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
       rendered = true;
     }
 
@@ -495,12 +501,14 @@ int ViewerApp::run() {
     std::copy(legend_px, legend_px + 4, heat.legend_rect);
     glClearColor(0, 0, 0, 1);
     glClear(GL_COLOR_BUFFER_BIT);
+    const auto t_draw = Clock::now();
     m_presenter->draw(fb_w, fb_h, m_settings.heatmap ? &heat : nullptr);
     if (m_settings.show_ui) m_ui->end_frame();
     if (!m_pending_window_shot.empty()) {
       save_window_screenshot(m_pending_window_shot, fb_w, fb_h);
       m_pending_window_shot.clear();
     }
+    const auto t_swap = Clock::now();
     m_window->swap(m_settings.vsync);
 
     const auto swapped = Clock::now();
@@ -516,7 +524,14 @@ int ViewerApp::run() {
     }
     if (m_scripted) {
       // Frame 0 includes setup; warm-up frames are not timed either.
-      if (m_frame >= (m_args.path ? std::max(1, m_args.warmup) : 1)) m_frame_ms.push_back(frame_ms);
+      if (m_frame >= (m_args.path ? std::max(1, m_args.warmup) : 1)) {
+        m_frame_ms.push_back(frame_ms);
+        // Where the frame's wall time goes (CPU side): the render call (queues the GPU work,
+        // or renders on the CPU), drawing + panels, and the swap (on Xvfb: the copy to the server).
+        m_split_ms[0] += render_call_ms;
+        m_split_ms[1] += std::chrono::duration<double, std::milli>(t_swap - t_draw).count();
+        m_split_ms[2] += std::chrono::duration<double, std::milli>(swapped - t_swap).count();
+      }
       ++m_frame;
       const int needed = m_args.path ? m_args.frames + m_args.warmup : std::max(1, m_args.frames);
       if (m_frame == 1 && !m_args.then_open.empty()) open_scene(m_args.then_open);  // must fail softly

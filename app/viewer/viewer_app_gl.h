@@ -82,6 +82,7 @@ class ViewerApp {
   KeyScript m_script;
   int m_frame = 0;
   std::vector<double> m_frame_ms;
+  double m_split_ms[3] = {0, 0, 0};  // render call, draw + panels, swap (timed frames)
   int m_exit_code = 0;
   std::string m_pending_window_shot;
   bool m_close_after_shot = false;

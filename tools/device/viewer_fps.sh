@@ -85,7 +85,7 @@ run_one() {  # scene-label render-size window-label viewer-args...
   mean=$(echo "$frames" | sed -E 's/.*mean ([0-9.]+) ms.*/\1/')
   p95=$(echo "$frames" | sed -E 's/.*p95 ([0-9.]+) ms.*/\1/')
   printf '%-44s %-10s %-22s %8s %9s %9s  %s\n' "$label" "$res" "$window" "$fps" "$mean" "$p95" "$path" | tee -a "$summary"
-  grep -m1 "^viewer render:" "$log" | sed 's/^/    /' >> "$summary"
+  grep -E "^viewer (render|split):" "$log" | sed 's/^/    /' | tee -a "$summary"
 }
 
 for scene in "${scenes[@]}"; do
