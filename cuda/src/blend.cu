@@ -36,9 +36,9 @@ __device__ __forceinline__ BlendGaussian load_gaussian(const BlendGaussian* g) {
   BlendGaussian r;
   const float4* src = reinterpret_cast<const float4*>(g);
   const float4 p = __ldg(src), q = __ldg(src + 1), s = __ldg(src + 2);
-  r.mean_x = p.x, r.mean_y = p.y, r.conic_a = p.z, r.conic_b = p.w;
-  r.conic_c = q.x, r.opacity = q.y, r.red = q.z, r.green = q.w;
-  r.blue = s.x, r.pad0 = r.pad1 = r.pad2 = 0.0f;
+  r.mean_x = p.x, r.mean_y = p.y, r.w0 = p.z, r.w1 = p.w;
+  r.w2 = q.x, r.w3 = q.y, r.opacity = q.z, r.red = q.w;
+  r.green = s.x, r.blue = s.y, r.pad0 = r.pad1 = 0.0f;
   return r;
 }
 
@@ -65,8 +65,9 @@ __global__ void __launch_bounds__(kTile * kTile) blend_per_pixel_kernel(BlendArg
     for (unsigned j = 0; j < n && !done; ++j) {
       const BlendGaussian& g = batch[j];
       const float dx = fx - g.mean_x, dy = fy - g.mean_y;
-      const float power = -0.5f * (g.conic_a * dx * dx + g.conic_c * dy * dy) - g.conic_b * dx * dy;
-      if (power > 0.0f) continue;
+      // Whitened form, as the CPU: q >= 0 by construction, so no "power > 0" skip.
+      const float u = g.w0 * dx + g.w1 * dy, v = g.w2 * dx + g.w3 * dy;
+      const float power = -0.5f * (u * u + v * v);
       const float alpha = fminf(gm::kAlphaMax, g.opacity * expf(power));
       if (alpha < gm::kAlphaMin) continue;
       const float next_t = t * (1.0f - alpha);
@@ -93,7 +94,7 @@ constexpr int kLanePixelsX = 2, kLanePixelsY = 4;  // 8 lanes across x 4 down = 
 // reads, independent attribute loads), stage them in shared memory and all read them back as
 // broadcasts. PIPELINED issues the next batch's loads before blending the current one, so
 // their latency hides behind 32 x 8 pixel evaluations. EXP2: alpha = exp2(q' + log2 o) from
-// the pre-scaled conic, with the 1/255 cut made on the exponent before any exp2.
+// the pre-scaled whitened rows, with the 1/255 cut made on the exponent before any exp2.
 template <bool PIPELINED, bool EXP2, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
   __shared__ BlendGaussian batch[kWarpsPerBlock][kWarp];
@@ -127,28 +128,33 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     const unsigned n = min(static_cast<unsigned>(kWarp), range.y - base);
     for (unsigned j = 0; j < n && live; ++j) {
       const BlendGaussian& g = batch[warp][j];
-      const float dx0 = static_cast<float>(x0) - g.mean_x;
-      const float dy0 = static_cast<float>(y0) - g.mean_y;
-      (void)dx0;
-      (void)dy0;
+      // Per lane, the two columns' and four rows' parts of u and v, so a pixel costs two adds
+      // and a square-sum; in the exact mode this is the CPU's rounding, term for term.
+      float ux[kLanePixelsX], vx[kLanePixelsX], uy[kLanePixelsY], vy[kLanePixelsY];
+#pragma unroll
+      for (int c = 0; c < kLanePixelsX; ++c) {
+        const float dx = static_cast<float>(x0 + c) - g.mean_x;
+        ux[c] = g.w0 * dx;
+        vx[c] = g.w2 * dx;
+      }
+#pragma unroll
+      for (int r = 0; r < kLanePixelsY; ++r) {
+        const float dy = static_cast<float>(y0 + r) - g.mean_y;
+        uy[r] = g.w1 * dy;
+        vy[r] = g.w3 * dy;
+      }
 #pragma unroll
       for (int p = 0; p < 8; ++p) {
         if (!(live & (1u << p))) continue;
+        const int c = p % kLanePixelsX, r = p / kLanePixelsX;
+        const float u = ux[c] + uy[r], v = vx[c] + vy[r];
         float alpha;
         if constexpr (EXP2) {
-          const float dx = dx0 + static_cast<float>(p % kLanePixelsX);
-          const float dy = dy0 + static_cast<float>(p / kLanePixelsX);
-          // q' <= 0 for a positive definite conic; FMA keeps it to 3 instructions.
-          const float q = __fmaf_rn(dx, __fmaf_rn(g.conic_a, dx, g.conic_b * dy), g.conic_c * dy * dy);
-          const float e = q + g.opacity;  // opacity holds log2 o
-          if (q > 0.0f || e < kLog2AlphaMin) continue;
+          const float e = g.opacity - __fmaf_rn(u, u, v * v);  // log2 o - q'
+          if (e < kLog2AlphaMin) continue;
           alpha = fminf(gm::kAlphaMax, exp2f(e));
         } else {
-          // Exactly the CPU's rounding: offsets from the integer pixel centre.
-          const float dx = static_cast<float>(x0 + p % kLanePixelsX) - g.mean_x;
-          const float dy = static_cast<float>(y0 + p / kLanePixelsX) - g.mean_y;
-          const float power = -0.5f * (g.conic_a * dx * dx + g.conic_c * dy * dy) - g.conic_b * dx * dy;
-          if (power > 0.0f) continue;
+          const float power = -0.5f * (u * u + v * v);
           alpha = fminf(gm::kAlphaMax, g.opacity * expf(power));
           if (alpha < gm::kAlphaMin) continue;
         }

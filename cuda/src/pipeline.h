@@ -31,13 +31,15 @@ struct DeviceScene {
   float4* sh_rest = nullptr;           // [count][rest_stride_vec4] bands 1.., [k][channel], zero padded
 };
 
-// What the blend stage reads per Gaussian (48 bytes, three 16-byte loads). In exp2 mode the
-// conic is pre-scaled by -log2(e)/2 (b by -log2(e)) and the opacity is stored as log2(o), so
-// alpha = exp2(q' + log2 o) with no multiply; otherwise it is the CPU's raw conic and opacity.
+// What the blend stage reads per Gaussian (48 bytes, three 16-byte loads): the whitened
+// footprint (gm::Footprint::whiten, q = (w0 dx + w1 dy)^2 + (w2 dx + w3 dy)^2, accurate far
+// along needles where the conic form cancels). In exp2 mode w is pre-scaled by
+// sqrt(log2(e) / 2) and the opacity is stored as log2(o), so alpha = exp2(log2 o - q') with
+// q' = u'^2 + v'^2; otherwise it is the CPU's raw whitened rows and opacity.
 struct alignas(16) BlendGaussian {
-  float mean_x, mean_y, conic_a, conic_b;
-  float conic_c, opacity, red, green;
-  float blue, pad0, pad1, pad2;
+  float mean_x, mean_y, w0, w1;
+  float w2, w3, opacity, red;
+  float green, blue, pad0, pad1;
 };
 
 // Counters one frame accumulates on the device; copied to the host once per frame.

@@ -37,6 +37,19 @@ __device__ __forceinline__ void colour(const DeviceScene& scene, unsigned i, con
   }
 }
 
+// The whole footprint of lane `src`, word by word, so that no field can be forgotten.
+__device__ __forceinline__ gm::Footprint shfl_footprint(const gm::Footprint& f, int src) {
+  static_assert(sizeof(gm::Footprint) % 4 == 0, "footprint is made of 32-bit words");
+  constexpr int kWords = sizeof(gm::Footprint) / 4;
+  unsigned words[kWords];
+  memcpy(words, &f, sizeof(f));
+#pragma unroll
+  for (int k = 0; k < kWords; ++k) words[k] = __shfl_sync(kFullMask, words[k], src);
+  gm::Footprint g;
+  memcpy(&g, words, sizeof(g));
+  return g;
+}
+
 __device__ __forceinline__ bool touches(const gm::Footprint& f, int tx, int ty, const gm::CameraParams& cam,
                                         bool exact) {
   return !exact || gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height);
@@ -76,15 +89,15 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
       colour<DEGREE>(scene, i, cam, pos, dc, rgb);
       float4* out = reinterpret_cast<float4*>(buf.blend + i);
       if (args.exp2_alpha) {
-        // q' = -log2(e)/2 q, so o e^(-q/2) = exp2(q' + log2 o): one exp2, no multiply.
-        const float ha = -0.5f * kLog2e;
-        out[0] = make_float4(f.mean_x, f.mean_y, ha * f.conic_a, -kLog2e * f.conic_b);
-        out[1] = make_float4(ha * f.conic_c, log2f(po.w), rgb[0], rgb[1]);
+        // w' = sqrt(log2(e) / 2) w, so o e^(-q/2) = exp2(log2 o - (u'^2 + v'^2)): one exp2.
+        const float hs = sqrtf(0.5f * kLog2e);
+        out[0] = make_float4(f.mean_x, f.mean_y, hs * f.whiten[0], hs * f.whiten[1]);
+        out[1] = make_float4(hs * f.whiten[2], hs * f.whiten[3], log2f(po.w), rgb[0]);
       } else {
-        out[0] = make_float4(f.mean_x, f.mean_y, f.conic_a, f.conic_b);
-        out[1] = make_float4(f.conic_c, po.w, rgb[0], rgb[1]);
+        out[0] = make_float4(f.mean_x, f.mean_y, f.whiten[0], f.whiten[1]);
+        out[1] = make_float4(f.whiten[2], f.whiten[3], po.w, rgb[0]);
       }
-      out[2] = make_float4(rgb[2], 0.0f, 0.0f, 0.0f);
+      out[2] = make_float4(rgb[1], rgb[2], 0.0f, 0.0f);
 
       const int box_w = f.tile_x1 - f.tile_x0;
       const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
@@ -135,17 +148,7 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
     while (pending) {
       const int src = __ffs(pending) - 1;
       pending &= pending - 1;
-      gm::Footprint g;
-      g.mean_x = __shfl_sync(kFullMask, f.mean_x, src);
-      g.mean_y = __shfl_sync(kFullMask, f.mean_y, src);
-      g.conic_a = __shfl_sync(kFullMask, f.conic_a, src);
-      g.conic_b = __shfl_sync(kFullMask, f.conic_b, src);
-      g.conic_c = __shfl_sync(kFullMask, f.conic_c, src);
-      g.threshold = __shfl_sync(kFullMask, f.threshold, src);
-      g.tile_x0 = __shfl_sync(kFullMask, f.tile_x0, src);
-      g.tile_y0 = __shfl_sync(kFullMask, f.tile_y0, src);
-      g.tile_x1 = __shfl_sync(kFullMask, f.tile_x1, src);
-      g.tile_y1 = __shfl_sync(kFullMask, f.tile_y1, src);
+      const gm::Footprint g = shfl_footprint(f, src);
       const std::uint32_t g_depth = __shfl_sync(kFullMask, depth_bits, src);
       const unsigned g_id = __shfl_sync(kFullMask, i, src);
       const unsigned box_w = static_cast<unsigned>(g.tile_x1 - g.tile_x0);
