@@ -96,7 +96,7 @@ std::string plot_svg(const std::vector<SweepResult>& results, const std::string&
   add("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
       "font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n",
       width, height, width, height);
-  add("<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
+  svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   add("<text x=\"%.0f\" y=\"28\" font-size=\"18\" font-weight=\"bold\">%s</text>\n", left, escape(title).c_str());
   add("<text x=\"%.0f\" y=\"50\" font-size=\"12\" fill=\"#444\">%s</text>\n", left, escape(subtitle).c_str());
   // Grid and ticks.
