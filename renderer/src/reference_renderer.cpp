@@ -25,6 +25,7 @@ constexpr double kFloatMax = 3.4028234663852886e38;
 
 struct RefGaussian {
   double mean_x, mean_y, depth;
+  float sort_depth;  // the backends' float view depth (their sort key)
   double a, b, c;  // conic
   double opacity;
   double rgb[3];
@@ -139,6 +140,17 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
     g.mean_x = fx * v[0] / z + camera.cx;
     g.mean_y = fy * v[1] / z + camera.cy;
     g.depth = z;
+    {
+      // The order is part of the rule: the backends sort by the view depth they compute in
+      // float (gm::to_view). The double depth rounded to float can differ from it by an ulp,
+      // which swaps two nearly coincident layers (measured: 0.021 on a pc_playbot pixel).
+      gm::CameraParams cam_f{};
+      for (int k = 0; k < 9; ++k) cam_f.rotation[k] = camera.rotation[k];
+      for (int k = 0; k < 3; ++k) cam_f.position[k] = camera.position[k];
+      float v_f[3];
+      gm::to_view(cam_f, &scene.positions[i * 3], v_f);
+      g.sort_depth = v_f[2];
+    }
     g.a = c / det;
     g.b = -b / det;
     g.c = a / det;
@@ -156,8 +168,8 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
     gaussians.push_back(g);
   }
   std::sort(gaussians.begin(), gaussians.end(), [](const RefGaussian& l, const RefGaussian& r) {
-    // Compare the float depths the renderers sort by, then the index: the same order.
-    const float lf = static_cast<float>(l.depth), rf = static_cast<float>(r.depth);
+    // The float depths the backends sort by, then the index: the same order.
+    const float lf = l.sort_depth, rf = r.sort_depth;
     return lf != rf ? lf < rf : l.index < r.index;
   });
 
