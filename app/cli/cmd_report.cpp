@@ -190,6 +190,7 @@ void run(const ReportArgs& args) {
   md << "| backend | configuration | median ms | p95 ms | kv pairs | peak MB | PSNR vs baseline | max abs vs baseline | "
         "> 1/255 vs baseline | PSNR vs fp64 | max abs vs fp64 | > 1/255 vs fp64 | Pareto |\n";
   md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::vector<std::string> plots;
   for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
     std::vector<SweepResult> subset;
     for (const SweepResult& r : results)
@@ -214,10 +215,12 @@ void run(const ReportArgs& args) {
                                  (bname == "cpu" ? " on " + cpu_model() : "");
     const std::string svg_path = stem + "_" + bname + ".svg";
     std::ofstream(svg_path) << plot_svg(subset, "Error vs run time: " + title + " (" + bname + ")", subtitle);
-    md << "\n";
+    plots.push_back("report_" + bname + ".svg");
     std::printf("wrote %s\n", svg_path.c_str());
   }
-  md << "\nPlots: " << "`report_cpu.svg`" << (backends.size() > 1 ? ", `report_cuda.svg`" : "") << "\n";
+  md << "\nPlots (error vs median frame time, one point per configuration, Pareto front marked):";
+  for (const std::string& p : plots) md << " [" << p << "](" << p << ")";
+  md << "\n";
   std::printf("wrote %s.csv and %s.md\n", stem.c_str(), stem.c_str());
 }
 
