@@ -463,6 +463,9 @@ int ViewerApp::run() {
     }
     apply_actions(actions);
 
+    const bool steering = nav.forward || nav.back || nav.left || nav.right || nav.up || nav.down ||
+                          nav.look_dx != 0.0f || nav.look_dy != 0.0f || nav.pan_dx != 0.0f || nav.pan_dy != 0.0f;
+    if (m_playing && steering) m_playing = false;  // taking the controls stops the path
     if (m_playing && m_camera_path && !m_camera_path->empty()) {
       m_path_t += dt / (m_settings.path_seconds_per_camera * double(m_camera_path->size()));
       m_controller.set_pose(m_camera_path->pose_at(m_path_t), 0.0f);
