@@ -105,6 +105,25 @@ TEST(Viewer, ScriptedKeysMoveTheCamera) {
   EXPECT_LT(d.psnr_db, 30.0) << "the key sequence did not change the picture";
 }
 
+TEST(Viewer, WindowResizeRecreatesTheFrame) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string shot = out_dir() + "/after_resize.png", ref = out_dir() + "/resize_reference.png";
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 320x180 --camera 4 --keys \"RESIZE:400:300,WAIT:0.05\" "
+                          "--screenshot " + shot + " --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const flashgs::Image a = flashgs::read_image(shot);
+  EXPECT_EQ(a.width, 400);
+  EXPECT_EQ(a.height, 300);
+  // At another aspect ratio the view is the free camera with the scene camera's pose and
+  // horizontal field of view; the CLI's --resolution keeps fx and fy apart instead, so the
+  // reference is the viewer started at that size.
+  const RunResult b = run(prefix + viewer() + " --backend cpu --size 400x300 --camera 4 --frames 2 --fov 60 "
+                          "--screenshot " + ref + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const flashgs::ImageDifference d = flashgs::compare_images(a, flashgs::read_image(ref));
+  EXPECT_GE(d.psnr_db, 40.0);
+}
+
 TEST(Viewer, FailedLoadKeepsTheCurrentScene) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir();

@@ -157,11 +157,13 @@ TEST(ViewerCameraPath, PassesThroughEveryCameraAndIsContinuous) {
 }
 
 TEST(ViewerKeyScript, ParsesHoldsAndDrags) {
-  auto script = fv::KeyScript::parse("W:0.5, d+shift:0.2,MOUSE:10:-5,WAIT:0.1");
-  ASSERT_EQ(script.size(), 4u);
-  int forward_frames = 0, right_fast_frames = 0, drags = 0, frames = 0;
+  auto script = fv::KeyScript::parse("W:0.5, d+shift:0.2,MOUSE:10:-5,RESIZE:800:450,WAIT:0.1");
+  ASSERT_EQ(script.size(), 5u);
+  int forward_frames = 0, right_fast_frames = 0, drags = 0, frames = 0, resizes = 0;
   while (!script.done()) {
-    const fv::NavigationInput in = script.next(1.0f / 60.0f);
+    const fv::ScriptFrame step = script.next(1.0f / 60.0f);
+    const fv::NavigationInput& in = step.nav;
+    resizes += step.resize_width == 800 && step.resize_height == 450;
     forward_frames += in.forward;
     right_fast_frames += in.right && in.fast;
     drags += in.look_dx == 10.0f && in.look_dy == -5.0f;
@@ -171,10 +173,11 @@ TEST(ViewerKeyScript, ParsesHoldsAndDrags) {
   EXPECT_NEAR(forward_frames, 30, 1);
   EXPECT_NEAR(right_fast_frames, 12, 1);
   EXPECT_EQ(drags, 1);
+  EXPECT_EQ(resizes, 1);
 }
 
 TEST(ViewerKeyScript, RejectsMalformedSteps) {
-  for (const char* bad : {"W", "W:abc", "X:0.5", "MOUSE:1", "W:-1", "W:0.5:1"}) {
+  for (const char* bad : {"W", "W:abc", "X:0.5", "MOUSE:1", "W:-1", "W:0.5:1", "RESIZE:0:10", "RESIZE:5"}) {
     try {
       fv::KeyScript::parse(bad);
       ADD_FAILURE() << "accepted " << bad;

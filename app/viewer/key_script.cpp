@@ -40,7 +40,15 @@ KeyScript KeyScript::parse(const std::string& text) {
     const auto fields = split(token, ':');
     const std::string bad = "--keys step \"" + token + "\": ";
     Step step;
-    if (fields[0] == "MOUSE") {
+    if (fields[0] == "RESIZE") {
+      float w = 0, h = 0;
+      if (fields.size() != 3 || !parse_float(fields[1], &w) || !parse_float(fields[2], &h) || w < 1 || h < 1 ||
+          w > 16384 || h > 16384)
+        throw Error(bad + "expected RESIZE:width:height (window points, 1..16384)");
+      step.resize_width = static_cast<int>(w);
+      step.resize_height = static_cast<int>(h);
+      step.is_drag = true;  // applied in one frame, like a drag
+    } else if (fields[0] == "MOUSE") {
       if (fields.size() != 3 || !parse_float(fields[1], &step.held.look_dx) ||
           !parse_float(fields[2], &step.held.look_dy))
         throw Error(bad + "expected MOUSE:dx:dy (window points of a right-button drag)");
@@ -57,7 +65,7 @@ KeyScript KeyScript::parse(const std::string& text) {
           else if (key == "Q") step.held.down = true;
           else if (key == "E") step.held.up = true;
           else if (key == "SHIFT") step.held.fast = true;
-          else throw Error(bad + "unknown key \"" + key + "\" (W A S D Q E SHIFT, WAIT, MOUSE)");
+          else throw Error(bad + "unknown key \"" + key + "\" (W A S D Q E SHIFT, WAIT, MOUSE, RESIZE)");
         }
     }
     script.m_steps.push_back(step);
@@ -65,14 +73,17 @@ KeyScript KeyScript::parse(const std::string& text) {
   return script;
 }
 
-NavigationInput KeyScript::next(float dt) {
-  if (done()) return {};
+ScriptFrame KeyScript::next(float dt) {
+  ScriptFrame frame;
+  if (done()) return frame;
   Step& step = m_steps[m_step];
+  frame.nav = step.held;
   if (step.is_drag) {
+    frame.resize_width = step.resize_width;
+    frame.resize_height = step.resize_height;
     ++m_step;
-    return step.held;
+    return frame;
   }
-  NavigationInput in = step.held;
   m_elapsed += dt;
   // The last frame of a step is shortened by the caller's dt only through the step boundary:
   // total simulated key time equals the requested seconds to within one frame.
@@ -80,7 +91,7 @@ NavigationInput KeyScript::next(float dt) {
     ++m_step;
     m_elapsed = 0;
   }
-  return in;
+  return frame;
 }
 
 }  // namespace flashgs::viewer

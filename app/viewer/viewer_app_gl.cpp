@@ -428,7 +428,11 @@ int ViewerApp::run() {
     UiActions actions;
     NavigationInput nav;
     gather_input(nav, actions, dt);
-    if (m_scripted && !m_script.done()) nav = m_script.next(dt);
+    if (m_scripted && !m_script.done()) {
+      const ScriptFrame step = m_script.next(dt);
+      nav = step.nav;
+      if (step.resize_width > 0) m_window->resize(step.resize_width, step.resize_height);
+    }
 
     UiModel model;
     const float fb_scale = m_window->framebuffer_scale();

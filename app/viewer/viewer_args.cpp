@@ -50,7 +50,7 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_option("--frames", a->frames, "scripted: render this many frames")->check(CLI::Range(0, 10000000));
   app.add_option("--keys", a->keys,
                  "scripted: keys held for seconds of simulated time (60 frames per second), e.g. "
-                 "\"W:0.5,D+SHIFT:0.2,MOUSE:120:-40,WAIT:0.1\"");
+                 "\"W:0.5,D+SHIFT:0.2,MOUSE:120:-40,RESIZE:800:450,WAIT:0.1\"");
   app.add_flag("--path", a->path, "scripted: play a smooth path through the scene's cameras and report frame times");
   app.add_option("--warmup", a->warmup, "scripted: untimed frames before the timed ones")->check(CLI::Range(0, 10000));
   app.add_option("--screenshot", a->screenshot, "scripted: save the rendered image (no UI) after the last frame");

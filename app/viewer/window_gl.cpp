@@ -59,6 +59,17 @@ void Window::swap(bool vsync) {
   glfwSwapBuffers(m_window);
 }
 
+void Window::resize(int width, int height) {
+  glfwSetWindowSize(m_window, width, height);
+  // Wait (briefly) until the X server has applied it, so the next frame renders at the new size.
+  for (int i = 0; i < 50; ++i) {
+    int w = 0, h = 0;
+    glfwGetWindowSize(m_window, &w, &h);
+    if (w == width && h == height) break;
+    glfwWaitEventsTimeout(0.01);
+  }
+}
+
 void Window::poll(bool wait_for_events) {
   if (wait_for_events) glfwWaitEventsTimeout(0.25);
   else glfwPollEvents();

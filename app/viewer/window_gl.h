@@ -21,6 +21,9 @@ class Window {
   bool should_close() const;
   void request_close();
   void swap(bool vsync);
+  // Asks for a new window size in screen points (the framebuffer follows once the window
+  // system has done it).
+  void resize(int width, int height);
   void poll(bool wait_for_events);
   // Framebuffer size in pixels (zero while minimised) and its ratio to window points (high DPI).
   void framebuffer_size(int* width, int* height) const;
