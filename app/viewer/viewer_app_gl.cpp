@@ -474,9 +474,9 @@ int ViewerApp::run() {
       m_path_t += dt / (m_settings.path_seconds_per_camera * double(m_camera_path->size()));
       m_controller.set_pose(m_camera_path->pose_at(m_path_t), 0.0f);
       m_settings.fov_x_degrees = m_camera_path->fov_at(m_path_t);
-    } else if (m_controller.update(nav, dt, m_settings)) {
-      m_playing = false;
     }
+    bool moving = m_playing;
+    if (!m_playing && m_controller.update(nav, dt, m_settings)) moving = true;
     if (m_scripted && m_args.path && m_camera_path && !m_camera_path->empty()) {
       const int timed = std::max(0, m_frame - m_args.warmup);
       const double t = double(timed) / std::max(1, m_args.frames);
@@ -484,10 +484,16 @@ int ViewerApp::run() {
       m_settings.fov_x_degrees = m_camera_path->fov_at(t);
     }
 
+    // A slow backend (the CPU) renders fewer pixels while the view moves, aiming at about 30
+    // frames per second, and the full frame as soon as it stops (the camera then differs, so it
+    // is rendered again).
+    float scale = m_settings.render_scale;
+    if (!m_scripted && m_settings.adaptive_resolution && moving && m_full_render_ms > 33.0)
+      scale *= static_cast<float>(std::clamp(std::sqrt(33.0 / m_full_render_ms), 0.25, 1.0));
     const int rw = m_settings.forced_width > 0 ? m_settings.forced_width
-                                               : std::max(1, int(std::lround(fb_w * m_settings.render_scale)));
+                                               : std::max(1, int(std::lround(fb_w * scale)));
     const int rh = m_settings.forced_height > 0 ? m_settings.forced_height
-                                                : std::max(1, int(std::lround(fb_h * m_settings.render_scale)));
+                                                : std::max(1, int(std::lround(fb_h * scale)));
     ensure_texture(rw, rh);
     const Camera camera = m_controller.render_camera(rw, rh, m_settings.fov_x_degrees);
     RenderOptions wanted = m_settings.options;
@@ -499,6 +505,7 @@ int ViewerApp::run() {
       const auto t0 = Clock::now();
       render_frame(camera);
       render_call_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+      if (scale == m_settings.render_scale) m_full_render_ms = render_call_ms;
       rendered = true;
     }
 

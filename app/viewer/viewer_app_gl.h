@@ -71,6 +71,7 @@ class ViewerApp {
   CompareResult m_compare;
   std::string m_status;
   double m_fps = 0;
+  double m_full_render_ms = 0;  // wall time of the last render at the full render scale
 
   // Input state between frames.
   double m_last_cursor_x = 0, m_last_cursor_y = 0;

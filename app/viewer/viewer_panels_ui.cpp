@@ -66,6 +66,7 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   ImGui::SliderFloat("FOV (deg)", &s.fov_x_degrees, 10.0f, 140.0f, "%.1f");
   ImGui::SliderFloat("Speed", &s.move_speed, 0.01f, 20.0f, "%.2f extents/s", ImGuiSliderFlags_Logarithmic);
   ImGui::SliderFloat("Render scale", &s.render_scale, 0.1f, 2.0f, "%.2f");
+  ImGui::Checkbox("Fewer pixels while moving (slow backends)", &s.adaptive_resolution);
   if (ImGui::Checkbox("Flip world up", &s.flip_up)) a.flip_up = true;
   ImGui::SameLine();
   ImGui::TextDisabled("up = (%.2f, %.2f, %.2f)", m.world_up[0], m.world_up[1], m.world_up[2]);

@@ -12,6 +12,7 @@ struct ViewerSettings {
   NavigationMode mode = NavigationMode::fly;
   float fov_x_degrees = 60.0f;      // horizontal field of view of the viewer camera
   float render_scale = 1.0f;        // render resolution = framebuffer size * scale
+  bool adaptive_resolution = true;  // fewer pixels while moving when a full frame takes > 33 ms
   int forced_width = 0, forced_height = 0;  // > 0: render at exactly this size (scripted runs)
   bool flip_up = false;             // invert the world-up axis guessed from the scene
   float move_speed = 1.0f;          // fly speed in scene extents per second (wheel scales it)
