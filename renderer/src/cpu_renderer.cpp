@@ -1,5 +1,7 @@
 // The CPU backend: runs the stages in order, times them, fills FrameStats.
 #include <chrono>
+#include <cstdio>
+#include <new>
 #include <thread>
 
 #include "cpu_frame.h"
@@ -29,6 +31,23 @@ class CpuRenderer final : public Renderer {
   void set_scene(std::shared_ptr<const Scene> scene) override { scene_ = std::move(scene); }
 
   void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats_out) override {
+    // A frame too large for this machine's memory (e.g. 65536^2: 51 GB of float RGB) is a
+    // clear error naming the size, not a bare std::bad_alloc.
+    try {
+      render_frame(camera, options, out, stats_out);
+    } catch (const std::bad_alloc&) {
+      const double gb = static_cast<double>(camera.width) * camera.height * 12.0 / 1e9;
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "cpu renderer: out of memory for a %dx%d frame (%.1f GB of float RGB, plus pairs for %zu "
+                    "Gaussians)",
+                    camera.width, camera.height, gb, scene_ ? scene_->size() : std::size_t{0});
+      throw Error(text);
+    }
+  }
+
+ private:
+  void render_frame(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats_out) {
     using Clock = std::chrono::steady_clock;
     auto ms_since = [](Clock::time_point t) {
       return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
