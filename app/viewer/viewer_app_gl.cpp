@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -146,6 +147,37 @@ bool ViewerApp::open_scene(const std::string& path) {
   }
 }
 
+void ViewerApp::request_open(const std::string& path) {
+  if (m_scripted) {  // scripted runs stay deterministic: load in the frame that asks
+    open_scene(path);
+    return;
+  }
+  if (m_pending_load.valid()) {
+    m_status = "still loading " + m_pending_path + "; " + path + " ignored";
+    return;
+  }
+  // Parsing a large PLY takes seconds: it runs beside the frame loop, which keeps drawing the
+  // current scene; the new one is installed (uploaded) on this thread once it is ready.
+  m_pending_path = path;
+  m_pending_load = std::async(std::launch::async, [path] { return load_scene(path); });
+}
+
+void ViewerApp::finish_pending_load() {
+  if (!m_pending_load.valid() ||
+      m_pending_load.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+    return;
+  const std::string path = m_pending_path;
+  m_pending_path.clear();
+  try {
+    install_scene(m_pending_load.get());
+    m_load_error.clear();
+    m_path_buffer = path;
+  } catch (const std::exception& e) {
+    m_load_error = e.what();
+    std::fprintf(stderr, "flashgs-viewer: cannot open %s: %s\n", path.c_str(), e.what());
+  }
+}
+
 void ViewerApp::snap_to_camera(int index) {
   if (m_scene.cameras.empty()) return;
   const int n = static_cast<int>(m_scene.cameras.size());
@@ -168,9 +200,15 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions, float) {
 
   const bool mouse_free = !(m_ui && m_settings.show_ui && m_ui->wants_mouse());
   const bool keys_free = !(m_ui && m_settings.show_ui && m_ui->wants_keyboard());
-  const std::vector<int> presses = m_window->take_key_presses();
-  auto pressed = [&](int key) {  // a press event since the last frame
-    return keys_free && std::find(presses.begin(), presses.end(), key) != presses.end();
+  const std::vector<KeyPress> presses = m_window->take_key_presses();
+  int mods = 0;
+  auto pressed = [&](int key) {  // a press event since the last frame; `mods` its modifiers
+    for (const KeyPress& p : presses)
+      if (keys_free && p.key == key) {
+        mods = p.mods;
+        return true;
+      }
+    return false;
   };
   if (keys_free) {
     nav.forward = m_window->key_down(GLFW_KEY_W);
@@ -187,7 +225,10 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions, float) {
   if (pressed(GLFW_KEY_C)) actions.compare = true;
   if (pressed(GLFW_KEY_H)) m_settings.heatmap = !m_settings.heatmap;
   if (pressed(GLFW_KEY_F1)) m_settings.show_ui = !m_settings.show_ui;
-  if (pressed(GLFW_KEY_F12)) actions.screenshot_path = m_shot_buffer;
+  if (pressed(GLFW_KEY_F12)) {
+    if (mods & GLFW_MOD_SHIFT) m_pending_window_shot = "flashgs_window.png";  // the whole window, panels included
+    else actions.screenshot_path = m_shot_buffer;
+  }
   if (pressed(GLFW_KEY_TAB))
     m_settings.mode = m_settings.mode == NavigationMode::fly ? NavigationMode::orbit : NavigationMode::fly;
   if (pressed(GLFW_KEY_B)) {
@@ -214,7 +255,7 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions, float) {
 }
 
 void ViewerApp::apply_actions(const UiActions& a) {
-  if (!a.open_path.empty()) open_scene(a.open_path);
+  if (!a.open_path.empty()) request_open(a.open_path);
   if (a.snap_camera >= 0) snap_to_camera(a.snap_camera);
   if (a.next_camera) snap_to_camera(m_camera_index + 1);
   if (a.previous_camera) snap_to_camera(m_camera_index < 0 ? 0 : m_camera_index - 1);
@@ -370,6 +411,9 @@ int ViewerApp::run() {
   glfwGetWindowContentScale(m_window->handle(), &xscale, &yscale);
   m_ui = std::make_unique<ImGuiLayer>(m_window->handle(), std::max(1.0f, xscale));
   select_frame_path();
+  // On the CPU a frame takes long: re-render only when something changes, so the panels stay
+  // responsive (GPU paths render every frame and show their FPS).
+  m_settings.continuous = !m_path_is_cpu;
 
   // The first scene: generated, the argument, or the demo; a failure leaves the generated demo.
   bool loaded = false;
@@ -449,6 +493,7 @@ int ViewerApp::run() {
       model.camera_count = static_cast<int>(m_scene.cameras.size());
       model.scene_note = m_scene.cameras_note;
       model.load_error = m_load_error;
+      model.loading = m_pending_path;
       model.current_camera = m_camera_index;
       model.on_scene_camera = m_controller.on_scene_camera();
       model.playing = m_playing;
@@ -466,6 +511,7 @@ int ViewerApp::run() {
       draw_panels(model, m_settings, actions, m_path_buffer, m_shot_buffer);
     }
     apply_actions(actions);
+    finish_pending_load();
 
     const bool steering = nav.forward || nav.back || nav.left || nav.right || nav.up || nav.down ||
                           nav.look_dx != 0.0f || nav.look_dy != 0.0f || nav.pan_dx != 0.0f || nav.pan_dy != 0.0f;

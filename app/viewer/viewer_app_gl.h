@@ -1,6 +1,7 @@
 // ViewerApp: the viewer's frame loop tying together window, scene, navigation, frame path, presenter and panels.
 #pragma once
 
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,7 +33,9 @@ class ViewerApp {
  private:
   void select_frame_path();
   void use_cpu_path(const std::string& why);
-  bool open_scene(const std::string& path);
+  bool open_scene(const std::string& path);  // loads now; false (error kept) on failure
+  void request_open(const std::string& path);  // loads in the background (interactive runs)
+  void finish_pending_load();
   void install_scene(LoadedScene scene);
   void apply_up_choice();
   void snap_to_camera(int index);
@@ -55,6 +58,8 @@ class ViewerApp {
 
   LoadedScene m_scene;
   std::string m_load_error;
+  std::future<LoadedScene> m_pending_load;
+  std::string m_pending_path;
   CameraController m_controller;
   std::unique_ptr<CameraPath> m_camera_path;
   int m_camera_index = -1;

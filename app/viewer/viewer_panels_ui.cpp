@@ -30,6 +30,7 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
                                               ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
   if ((ImGui::Button("Open") || enter) && !path_buffer.empty()) a.open_path = path_buffer;
+  if (!m.loading.empty()) ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1), "loading %s ...", m.loading.c_str());
   if (!m.load_error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1));
     ImGui::TextWrapped("Load failed, previous scene kept: %s", m.load_error.c_str());
@@ -235,7 +236,8 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
     ImGui::TextWrapped("Fly: WASD move, Q/E down/up, right-drag look, wheel speed, Shift fast. "
                        "Orbit: left-drag rotate, right-drag (or Shift+left) pan, wheel or W/S zoom. "
                        "N/P next/previous camera, Space play path, Tab fly/orbit, B baseline/flash, "
-                       "H heat map, C compare, F12 screenshot, F1 hide panels. Drop a PLY to open it.");
+                       "H heat map, C compare, F12 screenshot (Shift+F12: the whole window), F1 hide panels. "
+                       "Drop a PLY to open it.");
   }
   ImGui::PopItemWidth();
   ImGui::End();

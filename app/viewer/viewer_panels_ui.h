@@ -19,6 +19,7 @@ struct UiModel {
   int camera_count = 0;
   std::string scene_note;         // loader report / cameras problem
   std::string load_error;         // the last failed load (the scene shown is the previous one)
+  std::string loading;            // the file being loaded in the background, if any
   int current_camera = -1;        // the scene camera the view sits on, -1 when moved
   bool on_scene_camera = false;
   bool playing = false;

@@ -92,10 +92,11 @@ float Window::take_scroll() {
 
 std::vector<std::string> Window::take_drops() { return std::move(m_drops); }
 
-std::vector<int> Window::take_key_presses() { return std::move(m_key_presses); }
+std::vector<KeyPress> Window::take_key_presses() { return std::move(m_key_presses); }
 
-void Window::on_key(GLFWwindow* w, int key, int, int action, int) {
-  if (action == GLFW_PRESS && key >= 0) static_cast<Window*>(glfwGetWindowUserPointer(w))->m_key_presses.push_back(key);
+void Window::on_key(GLFWwindow* w, int key, int, int action, int mods) {
+  if (action == GLFW_PRESS && key >= 0)
+    static_cast<Window*>(glfwGetWindowUserPointer(w))->m_key_presses.push_back({key, mods});
 }
 
 bool Window::key_down(int key) const { return glfwGetKey(m_window, key) == GLFW_PRESS; }

@@ -8,6 +8,11 @@ struct GLFWwindow;
 
 namespace flashgs::viewer {
 
+struct KeyPress {
+  int key = 0;   // GLFW key code
+  int mods = 0;  // GLFW modifier bits held at the press
+};
+
 class Window {
  public:
   // Creates a window of width x height screen points with a GL 3.3+ context, current on this
@@ -34,7 +39,7 @@ class Window {
   std::vector<std::string> take_drops();
   // Keys pressed since the last call (GLFW key codes), so that a tap shorter than a slow
   // frame is not lost the way polling glfwGetKey would lose it.
-  std::vector<int> take_key_presses();
+  std::vector<KeyPress> take_key_presses();
 
   bool key_down(int glfw_key) const;
   bool mouse_down(int glfw_button) const;
@@ -48,7 +53,7 @@ class Window {
   GLFWwindow* m_window = nullptr;
   float m_scroll = 0;
   std::vector<std::string> m_drops;
-  std::vector<int> m_key_presses;
+  std::vector<KeyPress> m_key_presses;
   int m_swap_interval = -1;
 };
 
