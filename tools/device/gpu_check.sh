@@ -20,11 +20,9 @@ setup() {
     [ -f "${f%.xz}" ] || xz -d -k -T0 "$f"
   done
   # The carried binaries name the scene and asset folders of the machine they were built on.
-  if [ ! -e /work/shared/scenes ] && [ ! -e /work/main ]; then
-    mkdir -p /work/shared /work/main
-    ln -sfn "$SCENES" /work/shared/scenes
-    ln -sfn "$ROOT/assets" /work/main/assets
-  fi
+  if [ ! -e /work/shared/scenes ]; then mkdir -p /work/shared && ln -sfn "$SCENES" /work/shared/scenes; fi
+  if [ ! -e /work/main/assets ]; then mkdir -p /work/main && ln -sfn "$ROOT/assets" /work/main/assets; fi
+  ls /work/shared/scenes/ | tr '\n' ' '; echo
   ldconfig -p | grep -q libgomp.so.1 || export LD_LIBRARY_PATH=$ROOT/.deps/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
   if "$BIN/flashgs" --help > /dev/null 2>&1; then
     FLASHGS=$BIN/flashgs
@@ -40,7 +38,7 @@ build() {
   cmake -S . -B build-dev -G Ninja -DCMAKE_BUILD_TYPE=Release -DFLASHGS_HEADER_DEPS_DIR="$ROOT/.deps/include" \
     -DCMAKE_CUDA_ARCHITECTURES=90 -DFLASHGS_BUILD_APP=OFF -DFLASHGS_SHARED_SCENES="$SCENES" \
     -DFLASHGS_GTEST_SOURCE_DIR="$ROOT/.deps/googletest" > "$OUT/build.log" 2>&1 &&
-    ninja -C build-dev flashgs test_cuda_render >> "$OUT/build.log" 2>&1
+    ninja -C build-dev flashgs test_cuda_render test_stress_gpu >> "$OUT/build.log" 2>&1
   local rc=$?
   log "device build rc=$rc"
   if [ $rc -eq 0 ]; then
@@ -54,6 +52,11 @@ tests() {
   log "gpu tests"
   "$TESTS" --gtest_filter=-CudaSanitizer.* 2>&1 | tee "$OUT/gpu_tests.log" | grep -E "^\[  (FAILED|PASSED|SKIPPED) |Failure|expected error" | head -40
   log "gpu tests rc=${PIPESTATUS[0]}"
+  if [ -x "$BIN/test_stress_gpu" ]; then
+    log "stress gpu tests"
+    "$BIN/test_stress_gpu" 2>&1 | tee "$OUT/stress_gpu.log" | grep -E "^\[  (FAILED|PASSED) |Failure" | head -20
+    log "stress gpu rc=${PIPESTATUS[0]}"
+  fi
 }
 
 sanitize() {
