@@ -63,6 +63,7 @@ sanitize() {
   export FLASHGS_SANITIZER_SCENE=pc_biker
   for tool in memcheck racecheck; do
     log "compute-sanitizer $tool"
+    if [ $tool = racecheck ]; then export FLASHGS_SANITIZER_QUICK=1; fi
     timeout 300 compute-sanitizer --tool $tool --error-exitcode 9 --print-limit 20 \
       "$TESTS" --gtest_filter=CudaSanitizer.* > "$OUT/sanitizer_$tool.log" 2>&1
     log "sanitizer $tool rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$OUT/sanitizer_$tool.log" | tail -1)"
