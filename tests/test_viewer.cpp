@@ -151,7 +151,7 @@ TEST(Viewer, CameraPathReportsFrameTimes) {
 TEST(Viewer, HeatmapAndCompareRun) {
   REQUIRE_DISPLAY(prefix);
   const std::string shot = out_dir() + "/heatmap_window.png";
-  const RunResult r = run(prefix + viewer() + " --backend cpu --size 480x270 --camera 1 --frames 2 --heatmap --compare "
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 480x270 --camera 1 --frames 2 --heatmap --compare --check-frame "
                           "--window-screenshot " + shot + " --exit");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // flash vs baseline at tau = 1/255 on the demo scene: equal within rounding.
@@ -160,6 +160,9 @@ TEST(Viewer, HeatmapAndCompareRun) {
   const double psnr = std::atof(r.output.c_str() + at + std::string("viewer compare: flash vs baseline PSNR ").size());
   EXPECT_GE(psnr, 50.0) << r.output;
   EXPECT_TRUE(std::filesystem::exists(shot));
+  // The texture on screen holds exactly the backend's image of the view.
+  EXPECT_NE(r.output.find("viewer frame check: displayed 480x270"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("-> ok"), std::string::npos) << r.output;
 }
 
 }  // namespace

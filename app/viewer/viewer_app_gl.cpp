@@ -359,6 +359,35 @@ void ViewerApp::save_window_screenshot(const std::string& path, int width, int h
   if (m_close_after_shot) m_window->request_close();
 }
 
+void ViewerApp::check_displayed_frame() {
+  // What the window shows (the texture, written by interop or uploaded) against the same
+  // backend's host-memory image of the same view, rounded to 8 bits as the texture is: catches
+  // a flipped, shifted, channel-swapped or stale frame on any path.
+  const Image shown = m_presenter->read_back();
+  Image expected;
+  m_path->render_image(m_last_camera, m_last_options, expected, nullptr);
+  int worst = 0;
+  std::size_t off = 0;
+  if (shown.width != expected.width || shown.height != expected.height) {
+    worst = 255;
+  } else {
+    for (std::size_t i = 0; i < shown.rgb.size(); ++i) {
+      const float e = expected.rgb[i];
+      const int want = !(e > 0.0f) ? 0 : static_cast<int>(std::lround(std::min(e, 1.0f) * 255.0f));
+      const int got = static_cast<int>(std::lround(shown.rgb[i] * 255.0f));
+      const int d = std::abs(want - got);
+      worst = std::max(worst, d);
+      off += d > 1;
+    }
+  }
+  // One step of 8-bit rounding is allowed: the GPU's conversion may round a value that sits
+  // on a half step the other way.
+  const bool ok = worst <= 1;
+  std::printf("viewer frame check: displayed %dx%d vs %s host image: max diff %d/255, %zu values off by > 1 -> %s\n",
+              shown.width, shown.height, m_path->name().c_str(), worst, off, ok ? "ok" : "WRONG");
+  if (!ok) m_exit_code = 4;
+}
+
 void ViewerApp::finish_script() {
   if (!m_frame_ms.empty()) {
     const FrameTimeSummary s = summarize_frame_times(m_frame_ms);
@@ -383,6 +412,7 @@ void ViewerApp::finish_script() {
       std::printf("viewer compare: %s vs baseline PSNR %.2f dB max abs %.6f\n", m_compare.current_label.c_str(),
                   m_compare.difference.psnr_db, m_compare.difference.max_abs);
   }
+  if (m_args.check_frame && m_have_frame) check_displayed_frame();
   if (!m_args.screenshot.empty()) save_screenshot(m_args.screenshot);
   std::fflush(stdout);
   if (!m_args.window_screenshot.empty()) {

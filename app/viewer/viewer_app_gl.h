@@ -46,6 +46,7 @@ class ViewerApp {
   void save_screenshot(const std::string& path);
   void save_window_screenshot(const std::string& path, int width, int height);
   void finish_script();
+  void check_displayed_frame();
 
   ViewerArgs m_args;
   ViewerSettings m_settings;

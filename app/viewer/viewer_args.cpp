@@ -59,6 +59,9 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_flag("--exit", a->exit_after, "scripted: quit when done");
   app.add_option("--then-open", a->then_open,
                  "scripted: open this scene after the first frame (a failure must keep the current scene)");
+  app.add_flag("--check-frame", a->check_frame,
+               "scripted: compare the displayed texture with the backend's host image of the same view "
+               "(exit 4 when they differ)");
   app.add_flag("--compare", a->compare, "scripted: compare the last frame with the baseline and print PSNR");
   try {
     app.parse(argc, argv);

@@ -37,6 +37,7 @@ struct ViewerArgs {
   std::string window_screenshot; // after the last scripted frame: the whole window, panels included
   bool exit_after = false;       // quit when the script is done
   std::string then_open;         // scripted: try to open this scene after the first frame (error-path test)
+  bool check_frame = false;      // scripted: check the displayed texture against a host render
   bool compare = false;          // run compare mode once on the last frame and print it
 
   bool scripted() const { return frames > 0 || !keys.empty() || path || !screenshot.empty() ||

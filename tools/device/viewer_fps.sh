@@ -85,7 +85,7 @@ run_one() {  # scene-label render-size window-label viewer-args...
   mean=$(echo "$frames" | sed -E 's/.*mean ([0-9.]+) ms.*/\1/')
   p95=$(echo "$frames" | sed -E 's/.*p95 ([0-9.]+) ms.*/\1/')
   printf '%-44s %-10s %-22s %8s %9s %9s  %s\n' "$label" "$res" "$window" "$fps" "$mean" "$p95" "$path" | tee -a "$summary"
-  grep -E "^viewer (render|split):" "$log" | sed 's/^/    /' | tee -a "$summary"
+  grep -E "^viewer (render:|split)" "$log" | sed 's/^/    /' | tee -a "$summary"
 }
 
 for scene in "${scenes[@]}"; do
@@ -96,6 +96,12 @@ for scene in "${scenes[@]}"; do
   esac
   label=$(basename "$(dirname "$scene")")/$(basename "$scene")
   [[ "$scene" == demo:* ]] && label=$scene
+  # Correctness first: the texture shown (written through interop) must equal the backend's
+  # own host image of the same view.
+  check_log="$OUT/viewer_fps/$(echo "${label}_check" | tr '/: @' '____').log"
+  timeout 300 "$VIEWER" "${args[@]}" --size 1920x1080 --camera 0 --frames 5 --check-frame --exit > "$check_log" 2>&1
+  say "check $label: exit $? | $(grep -m1 "frame path:" "$check_log" | sed 's/.*frame path: //')"
+  grep -m1 "viewer frame check" "$check_log" | sed 's/^/    /' | tee -a "$summary"
   for res in $RESOLUTIONS; do
     # The window is the render size: Xvfb's copy of every presented frame included.
     run_one "$label" "$res" "window $res" "${args[@]}" --size "$res"
