@@ -88,26 +88,33 @@ __global__ void __launch_bounds__(kTile * kTile) blend_per_pixel_kernel(BlendArg
 }
 
 constexpr int kWarpsPerBlock = 4;
-constexpr int kLanePixelsX = 2, kLanePixelsY = 4;  // 8 lanes across x 4 down = a 16x16 tile
+constexpr int kLanePixelsX = 2;  // 8 lanes across x 2 pixels = the tile's 16 columns
 
-// FlashGS render kernel: a warp per tile. Lanes load 32 Gaussians at once (coalesced id
-// reads, independent attribute loads), stage them in shared memory and all read them back as
+// FlashGS render kernel: a warp per strip of 4 x ROWS rows of a tile (ROWS = 4: a warp per
+// tile, each lane a 2x4 pixel block, as in FlashGS; ROWS = 1: four warps per tile, each lane
+// 2x1 pixels, four times the parallelism on the heavy tiles that set the kernel's length).
+// Each warp walks its tile's list on its own, so it stops as soon as its own pixels are
+// opaque, with no block barrier. Lanes load 32 Gaussians at once (coalesced id reads,
+// independent attribute loads), stage them in shared memory and read them back as
 // broadcasts. PIPELINED issues the next batch's loads before blending the current one, so
-// their latency hides behind 32 x 8 pixel evaluations. EXP2: alpha = exp2(q' + log2 o) from
-// the pre-scaled whitened rows, with the 1/255 cut made on the exponent before any exp2.
-template <bool PIPELINED, bool EXP2, bool SURFACE>
+// their latency hides behind the current batch. EXP2: alpha = exp2(log2 o - q') from the
+// pre-scaled whitened rows, with the 1/255 cut made on the exponent before any exp2.
+template <int ROWS, bool PIPELINED, bool EXP2, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
+  constexpr int kPixels = kLanePixelsX * ROWS;
+  constexpr unsigned kStripsPerTile = 4 / ROWS;
   __shared__ BlendGaussian batch[kWarpsPerBlock][kWarp];
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
-  const unsigned tile = blockIdx.x * kWarpsPerBlock + warp;
+  const unsigned strip = blockIdx.x * kWarpsPerBlock + warp;
+  const unsigned tile = strip / kStripsPerTile;
   if (tile >= static_cast<unsigned>(a.tiles_x) * static_cast<unsigned>(a.tiles_y)) return;  // whole warp
   const int tx = static_cast<int>(tile % a.tiles_x), ty = static_cast<int>(tile / a.tiles_x);
   const int x0 = tx * kTile + static_cast<int>(lane % 8) * kLanePixelsX;
-  const int y0 = ty * kTile + static_cast<int>(lane / 8) * kLanePixelsY;
-  float t[8], cr[8], cg[8], cb[8];
+  const int y0 = ty * kTile + static_cast<int>(strip % kStripsPerTile) * 4 * ROWS + static_cast<int>(lane / 8) * ROWS;
+  float t[kPixels], cr[kPixels], cg[kPixels], cb[kPixels];
   unsigned live = 0;  // bit p: pixel p still blending
 #pragma unroll
-  for (int p = 0; p < 8; ++p) {
+  for (int p = 0; p < kPixels; ++p) {
     t[p] = 1.0f;
     cr[p] = cg[p] = cb[p] = 0.0f;
     const int x = x0 + p % kLanePixelsX, y = y0 + p / kLanePixelsX;
@@ -128,9 +135,9 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     const unsigned n = min(static_cast<unsigned>(kWarp), range.y - base);
     for (unsigned j = 0; j < n && live; ++j) {
       const BlendGaussian& g = batch[warp][j];
-      // Per lane, the two columns' and four rows' parts of u and v, so a pixel costs two adds
-      // and a square-sum; in the exact mode this is the CPU's rounding, term for term.
-      float ux[kLanePixelsX], vx[kLanePixelsX], uy[kLanePixelsY], vy[kLanePixelsY];
+      // Per lane, the columns' and rows' parts of u and v, so a pixel costs two adds and a
+      // square-sum; in the exact mode this is the CPU's rounding, term for term.
+      float ux[kLanePixelsX], vx[kLanePixelsX], uy[ROWS], vy[ROWS];
 #pragma unroll
       for (int c = 0; c < kLanePixelsX; ++c) {
         const float dx = static_cast<float>(x0 + c) - g.mean_x;
@@ -138,13 +145,13 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
         vx[c] = g.w2 * dx;
       }
 #pragma unroll
-      for (int r = 0; r < kLanePixelsY; ++r) {
+      for (int r = 0; r < ROWS; ++r) {
         const float dy = static_cast<float>(y0 + r) - g.mean_y;
         uy[r] = g.w1 * dy;
         vy[r] = g.w3 * dy;
       }
 #pragma unroll
-      for (int p = 0; p < 8; ++p) {
+      for (int p = 0; p < kPixels; ++p) {
         if (!(live & (1u << p))) continue;
         const int c = p % kLanePixelsX, r = p / kLanePixelsX;
         const float u = ux[c] + uy[r], v = vx[c] + vy[r];
@@ -172,10 +179,22 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     }
   }
 #pragma unroll
-  for (int p = 0; p < 8; ++p)
+  for (int p = 0; p < kPixels; ++p)
     if (inside & (1u << p))
       write_pixel<SURFACE>(a, x0 + p % kLanePixelsX, y0 + p / kLanePixelsX, cr[p] + t[p] * a.background[0],
                            cg[p] + t[p] * a.background[1], cb[p] + t[p] * a.background[2]);
+}
+
+template <int ROWS, bool SURFACE>
+void launch_warp_tile(const BlendArgs& a, unsigned tiles, cudaStream_t stream) {
+  const unsigned strips = tiles * (4 / ROWS);
+  const unsigned blocks = (strips + kWarpsPerBlock - 1) / kWarpsPerBlock;
+  const unsigned threads = kWarpsPerBlock * kWarp;
+  const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
+  if (pipelined && a.exp2_alpha) blend_warp_tile_kernel<ROWS, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else if (pipelined) blend_warp_tile_kernel<ROWS, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else if (a.exp2_alpha) blend_warp_tile_kernel<ROWS, false, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else blend_warp_tile_kernel<ROWS, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
 }
 
 template <bool SURFACE>
@@ -185,13 +204,11 @@ void launch_for_output(const BlendArgs& a, cudaStream_t stream) {
     blend_per_pixel_kernel<SURFACE><<<tiles, kTile * kTile, 0, stream>>>(a);
     return;
   }
-  const unsigned blocks = (tiles + kWarpsPerBlock - 1) / kWarpsPerBlock;
-  const unsigned threads = kWarpsPerBlock * kWarp;
-  const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
-  if (pipelined && a.exp2_alpha) blend_warp_tile_kernel<true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (pipelined) blend_warp_tile_kernel<true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (a.exp2_alpha) blend_warp_tile_kernel<false, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else blend_warp_tile_kernel<false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  switch (a.lane_rows) {
+    case 4: launch_warp_tile<4, SURFACE>(a, tiles, stream); break;
+    case 2: launch_warp_tile<2, SURFACE>(a, tiles, stream); break;
+    default: launch_warp_tile<1, SURFACE>(a, tiles, stream); break;
+  }
 }
 
 }  // namespace

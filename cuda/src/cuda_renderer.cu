@@ -2,6 +2,7 @@
 #include <cuda_runtime.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -117,6 +118,8 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaGetDeviceProperties(&prop, device_), "cudaGetDeviceProperties");
     device_name_ = prop.name;
     check_cuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "stream creation");
+    // Tuning knob for the benchmark script (rows of pixels per lane in the warp blend).
+    if (const char* rows = std::getenv("FLASHGS_BLEND_ROWS")) lane_rows_ = std::atoi(rows);
     for (cudaEvent_t& e : events_) check_cuda(cudaEventCreate(&e), "event creation");
     check_cuda(cudaMallocHost(&host_counters_, sizeof(cuda::FrameCounters)), "pinned counter allocation");
     for (DeviceBuffer* b : working_buffers()) b->bind(&working_bytes_, &peak_bytes_);
@@ -358,6 +361,7 @@ class CudaRendererImpl final : public CudaRenderer {
                             : (options.pipelined_blend ? cuda::BlendKernel::warp_tile_pipelined
                                                        : cuda::BlendKernel::warp_tile);
     blend.exp2_alpha = args.exp2_alpha;
+    blend.lane_rows = lane_rows_;
     blend.values = b.values[which];
     blend.tile_ranges = b.tile_ranges;
     blend.gaussians = b.blend;
@@ -416,6 +420,7 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;
   std::uint64_t pair_capacity_ = 0;
   std::size_t last_tiles_ = 0;
+  int lane_rows_ = 1;
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_;
   // Working memory.

@@ -81,6 +81,16 @@ bench_quick() {
   bench_scene "$SCENES/pc_biker" bench_biker_quick --backend cuda -r 1920x1080 --configs baseline,flash --warmup 2 --repeat 5
 }
 
+bench_rows() {  # warp-blend pixel rows per lane: 1, 2, 4
+  for rows in 1 2 4; do
+    log "bench rows=$rows"
+    for scene in pc_biker pc_playbot; do
+      FLASHGS_BLEND_ROWS=$rows bench_scene "$SCENES/$scene" bench_rows${rows}_$scene --backend cuda \
+        -r 1920x1080,3840x2160 --configs flash --warmup 2 --repeat 5 | grep -E "^[0-9]+x"
+    done
+  done
+}
+
 bench() {
   log "bench pc_biker"
   bench_scene "$SCENES/pc_biker" bench_biker --backend cuda -r 1920x1080,3840x2160
@@ -117,6 +127,7 @@ for step in "$@"; do
     sanitize) sanitize ;;
     bench-quick) bench_quick ;;
     bench) bench ;;
+    bench-rows) bench_rows ;;
     bench-cpu) bench_cpu ;;
     profile) profile ;;
     *) echo "unknown step $step" ;;
