@@ -138,7 +138,7 @@ std::unique_ptr<FramePath> make_cuda_path(ImagePresenter* presenter, std::string
   bool on_our_device = false;
   for (unsigned i = 0; i < count && i < 4; ++i) on_our_device |= gl_devices[i] == device;
   if (e != cudaSuccess || !on_our_device) {
-    cudaGetLastError();  // clear the sticky-free error so later calls do not report it
+    cudaGetLastError();  // clear the (non-sticky) error so that later calls do not report it
     *why = e != cudaSuccess ? "CUDA-GL interop refused (" + cuda_error("cudaGLGetDevices", e) + ")"
                             : "CUDA-GL interop refused: the GL context is not on CUDA device " + std::to_string(device);
     return std::make_unique<CudaHostCopyPath>(std::move(renderer), presenter, device_name);
