@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <string>
 
+#include <unistd.h>
+
 #include "flashgs/image.h"
 #include "flashgs/image_io.h"
 #include "test_support.h"
@@ -19,7 +21,7 @@ struct RunResult {
   std::string output;  // stdout and stderr together
 };
 
-RunResult run(const std::string& command) {
+RunResult run_once(const std::string& command) {
   RunResult r;
   FILE* pipe = popen((command + " 2>&1").c_str(), "r");
   if (!pipe) return r;
@@ -27,6 +29,17 @@ RunResult run(const std::string& command) {
   while (std::fgets(buffer.data(), buffer.size(), pipe)) r.output += buffer.data();
   const int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// Runs a command; retried when xvfb-run itself could not start its X server (a display-number
+// race with another test), never when the viewer failed.
+RunResult run(const std::string& command) {
+  RunResult r;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    r = run_once(command);
+    if (r.exit_code == 0 || r.output.find("xvfb-run: error") == std::string::npos) break;
+  }
   return r;
 }
 
@@ -39,7 +52,10 @@ std::string out_dir() {
 // The viewer needs an X display: the one we have, or a private Xvfb through xvfb-run.
 // Returns the command prefix, or empty when neither exists.
 std::string display_prefix() {
-  if (run("command -v xvfb-run").exit_code == 0) return "xvfb-run -a -s \"-screen 0 1920x1080x24\" ";
+  // ctest runs the tests in parallel: each process starts its search for a free display number
+  // at its own place, so that two xvfb-run calls rarely race for the same one.
+  if (run("command -v xvfb-run").exit_code == 0)
+    return "xvfb-run -a -n " + std::to_string(100 + (getpid() * 37) % 800) + " -s \"-screen 0 1920x1080x24\" ";
   if (std::getenv("DISPLAY")) return " ";
   return "";
 }
