@@ -439,7 +439,15 @@ int ViewerApp::run() {
                reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
   float xscale = 1.0f, yscale = 1.0f;
   glfwGetWindowContentScale(m_window->handle(), &xscale, &yscale);
-  m_ui = std::make_unique<ImGuiLayer>(m_window->handle(), std::max(1.0f, xscale));
+  int fb_w0 = 0, fb_h0 = 0;
+  m_window->framebuffer_size(&fb_w0, &fb_h0);
+  // X11 and Windows report a content scale of 2 on a 192-dpi screen with the framebuffer in
+  // window units; macOS reports 2 and a framebuffer twice the window: the UI then needs no
+  // extra scale, ImGui's points already being two pixels.
+  m_ui_scale = std::max(1.0f, xscale / m_window->framebuffer_scale());
+  std::fprintf(stderr, "flashgs-viewer: framebuffer %dx%d pixels, content scale %.2f, UI scale %.2f\n", fb_w0, fb_h0,
+               xscale, m_ui_scale);
+  m_ui = std::make_unique<ImGuiLayer>(m_window->handle(), m_ui_scale);
   select_frame_path();
   // On the CPU a frame takes long: re-render only when something changes, so the panels stay
   // responsive (GPU paths render every frame and show their FPS).
@@ -511,8 +519,9 @@ int ViewerApp::run() {
     UiModel model;
     const float fb_scale = m_window->framebuffer_scale();
     // Bottom right, clear of the main panel (top left) and the statistics (top right).
-    const float legend_px[4] = {float(fb_w) - 300.0f * fb_scale, float(fb_h) - 30.0f * fb_scale,
-                                float(fb_w) - 20.0f * fb_scale, float(fb_h) - 16.0f * fb_scale};
+    const float u = m_ui_scale * fb_scale;  // legend sizes in pixels
+    const float legend_px[4] = {float(fb_w) - 300.0f * u, float(fb_h) - 30.0f * u, float(fb_w) - 20.0f * u,
+                                float(fb_h) - 16.0f * u};
     if (m_settings.show_ui) {
       m_ui->begin_frame();
       model.frame_path = m_path->name();
@@ -536,6 +545,7 @@ int ViewerApp::run() {
       model.heatmap_max = m_presenter->heatmap_max();
       for (int k = 0; k < 4; ++k) model.legend_rect_points[k] = legend_px[k] / fb_scale;
       model.status = m_status;
+      model.ui_scale = m_ui_scale;
       const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
       for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
       draw_panels(model, m_settings, actions, m_path_buffer, m_shot_buffer);

@@ -77,6 +77,7 @@ class ViewerApp {
   CompareResult m_compare;
   std::string m_status;
   double m_fps = 0;
+  float m_ui_scale = 1.0f;
   double m_full_render_ms = 0;  // wall time of the last render at the full render scale
 
   // Input state between frames.

@@ -11,6 +11,11 @@
 namespace flashgs::viewer {
 namespace {
 
+// Widget sizes are written for a 1x screen and multiplied by the UI scale (2 on a 192-dpi X
+// screen; 1 on a Retina Mac, where ImGui's points already cover two pixels).
+float g_ui = 1.0f;
+float ui(float v) { return v * g_ui; }
+
 std::string human_count(double v) {
   char text[32];
   if (v >= 1e6) std::snprintf(text, sizeof text, "%.2fM", v / 1e6);
@@ -25,7 +30,7 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   ImGui::Text("%s Gaussians, SH degree %d, %d cameras", human_count(double(m.gaussians)).c_str(), m.sh_degree,
               m.camera_count);
   if (!m.scene_note.empty()) ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.scene_note.c_str());
-  ImGui::SetNextItemWidth(-60);
+  ImGui::SetNextItemWidth(ui(-60));
   const bool enter = ImGui::InputTextWithHint("##open", "PLY path or folder (or drop a file)", &path_buffer,
                                               ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
@@ -52,13 +57,13 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
     if (ImGui::ArrowButton("##prev", ImGuiDir_Left)) a.previous_camera = true;
     ImGui::SameLine();
     int cam = std::max(m.current_camera, 0);
-    ImGui::SetNextItemWidth(110);
+    ImGui::SetNextItemWidth(ui(110));
     if (ImGui::SliderInt("##cam", &cam, 0, m.camera_count - 1, "camera %d")) a.snap_camera = cam;
     ImGui::SameLine();
     if (ImGui::ArrowButton("##next", ImGuiDir_Right)) a.next_camera = true;
     ImGui::SameLine();
     if (ImGui::Button(m.playing ? "Stop" : "Play path")) a.toggle_play = true;
-    ImGui::SetNextItemWidth(140);
+    ImGui::SetNextItemWidth(ui(140));
     ImGui::SliderFloat("s per camera", &s.path_seconds_per_camera, 0.2f, 10.0f, "%.1f");
     ImGui::Text(m.on_scene_camera ? "on camera %d (exact)" : "free view (last camera %d)", m.current_camera);
   } else {
@@ -161,9 +166,9 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
   ImGui::Checkbox("Tile heat map (H)", &s.heatmap);
   ImGui::SameLine();
   ImGui::Checkbox("log", &s.heatmap_log);
-  ImGui::SetNextItemWidth(120);
+  ImGui::SetNextItemWidth(ui(120));
   ImGui::SliderFloat("opacity", &s.heatmap_opacity, 0.1f, 1.0f);
-  ImGui::SetNextItemWidth(-70);
+  ImGui::SetNextItemWidth(ui(-70));
   ImGui::InputText("##shot", &shot);
   ImGui::SameLine();
   if (ImGui::Button("Save") && !shot.empty()) a.screenshot_path = shot;
@@ -172,7 +177,7 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
 
 void stats_window(const UiModel& m) {
   const ImGuiViewport* vp = ImGui::GetMainViewport();
-  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x - 10, vp->WorkPos.y + 10), ImGuiCond_Always,
+  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x - ui(10), vp->WorkPos.y + ui(10)), ImGuiCond_Always,
                           ImVec2(1, 0));
   ImGui::SetNextWindowBgAlpha(0.75f);
   ImGui::Begin("Statistics", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
@@ -201,7 +206,7 @@ void stats_window(const UiModel& m) {
       char overlay[64];
       std::snprintf(overlay, sizeof overlay, "%s %.2f ms (max %.2f)", StatsHistory::name(s), h->mean(s), h->max(s));
       ImGui::PlotLines("##h", values, count, offset, overlay, 0.0f, float(h->max(s) * 1.1 + 1e-3),
-                       ImVec2(300, s == StatsHistory::kFrame ? 40 : 26));
+                       ImVec2(ui(300), ui(s == StatsHistory::kFrame ? 40 : 26)));
     }
   }
   ImGui::End();
@@ -211,19 +216,21 @@ void legend_labels(const UiModel& m) {
   ImDrawList* draw = ImGui::GetForegroundDrawList();
   const float* r = m.legend_rect_points;
   const ImU32 white = IM_COL32(255, 255, 255, 255);
-  draw->AddRectFilled(ImVec2(r[0] - 6, r[1] - 22), ImVec2(r[2] + 6, r[1] - 1), IM_COL32(0, 0, 0, 150), 3.0f);
+  draw->AddRectFilled(ImVec2(r[0] - ui(6), r[1] - ui(22)), ImVec2(r[2] + ui(6), r[1] - 1), IM_COL32(0, 0, 0, 150),
+                      ui(3.0f));
   char text[64];
   std::snprintf(text, sizeof text, "pairs per tile: 0 .. %u", m.heatmap_max);
-  draw->AddText(ImVec2(r[0], r[1] - 19), white, text);
+  draw->AddText(ImVec2(r[0], r[1] - ui(19)), white, text);
 }
 
 }  // namespace
 
 void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer, std::string& shot) {
-  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  g_ui = m.ui_scale;
+  ImGui::SetNextWindowPos(ImVec2(ui(10), ui(10)), ImGuiCond_FirstUseEver);
   const ImGuiViewport* vp = ImGui::GetMainViewport();
-  ImGui::SetNextWindowSizeConstraints(ImVec2(300, 100), ImVec2(600, std::max(120.0f, vp->WorkSize.y - 20)));
-  ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(ui(300), ui(100)), ImVec2(ui(600), std::max(ui(120), vp->WorkSize.y - ui(20))));
+  ImGui::SetNextWindowSize(ImVec2(ui(380), 0), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("flashgs-viewer");
   ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels

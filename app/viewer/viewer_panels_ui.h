@@ -30,6 +30,7 @@ struct UiModel {
   const CompareResult* compare = nullptr;
   std::uint32_t heatmap_max = 0;
   float legend_rect_points[4] = {0, 0, 0, 0};  // where the legend bar is drawn, window points
+  float ui_scale = 1.0f;          // widget size multiplier (high-DPI screens)
   std::string status;             // last screenshot / action message
   float world_up[3] = {0, -1, 0};
   float position[3] = {0, 0, 0};
