@@ -142,7 +142,7 @@ bool ViewerApp::open_scene(const std::string& path) {
     return true;
   } catch (const std::exception& e) {
     m_load_error = e.what();
-    std::fprintf(stderr, "flashgs-viewer: cannot open %s: %s\n", path.c_str(), e.what());
+    std::fprintf(stderr, "flashgs-viewer: load failed, scene kept: %s\n", e.what());
     return false;
   }
 }
@@ -174,7 +174,7 @@ void ViewerApp::finish_pending_load() {
     m_path_buffer = path;
   } catch (const std::exception& e) {
     m_load_error = e.what();
-    std::fprintf(stderr, "flashgs-viewer: cannot open %s: %s\n", path.c_str(), e.what());
+    std::fprintf(stderr, "flashgs-viewer: load failed, scene kept: %s\n", e.what());
   }
 }
 
