@@ -207,6 +207,28 @@ exit $status
 #endif
 }
 
+// The heat-map shader draws over the frame, and its legend runs from blue (0) to red (max).
+TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string with = dir + "/overlay_on.png", without = dir + "/overlay_off.png";
+  const std::string common = prefix + viewer() + " --backend cpu --size 480x270 --camera 1 --frames 2 --no-ui ";
+  const RunResult a = run(common + "--heatmap --window-screenshot " + with + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const RunResult b = run(common + "--window-screenshot " + without + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const flashgs::Image on = flashgs::read_image(with), off = flashgs::read_image(without);
+  ASSERT_EQ(on.width, 480);
+  EXPECT_LT(flashgs::compare_images(on, off).psnr_db, 30.0) << "the overlay changed nothing";
+  // Legend bar: x in [480 - 300, 480 - 20), y in [270 - 30, 270 - 16) at UI scale 1.
+  const float* low = on.pixel(185, 247);
+  const float* high = on.pixel(455, 247);
+  EXPECT_GT(low[2], 0.25f);
+  EXPECT_LT(low[0], 0.2f);
+  EXPECT_GT(high[0], 0.7f);
+  EXPECT_LT(high[2], 0.2f);
+}
+
 TEST(Viewer, CameraPathReportsFrameTimes) {
   REQUIRE_DISPLAY(prefix);
   const RunResult r = run(prefix + viewer() + " --backend cpu --size 320x180 --path --frames 4 --warmup 1 --exit");
