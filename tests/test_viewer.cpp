@@ -43,6 +43,9 @@ RunResult run(const std::string& command) {
   return r;
 }
 
+// PNG where OpenImageIO is built in, else the built-in PPM (same 8-bit bytes).
+const std::string kExt = flashgs::image_io_has_oiio() ? ".png" : ".ppm";
+
 std::string out_dir() {
   const std::string dir = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/viewer";
   std::filesystem::create_directories(dir);
@@ -70,7 +73,7 @@ std::string cli() { return FLASHGS_CLI; }
 // The viewer's screenshot of `camera` vs `flashgs render` of the same camera at the same size.
 void expect_matches_cli(const std::string& prefix, const std::string& scene, int camera, const std::string& stem) {
   const std::string dir = out_dir();
-  const std::string shot = dir + "/" + stem + "_viewer.png", ref = dir + "/" + stem + "_cli.png";
+  const std::string shot = dir + "/" + stem + "_viewer" + kExt, ref = dir + "/" + stem + "_cli" + kExt;
   std::filesystem::remove(shot);
   const std::string scene_arg = scene.empty() ? "" : "\"" + scene + "\" ";
   const RunResult v = run(prefix + viewer() + " " + scene_arg + "--backend cpu --size 640x360 --camera " +
@@ -104,7 +107,7 @@ TEST(Viewer, BikerCameraZeroMatchesCliRender) {
 TEST(Viewer, ScriptedKeysMoveTheCamera) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir();
-  const std::string still = dir + "/keys_still.png", moved = dir + "/keys_moved.png";
+  const std::string still = dir + "/keys_still" + kExt, moved = dir + "/keys_moved" + kExt;
   const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --camera 0 ";
   const RunResult a = run(common + "--frames 1 --screenshot " + still + " --exit");
   ASSERT_EQ(a.exit_code, 0) << a.output;
@@ -123,7 +126,7 @@ TEST(Viewer, ScriptedKeysMoveTheCamera) {
 
 TEST(Viewer, WindowResizeRecreatesTheFrame) {
   REQUIRE_DISPLAY(prefix);
-  const std::string shot = out_dir() + "/after_resize.png", ref = out_dir() + "/resize_reference.png";
+  const std::string shot = out_dir() + "/after_resize" + kExt, ref = out_dir() + "/resize_reference" + kExt;
   const RunResult r = run(prefix + viewer() + " --backend cpu --size 320x180 --camera 4 --keys \"RESIZE:400:300,WAIT:0.05\" "
                           "--screenshot " + shot + " --exit");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -145,7 +148,7 @@ TEST(Viewer, FailedLoadKeepsTheCurrentScene) {
   const std::string dir = out_dir();
   const std::string bad = dir + "/not_a_scene.ply";
   { FILE* f = std::fopen(bad.c_str(), "wb"); ASSERT_TRUE(f); std::fputs("ply\nformat ascii 9.9\n", f); std::fclose(f); }
-  const std::string shot = dir + "/after_failed_load.png", ref = dir + "/before_failed_load.png";
+  const std::string shot = dir + "/after_failed_load" + kExt, ref = dir + "/before_failed_load" + kExt;
   const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --camera 2 --frames 3 ";
   const RunResult a = run(common + "--then-open " + bad + " --screenshot " + shot + " --exit");
   ASSERT_EQ(a.exit_code, 0) << a.output;
@@ -211,7 +214,7 @@ exit $status
 TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir();
-  const std::string with = dir + "/overlay_on.png", without = dir + "/overlay_off.png";
+  const std::string with = dir + "/overlay_on" + kExt, without = dir + "/overlay_off" + kExt;
   const std::string common = prefix + viewer() + " --backend cpu --size 480x270 --camera 1 --frames 2 --no-ui ";
   const RunResult a = run(common + "--heatmap --window-screenshot " + with + " --exit");
   ASSERT_EQ(a.exit_code, 0) << a.output;
@@ -239,7 +242,7 @@ TEST(Viewer, CameraPathReportsFrameTimes) {
 
 TEST(Viewer, HeatmapAndCompareRun) {
   REQUIRE_DISPLAY(prefix);
-  const std::string shot = out_dir() + "/heatmap_window.png";
+  const std::string shot = out_dir() + "/heatmap_window" + kExt;
   const RunResult r = run(prefix + viewer() + " --backend cpu --size 480x270 --camera 1 --frames 2 --heatmap --compare --check-frame "
                           "--window-screenshot " + shot + " --exit");
   ASSERT_EQ(r.exit_code, 0) << r.output;
