@@ -180,7 +180,7 @@ TEST(CudaSanitizer, Frames) {
   const bool quick = std::getenv("FLASHGS_SANITIZER_QUICK") != nullptr;
   for (const Camera& camera : sanitizer_cameras(*scene, cameras))
     for (RenderOptions o : all_configs()) {
-      if (quick && !(o.is_baseline() || o.label() == "flash" || !o.pipelined_blend || !o.exp2_alpha || !o.fused_emit))
+      if (quick && !(o.is_baseline() || o.label() == "flash" || !o.pipelined_blend))
         continue;
       o.collect_tile_counts = true;
       const Result r = render(*gpu, camera, o);

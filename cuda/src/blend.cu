@@ -38,7 +38,7 @@ __device__ __forceinline__ BlendGaussian load_gaussian(const BlendGaussian* g) {
   const float4 p = __ldg(src), q = __ldg(src + 1), s = __ldg(src + 2);
   r.mean_x = p.x, r.mean_y = p.y, r.w0 = p.z, r.w1 = p.w;
   r.w2 = q.x, r.w3 = q.y, r.opacity = q.z, r.red = q.w;
-  r.green = s.x, r.blue = s.y, r.pad0 = r.pad1 = 0.0f;
+  r.green = s.x, r.blue = s.y, r.reach_y = s.z, r.pad0 = 0.0f;
   return r;
 }
 
@@ -111,6 +111,9 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const int tx = static_cast<int>(tile % a.tiles_x), ty = static_cast<int>(tile / a.tiles_x);
   const int x0 = tx * kTile + static_cast<int>(lane % 8) * kLanePixelsX;
   const int y0 = ty * kTile + static_cast<int>(strip % kStripsPerTile) * 4 * ROWS + static_cast<int>(lane / 8) * ROWS;
+  const float strip_half_h = 0.5f * (4 * ROWS - 1);
+  const float strip_mid_y =
+      static_cast<float>(ty * kTile + static_cast<int>(strip % kStripsPerTile) * 4 * ROWS) + strip_half_h;
   float t[kPixels], cr[kPixels], cg[kPixels], cb[kPixels];
   unsigned live = 0;  // bit p: pixel p still blending
 #pragma unroll
@@ -135,6 +138,8 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     const unsigned n = min(static_cast<unsigned>(kWarp), range.y - base);
     for (unsigned j = 0; j < n && live; ++j) {
       const BlendGaussian& g = batch[warp][j];
+      // The whole strip lies beyond the rows this Gaussian can reach: a warp-uniform skip.
+      if (fabsf(strip_mid_y - g.mean_y) > g.reach_y + strip_half_h) continue;
       // Per lane, the columns' and rows' parts of u and v, so a pixel costs two adds and a
       // square-sum; in the exact mode this is the CPU's rounding, term for term.
       float ux[kLanePixelsX], vx[kLanePixelsX], uy[ROWS], vy[ROWS];

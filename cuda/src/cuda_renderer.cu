@@ -231,7 +231,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &image_, &cub_temp_};
+            &values_[1], &ranges_, &image_, &cub_temp_, &huge_footprints_, &huge_ids_};
   }
   std::vector<DeviceBuffer*> scene_buffers() { return {&scene_pos_, &scene_rot_, &scene_scale_, &scene_dc_, &scene_rest_}; }
 
@@ -246,6 +246,10 @@ class CudaRendererImpl final : public CudaRenderer {
       b.values[k] = values_[k].as<std::uint32_t>();
     }
     b.pair_capacity = pair_capacity_;
+    b.huge_footprints = huge_footprints_.as<gm::Footprint>();
+    b.huge_ids = huge_ids_.as<std::uint32_t>();
+    b.huge_capacity = static_cast<std::uint32_t>(
+        std::min(huge_footprints_.bytes() / sizeof(gm::Footprint), huge_ids_.bytes() / sizeof(std::uint32_t)));
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
     b.image_rgb = image_.as<float>();
@@ -295,6 +299,11 @@ class CudaRendererImpl final : public CudaRenderer {
 
     ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
+    if (fused && !baseline && options.warp_cooperative_emit) {
+      const std::size_t cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 4096 + n / 64);
+      huge_footprints_.reserve(cap * sizeof(gm::Footprint), "huge-Gaussian footprints");
+      huge_ids_.reserve(cap * sizeof(std::uint32_t), "huge-Gaussian ids");
+    }
     if (!fused) {
       footprints_.reserve(std::max<std::size_t>(n, 1) * sizeof(gm::Footprint), "per-Gaussian footprints");
       pair_counts_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair counts");
@@ -425,7 +434,7 @@ class CudaRendererImpl final : public CudaRenderer {
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_;
   // Working memory.
   DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, image_,
-      cub_temp_;
+      cub_temp_, huge_footprints_, huge_ids_;
 };
 
 }  // namespace

@@ -17,6 +17,9 @@ constexpr int kWarp = 32;
 // A Gaussian whose tile box holds more than this many tiles is emitted by a whole warp
 // (FlashGS section 4.3): below it one thread's loop is shorter than the warp's bookkeeping.
 constexpr int kLargeBoxTiles = 16;
+// Boxes of more than this many tiles go to a list that a second kernel emits with a whole
+// block per Gaussian: one warp looping over 10^4 tiles would set the preprocess kernel's length.
+constexpr int kHugeBoxTiles = 1024;
 
 // The scene on the device, in a compact layout sized to its SH degree (56 bytes per Gaussian
 // for degree 0, plus 48/96/192 bytes of higher bands for degree 1/2/3).
@@ -39,7 +42,7 @@ struct DeviceScene {
 struct alignas(16) BlendGaussian {
   float mean_x, mean_y, w0, w1;
   float w2, w3, opacity, red;
-  float green, blue, pad0, pad1;
+  float green, blue, reach_y, pad0;  // reach_y: |dy| beyond which alpha < 1/255 for sure
 };
 
 // Counters one frame accumulates on the device; copied to the host once per frame.
@@ -50,7 +53,7 @@ struct FrameCounters {
   unsigned int culled_offscreen;   // box or ellipse missed every tile
   unsigned int culled_low_opacity;
   unsigned int culled_degenerate;
-  unsigned int pad;
+  unsigned int huge;              // Gaussians deferred to the huge-emission kernel
 };
 
 // Buffers of the frame pipeline; every size is a high-water mark (grown, never shrunk).
@@ -60,6 +63,10 @@ struct FrameBuffers {
   gm::Footprint* footprints = nullptr;    // [gaussians] separate-emission path only
   std::uint32_t* pair_counts = nullptr;   // [gaussians] pairs per Gaussian (separate path)
   std::uint32_t* pair_offsets = nullptr;  // [gaussians] inclusive prefix sum of pair_counts
+  // Huge Gaussians deferred by the fused kernel (beyond the capacity they are emitted there).
+  gm::Footprint* huge_footprints = nullptr;  // [huge_capacity]
+  std::uint32_t* huge_ids = nullptr;         // [huge_capacity] Gaussian id
+  std::uint32_t huge_capacity = 0;
   // Per pair: key = tile << 32 | depth bits, value = Gaussian id; two of each for the sort.
   std::uint64_t* keys[2] = {nullptr, nullptr};    // [pair_capacity]
   std::uint32_t* values[2] = {nullptr, nullptr};  // [pair_capacity]

@@ -74,6 +74,7 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   unsigned count = 0;          // pairs of this Gaussian (small path / separate path)
   unsigned passed_mask = 0;    // tiles of a box of <= 32 tiles that passed the exact test
   bool large = false;          // emitted by the whole warp below
+  bool huge = false;           // emitted by huge_emit_kernel (counted there too)
   if (valid) {
     const float4 po = __ldg(scene.position_opacity + i);
     const float4 q = __ldg(scene.rotation + i);
@@ -97,11 +98,28 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
         out[0] = make_float4(f.mean_x, f.mean_y, f.whiten[0], f.whiten[1]);
         out[1] = make_float4(f.whiten[2], f.whiten[3], po.w, rgb[0]);
       }
-      out[2] = make_float4(rgb[1], rgb[2], 0.0f, 0.0f);
+      // Rows farther than reach_y from the centre have q > 2 ln(255 o), i.e. alpha < 1/255
+      // (min over dx of q at offset dy is dy^2 / Sigma_yy); the margins cover rounding, so
+      // the blend may skip them without changing a pixel.
+      const float det_w = f.whiten[0] * f.whiten[3] - f.whiten[1] * f.whiten[2];
+      const float q_cut = 2.0f * logf(255.0f * po.w) + 0.01f;
+      const float conic_a = f.whiten[0] * f.whiten[0] + f.whiten[2] * f.whiten[2];
+      float reach_y = q_cut > 0.0f ? sqrtf(q_cut * conic_a) / fabsf(det_w) + 0.01f : -1.0f;
+      if (!(reach_y < 1e30f) && q_cut > 0.0f) reach_y = 1e30f;  // degenerate: never skip
+      out[2] = make_float4(rgb[1], rgb[2], reach_y, 0.0f);
 
       const int box_w = f.tile_x1 - f.tile_x0;
       const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
-      if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kLargeBoxTiles)) {
+      if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kHugeBoxTiles)) {
+        const unsigned slot = atomicAdd(&buf.counters->huge, 1u);
+        if (slot < buf.huge_capacity) {
+          buf.huge_footprints[slot] = f;
+          buf.huge_ids[slot] = i;
+          huge = true;
+        } else {
+          large = true;
+        }
+      } else if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kLargeBoxTiles)) {
         large = true;
       } else if (!args.exact_tile_test) {
         count = box;
@@ -142,8 +160,8 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
               store_pair(buf, offset++, static_cast<unsigned>(ty) * cam.tiles_x + tx, depth_bits, i);
       }
     }
-    // Large Gaussians: the warp tests 32 tiles at a time, counts with a reduction, reserves
-    // with one atomic, then writes with ballot + popc offsets (FlashGS section 4.3).
+    // Large Gaussians: the warp tests 32 tiles at a time and writes the hits with ballot +
+    // popc offsets after one atomic per chunk (FlashGS section 4.3).
     unsigned pending = __ballot_sync(kFullMask, large);
     while (pending) {
       const int src = __ffs(pending) - 1;
@@ -153,27 +171,20 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
       const unsigned g_id = __shfl_sync(kFullMask, i, src);
       const unsigned box_w = static_cast<unsigned>(g.tile_x1 - g.tile_x0);
       const unsigned box = box_w * static_cast<unsigned>(g.tile_y1 - g.tile_y0);
-      unsigned lane_count = 0;
-      if (args.exact_tile_test) {
-        for (unsigned t = lane; t < box; t += kWarp)
-          lane_count += touches(g, g.tile_x0 + t % box_w, g.tile_y0 + t / box_w, cam, true) ? 1u : 0u;
-      } else {
-        lane_count = lane == 0 ? box : 0u;
-      }
-      const unsigned total = __reduce_add_sync(kFullMask, lane_count);
-      unsigned long long g_base = 0;
-      if (lane == 0 && total > 0) g_base = atomicAdd(&buf.counters->pairs, total);
-      g_base = __shfl_sync(kFullMask, g_base, 0);
-      if (total > 0) {
-        const unsigned lanes_below = (1u << lane) - 1u;
-        for (unsigned t0 = 0; t0 < box; t0 += kWarp) {
-          const unsigned t = t0 + lane;
-          const unsigned tx = g.tile_x0 + t % box_w, ty = g.tile_y0 + t / box_w;
-          const bool pass = t < box && touches(g, tx, ty, cam, args.exact_tile_test);
-          const unsigned ballot = __ballot_sync(kFullMask, pass);
-          if (pass) store_pair(buf, g_base + __popc(ballot & lanes_below), ty * cam.tiles_x + tx, g_depth, g_id);
-          g_base += __popc(ballot);
-        }
+      // One pass: each 32-tile chunk is tested, then reserved with one atomic for its hits.
+      const unsigned lanes_below = (1u << lane) - 1u;
+      unsigned total = 0;
+      for (unsigned t0 = 0; t0 < box; t0 += kWarp) {
+        const unsigned t = t0 + lane;
+        const unsigned tx = g.tile_x0 + t % box_w, ty = g.tile_y0 + t / box_w;
+        const bool pass = t < box && touches(g, tx, ty, cam, args.exact_tile_test);
+        const unsigned ballot = __ballot_sync(kFullMask, pass);
+        if (!ballot) continue;
+        unsigned long long chunk_base = 0;
+        if (lane == 0) chunk_base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(__popc(ballot)));
+        chunk_base = __shfl_sync(kFullMask, chunk_base, 0);
+        if (pass) store_pair(buf, chunk_base + __popc(ballot & lanes_below), ty * cam.tiles_x + tx, g_depth, g_id);
+        total += __popc(ballot);
       }
       if (static_cast<int>(lane) == src) count = total;
     }
@@ -186,7 +197,7 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
     if (lane == 0 && warp_total > 0) atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(warp_total));
   }
 
-  if (valid) {
+  if (valid && !huge) {
     int slot;
     if (reason == gm::kVisible) slot = count > 0 ? 0 : 2;  // box met the image, the ellipse did not
     else if (reason == gm::kCulledNear) slot = 1;
@@ -199,6 +210,40 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   if (threadIdx.x < 5 && block_counts[threadIdx.x] > 0) {
     unsigned* dst = threadIdx.x == 0 ? &buf.counters->visible : &buf.counters->culled_near + (threadIdx.x - 1);
     atomicAdd(dst, block_counts[threadIdx.x]);
+  }
+}
+
+// The deferred huge Gaussians: a block per Gaussian, each warp a 32-tile chunk at a time,
+// one atomic per chunk with hits; visibility is decided here from the block's total.
+__global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm::CameraParams cam, bool exact) {
+  __shared__ unsigned block_total;
+  const unsigned count = min(buf.counters->huge, buf.huge_capacity);
+  const unsigned lane = lane_id(), warp = threadIdx.x / kWarp;
+  const unsigned lanes_below = (1u << lane) - 1u;
+  for (unsigned h = blockIdx.x; h < count; h += gridDim.x) {
+    if (threadIdx.x == 0) block_total = 0;
+    __syncthreads();
+    const gm::Footprint f = buf.huge_footprints[h];
+    const unsigned id = buf.huge_ids[h];
+    const std::uint32_t depth_bits = gm::depth_bits(f.depth);
+    const unsigned box_w = static_cast<unsigned>(f.tile_x1 - f.tile_x0);
+    const unsigned box = box_w * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
+    unsigned warp_total = 0;
+    for (unsigned t0 = warp * kWarp; t0 < box; t0 += kBlock) {
+      const unsigned t = t0 + lane;
+      const unsigned tx = f.tile_x0 + t % box_w, ty = f.tile_y0 + t / box_w;
+      const bool pass = t < box && touches(f, tx, ty, cam, exact);
+      const unsigned ballot = __ballot_sync(kFullMask, pass);
+      if (!ballot) continue;
+      unsigned long long base = 0;
+      if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(__popc(ballot)));
+      base = __shfl_sync(kFullMask, base, 0);
+      if (pass) store_pair(buf, base + __popc(ballot & lanes_below), ty * cam.tiles_x + tx, depth_bits, id);
+      warp_total += __popc(ballot);
+    }
+    if (lane == 0 && warp_total) atomicAdd(&block_total, warp_total);
+    __syncthreads();
+    if (threadIdx.x == 0) atomicAdd(block_total > 0 ? &buf.counters->visible : &buf.counters->culled_offscreen, 1u);
   }
 }
 
@@ -219,8 +264,13 @@ void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, co
 void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
                        bool fused, cudaStream_t stream) {
   if (scene.count == 0) return;
-  if (fused) launch_for_degree<true>(scene, buffers, args, stream);
-  else launch_for_degree<false>(scene, buffers, args, stream);
+  if (fused) {
+    launch_for_degree<true>(scene, buffers, args, stream);
+    if (args.warp_cooperative && buffers.huge_capacity > 0)
+      huge_emit_kernel<<<264, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test);
+  } else {
+    launch_for_degree<false>(scene, buffers, args, stream);
+  }
   check_cuda(cudaGetLastError(), "preprocess kernel launch");
 }
 

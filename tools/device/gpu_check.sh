@@ -73,7 +73,7 @@ sanitize() {
 bench_scene() {  # scene-folder json-name extra-args...
   local dir=$1 name=$2
   shift 2
-  "$FLASHGS" bench "$dir/point_cloud.ply" -o "$OUT/$name.json" "$@" 2> "$OUT/$name.err" | tee "$OUT/$name.txt" | tail -14
+  "$FLASHGS" bench "$dir/point_cloud.ply" -o "$OUT/$name.json" "$@" 2> "$OUT/$name.err" | tee "$OUT/$name.txt" | tail -22
 }
 
 bench_quick() {
@@ -93,9 +93,9 @@ bench_rows() {  # warp-blend pixel rows per lane: 1, 2, 4
 
 bench() {
   log "bench pc_biker"
-  bench_scene "$SCENES/pc_biker" bench_biker --backend cuda -r 1920x1080,3840x2160
+  bench_scene "$SCENES/pc_biker" bench_biker --backend cuda -r 1920x1080,3840x2160 --warmup 2 --repeat 5
   log "bench pc_playbot"
-  bench_scene "$SCENES/pc_playbot" bench_playbot --backend cuda -r 1920x1080,3840x2160
+  bench_scene "$SCENES/pc_playbot" bench_playbot --backend cuda -r 1920x1080,3840x2160 --warmup 2 --repeat 5
   log "generate 7 x pc_playbot"
   [ -f /tmp/tile7/point_cloud.ply ] || "$FLASHGS" generate tile -i "$SCENES/pc_playbot/point_cloud.ply" -n 7 -o /tmp/tile7 | tail -1
   bench_scene /tmp/tile7 bench_tile7 --backend cuda -r 1920x1080,3840x2160 --configs baseline,flash --warmup 2 --repeat 5
@@ -134,3 +134,6 @@ for step in "$@"; do
   esac
 done
 log "done"
+# At most 8 files come back: everything but the summary goes into one archive.
+(cd "$OUT" && tar czf logs.tgz --exclude=logs.tgz --exclude=summary.txt --exclude='*.ppm' . 2>/dev/null &&
+  find . -maxdepth 1 -type f ! -name logs.tgz ! -name summary.txt -delete)
