@@ -177,10 +177,16 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
 
 void stats_window(const UiModel& m) {
   const ImGuiViewport* vp = ImGui::GetMainViewport();
-  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x - ui(10), vp->WorkPos.y + ui(10)), ImGuiCond_Always,
-                          ImVec2(1, 0));
+  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x - ui(10), vp->WorkPos.y + ui(10)),
+                          ImGuiCond_Always, ImVec2(1, 0));  // anchored top right as it grows and shrinks
+  // In a small window the panels would cover the picture: statistics start folded there.
+  ImGui::SetNextWindowCollapsed(vp->WorkSize.x < ui(1000), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.75f);
-  ImGui::Begin("Statistics", nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
+  // The title keeps the active path and the frame rate in view when the window is folded.
+  char title[256];
+  std::snprintf(title, sizeof title, "%.1f FPS | %s###Statistics", m.fps, m.frame_path.c_str());
+  ImGui::SetNextWindowSizeConstraints(ImVec2(ui(380), 0), ImVec2(vp->WorkSize.x, vp->WorkSize.y));
+  ImGui::Begin(title, nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
   ImGui::TextColored(ImVec4(0.5f, 0.9f, 0.6f, 1), "%s", m.frame_path.c_str());
   if (!m.frame_path_note.empty()) ImGui::TextDisabled("%s", m.frame_path_note.c_str());
   ImGui::Text("%.1f FPS   render %dx%d", m.fps, m.render_width, m.render_height);
@@ -206,7 +212,7 @@ void stats_window(const UiModel& m) {
       char overlay[64];
       std::snprintf(overlay, sizeof overlay, "%s %.2f ms (max %.2f)", StatsHistory::name(s), h->mean(s), h->max(s));
       ImGui::PlotLines("##h", values, count, offset, overlay, 0.0f, float(h->max(s) * 1.1 + 1e-3),
-                       ImVec2(ui(300), ui(s == StatsHistory::kFrame ? 40 : 26)));
+                       ImVec2(ui(260), ui(s == StatsHistory::kFrame ? 40 : 24)));
     }
   }
   ImGui::End();
