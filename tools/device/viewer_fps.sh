@@ -23,7 +23,8 @@
 #     cp -L /usr/lib/x86_64-linux-gnu/libgomp.so.1 .devgl/lib/   # OpenMP runtime, if the machine lacks it
 # The call sends at most 64 MiB in all: debs + binary + the working tree must fit. They may not
 # (debs ~60 MiB, tree ~4-8 MiB, binary ~3 MiB). Carried paths that a later call does not name
-# stay on a warm machine, so the carry can be split over two calls on the same machine:
+# stay on a warm machine (so the device tool says; not tried here), so the carry can be split
+# over two calls on the same machine:
 #   1) carry [".devgl/debs/xroot"] with command "true"   (Xvfb + Mesa: the bulk)
 #   2) carry [".devgl/debs/gl", ".devgl/debs/client", ".devgl/device-gl", ".devgl/bin", ".devgl/lib"]
 #      with command "bash tools/device/viewer_fps.sh"
