@@ -35,6 +35,8 @@ struct ReportArgs {
   int ref_cameras = 3;
   std::string output_dir = "report";
   std::string title;
+  std::string replot;    // re-plot this report.csv instead of measuring
+  std::string subtitle;  // for --replot
 };
 
 std::vector<int> parse_list(const std::string& text) {
@@ -62,7 +64,57 @@ std::string fmt(const char* f, double v) {
 
 std::string psnr_text(double db) { return std::isfinite(db) ? fmt("%.1f", db) : "inf"; }
 
+// Re-plots a report.csv (written by an earlier run) without measuring again.
+void replot(const ReportArgs& args) {
+  std::ifstream in(args.replot);
+  if (!in) throw Error(args.replot + ": cannot open");
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream h(line);
+    std::string cell;
+    while (std::getline(h, cell, ',')) header.push_back(cell);
+  }
+  auto column = [&](const std::string& name) {
+    for (std::size_t k = 0; k < header.size(); ++k)
+      if (header[k] == name) return k;
+    throw Error(args.replot + ": no column \"" + name + "\"");
+  };
+  const std::size_t c_backend = column("backend"), c_config = column("config"), c_group = column("group"),
+                    c_median = column("median_ms"), c_p95 = column("p95_ms"), c_psnr = column("psnr_vs_fp64_db");
+  std::vector<SweepResult> results;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    std::string cell;
+    while (std::getline(row, cell, ',')) cells.push_back(cell);
+    if (cells.size() < header.size()) continue;
+    SweepResult r;
+    r.backend = cells[c_backend];
+    r.config.name = cells[c_config];
+    r.config.group = cells[c_group];
+    r.median_ms = std::stod(cells[c_median]);
+    r.p95_ms = std::stod(cells[c_p95]);
+    r.vs_reference.psnr_db = cells[c_psnr] == "inf" ? INFINITY : std::stod(cells[c_psnr]);
+    results.push_back(r);
+  }
+  const std::string dir = std::filesystem::path(args.replot).parent_path().string();
+  for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
+    std::vector<SweepResult> subset;
+    for (const SweepResult& r : results)
+      if (r.backend == bname) subset.push_back(r);
+    if (subset.empty()) continue;
+    const std::string path = (dir.empty() ? std::string(".") : dir) + "/report_" + bname + ".svg";
+    std::ofstream(path) << plot_svg(subset, "Error vs run time: " + (args.title.empty() ? std::string("report") : args.title) +
+                                                " (" + bname + ")",
+                                    args.subtitle);
+    std::printf("wrote %s\n", path.c_str());
+  }
+}
+
 void run(const ReportArgs& args) {
+  if (!args.replot.empty()) return replot(args);
   const std::string scene_path = args.scene.resolved_scene();
   auto scene = load_scene_verbose(scene_path);
   const std::vector<Camera> all_cameras = load_cameras(args.scene.resolved_cameras());
@@ -248,6 +300,8 @@ void register_report(CLI::App& app) {
       ->check(CLI::Range(0, 1000));
   sub->add_option("--output-dir,-o", args->output_dir, "folder for report.csv, report.md, report_<backend>.svg");
   sub->add_option("--title", args->title, "title of the table and plots (default: the scene's folder name)");
+  sub->add_option("--replot", args->replot, "only redraw the SVG plot(s) from this report.csv (beside it)");
+  sub->add_option("--subtitle", args->subtitle, "with --replot: the plot's second line");
   sub->callback([args] { run(*args); });
 }
 

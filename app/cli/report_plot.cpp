@@ -146,7 +146,17 @@ std::string plot_svg(const std::vector<SweepResult>& results, const std::string&
     const double x = px(r.median_ms), y = py(plotted_psnr(r, cap));
     taken.push_back({x - 6, y - 6, x + 6, y + 6});
   }
-  for (std::size_t i = 0; i < results.size(); ++i) {
+  // Drawing order: dominated points, then the front, then baseline and flash on top (an
+  // equal-error switch can sit exactly on flash).
+  std::vector<std::size_t> order(results.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  auto layer = [&](std::size_t i) {
+    const std::string& g = results[i].config.group;
+    if (g == "flash" || g == "baseline") return 2;
+    return std::find(front.begin(), front.end(), i) != front.end() ? 1 : 0;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return layer(a) < layer(b); });
+  for (std::size_t i : order) {
     const SweepResult& r = results[i];
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
     const double x = px(r.median_ms), y = py(plotted_psnr(r, cap));
