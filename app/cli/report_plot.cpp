@@ -62,7 +62,7 @@ std::vector<std::size_t> pareto_front(const std::vector<SweepResult>& results) {
 }
 
 std::string plot_svg(const std::vector<SweepResult>& results, const std::string& title, const std::string& subtitle) {
-  const double width = 960, height = 600, left = 80, right = 250, top = 70, bottom = 70;
+  const double width = 960, height = 600, left = 80, right = 250, top = 74, bottom = 70;
   const double plot_w = width - left - right, plot_h = height - top - bottom;
   double t_lo = 1e300, t_hi = 0, e_lo = 1e300, e_hi = 0, finite_hi = 0;
   for (const SweepResult& r : results) {
@@ -98,7 +98,18 @@ std::string plot_svg(const std::vector<SweepResult>& results, const std::string&
       width, height, width, height);
   svg += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   add("<text x=\"%.0f\" y=\"28\" font-size=\"18\" font-weight=\"bold\">%s</text>\n", left, escape(title).c_str());
-  add("<text x=\"%.0f\" y=\"50\" font-size=\"12\" fill=\"#444\">%s</text>\n", left, escape(subtitle).c_str());
+  // The subtitle wraps once at a comma when it would run past the legend (~125 characters).
+  std::string line1 = subtitle, line2;
+  if (subtitle.size() > 125) {
+    const std::size_t cut = subtitle.rfind(", ", 125);
+    if (cut != std::string::npos) {
+      line1 = subtitle.substr(0, cut + 1);
+      line2 = subtitle.substr(cut + 2);
+    }
+  }
+  add("<text x=\"%.0f\" y=\"46\" font-size=\"12\" fill=\"#444\">%s</text>\n", left, escape(line1).c_str());
+  if (!line2.empty())
+    add("<text x=\"%.0f\" y=\"61\" font-size=\"12\" fill=\"#444\">%s</text>\n", left, escape(line2).c_str());
   // Grid and ticks.
   for (double t = x0; t <= x1 + xs * 0.5; t += xs) {
     add("<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", px(t), top, px(t), top + plot_h);
