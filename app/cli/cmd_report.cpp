@@ -63,6 +63,8 @@ std::string fmt(const char* f, double v) {
 }
 
 std::string psnr_text(double db) { return std::isfinite(db) ? fmt("%.1f", db) : "inf"; }
+// The CSV keeps more digits, so that --replot finds the same Pareto front.
+std::string psnr_csv(double db) { return std::isfinite(db) ? fmt("%.4f", db) : "inf"; }
 
 // Re-plots a report.csv (written by an earlier run) without measuring again.
 void replot(const ReportArgs& args) {
@@ -217,8 +219,8 @@ void run(const ReportArgs& args) {
             << ',' << o.exp2_alpha << ',' << fmt("%.6g", o.tau) << ',' << fmt("%.4f", r.median_ms) << ','
             << fmt("%.4f", r.p95_ms) << ',' << r.frame_ms.size() << ',' << fmt("%.0f", r.kv_pairs) << ','
             << (r.peak_memory_mb >= 0 ? fmt("%.1f", r.peak_memory_mb) : "") << ','
-            << psnr_text(r.vs_baseline.psnr_db) << ',' << fmt("%.3e", r.vs_baseline.max_abs) << ','
-            << fmt("%.3e", r.vs_baseline.fraction_over) << ',' << psnr_text(r.vs_reference.psnr_db) << ','
+            << psnr_csv(r.vs_baseline.psnr_db) << ',' << fmt("%.3e", r.vs_baseline.max_abs) << ','
+            << fmt("%.3e", r.vs_baseline.fraction_over) << ',' << psnr_csv(r.vs_reference.psnr_db) << ','
             << fmt("%.3e", r.vs_reference.max_abs) << ',' << fmt("%.3e", r.vs_reference.fraction_over) << ','
             << (r.vs_baseline.non_finite + r.vs_reference.non_finite) << ','
             << (std::find(front.begin(), front.end(), i) != front.end()) << '\n';
