@@ -20,11 +20,11 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
   frame.thread_tile_counts.resize(threads);
   const bool exact = options.uses_exact_tile_test();
   const int width = frame.camera.width, height = frame.camera.height, tiles_x = frame.camera.tiles_x;
-  std::uint64_t visible = 0;
+  std::uint64_t visible = 0, ellipse_missed = 0;
 
   // Static contiguous chunks: thread t owns Gaussians [t n / T, (t + 1) n / T), so the pair
   // lists, concatenated in thread order, are in Gaussian order whatever the timing.
-#pragma omp parallel num_threads(threads) reduction(+ : visible)
+#pragma omp parallel num_threads(threads) reduction(+ : visible, ellipse_missed)
   {
 #ifdef _OPENMP
     const int t = omp_get_thread_num();
@@ -53,18 +53,19 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
           counts[tile]++;
           any = true;
         }
-      if (any) visible++;
-      else frame.cull[i] = gm::kCulledOffscreen;  // box reached the image, the ellipse did not
+      if (any) {
+        visible++;
+      } else {  // the box reached the image, the ellipse did not
+        frame.cull[i] = gm::kCulledOffscreen;
+        ellipse_missed++;
+      }
     }
   }
   stats.visible = visible;
   std::uint64_t pairs = 0;
   for (int t = 0; t < threads; ++t) pairs += frame.thread_keys[t].size();
   stats.kv_pairs = pairs;
-  // Gaussians whose box met the image but no tile passed the exact test.
-  std::uint64_t ellipse_missed = 0;
-  for (std::int64_t i = 0; i < n; ++i) ellipse_missed += frame.cull[i] == gm::kCulledOffscreen;
-  stats.culled_offscreen = ellipse_missed;
+  stats.culled_offscreen += ellipse_missed;  // project counted the boxes that missed the image
 }
 
 }  // namespace cpu
