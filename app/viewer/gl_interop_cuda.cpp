@@ -87,35 +87,6 @@ class InteropPath final : public FramePath {
   int m_width = 0, m_height = 0;
 };
 
-// The CUDA backend through host memory (interop refused): render to a float image, upload.
-class CudaHostCopyPath final : public FramePath {
- public:
-  CudaHostCopyPath(std::unique_ptr<CudaRenderer> renderer, ImagePresenter* presenter, std::string device)
-      : m_renderer(std::move(renderer)), m_presenter(presenter), m_device(std::move(device)) {}
-  std::string name() const override { return "CUDA (" + m_device + ") + host copy, no interop"; }
-  void set_scene(std::shared_ptr<const Scene> scene) override { m_renderer->set_scene(std::move(scene)); }
-  void attach_texture(unsigned, int, int) override {}
-  void release_texture() override {}
-  void render_to_texture(const Camera& camera, const RenderOptions& options, FrameStats* stats) override {
-    m_renderer->render(camera, options, m_image, stats);
-    m_presenter->upload(m_image);
-  }
-  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
-    m_renderer->render(camera, options, out, stats);
-  }
-  void tile_counts(const FrameStats& stats, std::vector<std::uint32_t>& out) override {
-    if (!stats.tile_pair_counts.empty()) out = stats.tile_pair_counts;
-    else m_renderer->download_tile_counts(out);
-  }
-  const Image* last_image() const override { return &m_image; }
-
- private:
-  std::unique_ptr<CudaRenderer> m_renderer;
-  ImagePresenter* m_presenter;
-  std::string m_device;
-  Image m_image;
-};
-
 }  // namespace
 
 std::unique_ptr<FramePath> make_cuda_path(ImagePresenter* presenter, std::string* why) {
@@ -141,7 +112,9 @@ std::unique_ptr<FramePath> make_cuda_path(ImagePresenter* presenter, std::string
     cudaGetLastError();  // clear the (non-sticky) error so that later calls do not report it
     *why = e != cudaSuccess ? "CUDA-GL interop refused (" + cuda_error("cudaGLGetDevices", e) + ")"
                             : "CUDA-GL interop refused: the GL context is not on CUDA device " + std::to_string(device);
-    return std::make_unique<CudaHostCopyPath>(std::move(renderer), presenter, device_name);
+    // The same host path as the CPU backend's: the renderer fills the tile counts whenever
+    // the heat map asks for them (RenderOptions::collect_tile_counts).
+    return make_upload_path(std::move(renderer), presenter, "CUDA (" + device_name + ") + host copy, no interop");
   }
   return std::make_unique<InteropPath>(std::move(renderer), device_name);
 }
