@@ -38,7 +38,7 @@ __device__ __forceinline__ BlendGaussian load_gaussian(const BlendGaussian* g) {
   const float4 p = __ldg(src), q = __ldg(src + 1), s = __ldg(src + 2);
   r.mean_x = p.x, r.mean_y = p.y, r.w0 = p.z, r.w1 = p.w;
   r.w2 = q.x, r.w3 = q.y, r.opacity = q.z, r.red = q.w;
-  r.green = s.x, r.blue = s.y, r.reach_y = s.z, r.pad0 = 0.0f;
+  r.green = s.x, r.blue = s.y, r.reach_y = s.z, r.depth = s.w;
   return r;
 }
 
@@ -90,6 +90,14 @@ __global__ void __launch_bounds__(kTile * kTile) blend_per_pixel_kernel(BlendArg
 constexpr int kWarpsPerBlock = 4;
 constexpr int kLanePixelsX = 2;  // 8 lanes across x 2 pixels = the tile's 16 columns
 
+// 2^x by the hardware unit alone: x >= log2(1/255) here, so no denormal handling is needed
+// (exp2f adds a range check and two scalings around the same instruction).
+__device__ __forceinline__ float exp2_approx(float x) {
+  float y;
+  asm("ex2.approx.ftz.f32 %0, %1;" : "=f"(y) : "f"(x));
+  return y;
+}
+
 // FlashGS render kernel: a warp per strip of 4 x ROWS rows of a tile (ROWS = 4: a warp per
 // tile, each lane a 2x4 pixel block, as in FlashGS; ROWS = 1: four warps per tile, each lane
 // 2x1 pixels, four times the parallelism on the heavy tiles that set the kernel's length).
@@ -97,8 +105,12 @@ constexpr int kLanePixelsX = 2;  // 8 lanes across x 2 pixels = the tile's 16 co
 // opaque, with no block barrier. Lanes load 32 Gaussians at once (coalesced id reads,
 // independent attribute loads), stage them in shared memory and read them back as
 // broadcasts. PIPELINED issues the next batch's loads before blending the current one, so
-// their latency hides behind the current batch. EXP2: alpha = exp2(log2 o - q') from the
-// pre-scaled whitened rows, with the 1/255 cut made on the exponent before any exp2.
+// their latency hides behind the current batch.
+// EXP2 (the FlashGS arithmetic, the kernel is issue-bound): alpha = exp2(log2 o - q') from
+// the pre-scaled whitened rows, the 1/255 cut made on the exponent, FMAs throughout, and a
+// finished pixel folds the background in and sets T = 0, so later Gaussians add exactly
+// nothing to it and no per-pixel liveness test is needed. Otherwise the arithmetic is the
+// CPU's, operation for operation.
 template <int ROWS, bool PIPELINED, bool EXP2, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
   constexpr int kPixels = kLanePixelsX * ROWS;
@@ -118,68 +130,123 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   unsigned live = 0;  // bit p: pixel p still blending
 #pragma unroll
   for (int p = 0; p < kPixels; ++p) {
-    t[p] = 1.0f;
     cr[p] = cg[p] = cb[p] = 0.0f;
     const int x = x0 + p % kLanePixelsX, y = y0 + p / kLanePixelsX;
     if (x < a.width && y < a.height) live |= 1u << p;
+    t[p] = (!EXP2 || (live & (1u << p))) ? 1.0f : 0.0f;
   }
   const unsigned inside = live;
+  // The strip's pixel-centre rectangle, clipped to the image (for the EXP2 cull below).
+  const float strip_x0 = static_cast<float>(tx * kTile), strip_y0 = strip_mid_y - strip_half_h;
+  const float strip_x1 = fminf(strip_x0 + (kTile - 1), static_cast<float>(a.width - 1));
+  const float strip_y1 = fminf(strip_y0 + (4 * ROWS - 1), static_cast<float>(a.height - 1));
   const uint2 range = a.tile_ranges[tile];
   BlendGaussian next{};
   if (PIPELINED && range.x + lane < range.y) next = load_gaussian(a.gaussians + a.values[range.x + lane]);
   for (unsigned base = range.x; base < range.y; base += kWarp) {
+    if constexpr (EXP2) {
+      live = 0;
+#pragma unroll
+      for (int p = 0; p < kPixels; ++p) live |= t[p] > 0.0f ? 1u : 0u;
+    }
     if (!__any_sync(kFullMask, live)) break;
     if (!PIPELINED && base + lane < range.y) next = load_gaussian(a.gaussians + a.values[base + lane]);
     __syncwarp();
     batch[warp][lane] = next;
+    // EXP2: each lane tests its own Gaussian's alpha >= 1/255 ellipse against the strip (the
+    // exact ellipse-rectangle test, with a margin over the blend's rounding), so the loop
+    // below visits only the Gaussians that can change a pixel of this strip: 32 tests in
+    // parallel instead of a uniform test per Gaussian.
+    unsigned relevant = 0xffffffffu;
+    if constexpr (EXP2) {
+      bool meets = false;
+      const float cut = (next.opacity - kLog2AlphaMin) * 1.00001f + 1e-4f;  // q' of alpha = 1/255
+      if (base + lane < range.y && cut > 0.0f) {
+        const float w[4] = {next.w0, next.w1, next.w2, next.w3};
+        meets = gm::whitened_ellipse_meets_rect(w, cut, strip_x0 - next.mean_x, strip_x1 - next.mean_x,
+                                                strip_y0 - next.mean_y, strip_y1 - next.mean_y);
+      }
+      relevant = __ballot_sync(kFullMask, meets);
+    }
     __syncwarp();
     if (PIPELINED && base + kWarp + lane < range.y)
       next = load_gaussian(a.gaussians + a.values[base + kWarp + lane]);
     const unsigned n = min(static_cast<unsigned>(kWarp), range.y - base);
-    for (unsigned j = 0; j < n && live; ++j) {
-      const BlendGaussian& g = batch[warp][j];
-      // The whole strip lies beyond the rows this Gaussian can reach: a warp-uniform skip.
-      if (fabsf(strip_mid_y - g.mean_y) > g.reach_y + strip_half_h) continue;
-      // Per lane, the columns' and rows' parts of u and v, so a pixel costs two adds and a
-      // square-sum; in the exact mode this is the CPU's rounding, term for term.
-      float ux[kLanePixelsX], vx[kLanePixelsX], uy[ROWS], vy[ROWS];
+    if (n < kWarp) relevant &= (1u << n) - 1u;
+    for (unsigned m = relevant; m && (EXP2 || live); m &= m - 1) {
+      const BlendGaussian& g = batch[warp][__ffs(m) - 1];
+      if constexpr (EXP2) {
+        float dx[kLanePixelsX], uy[ROWS], vy[ROWS];
 #pragma unroll
-      for (int c = 0; c < kLanePixelsX; ++c) {
-        const float dx = static_cast<float>(x0 + c) - g.mean_x;
-        ux[c] = g.w0 * dx;
-        vx[c] = g.w2 * dx;
-      }
+        for (int c = 0; c < kLanePixelsX; ++c) dx[c] = static_cast<float>(x0 + c) - g.mean_x;
 #pragma unroll
-      for (int r = 0; r < ROWS; ++r) {
-        const float dy = static_cast<float>(y0 + r) - g.mean_y;
-        uy[r] = g.w1 * dy;
-        vy[r] = g.w3 * dy;
-      }
+        for (int r = 0; r < ROWS; ++r) {
+          const float dy = static_cast<float>(y0 + r) - g.mean_y;
+          uy[r] = g.w1 * dy;
+          vy[r] = g.w3 * dy;
+        }
 #pragma unroll
-      for (int p = 0; p < kPixels; ++p) {
-        if (!(live & (1u << p))) continue;
-        const int c = p % kLanePixelsX, r = p / kLanePixelsX;
-        const float u = ux[c] + uy[r], v = vx[c] + vy[r];
-        float alpha;
-        if constexpr (EXP2) {
-          const float e = g.opacity - __fmaf_rn(u, u, v * v);  // log2 o - q'
-          if (e < kLog2AlphaMin) continue;
-          alpha = fminf(gm::kAlphaMax, exp2f(e));
-        } else {
+        for (int p = 0; p < kPixels; ++p) {
+          const int c = p % kLanePixelsX, r = p / kLanePixelsX;
+          const float u = __fmaf_rn(g.w0, dx[c], uy[r]), v = __fmaf_rn(g.w2, dx[c], vy[r]);
+          const float e = __fmaf_rn(-u, u, __fmaf_rn(-v, v, g.opacity));  // log2 alpha
+          if (e >= kLog2AlphaMin) {
+            // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the
+            // FMA gives T (1 - alpha) with one rounding: with 1 - alpha exact (alpha >= 1/2),
+            // the CPU's T, so the stop rule's decisions on stacked opaque layers are its own.
+            const float alpha = fminf(gm::kAlphaMax, exp2_approx(e));
+            const float w = alpha * t[p];
+            const float next_t = __fmaf_rn(-alpha, t[p], t[p]);
+            if (next_t < gm::kTransmittanceMin) {  // finished (or already finished: t = 0, adds 0)
+              cr[p] = __fmaf_rn(t[p], a.background[0], cr[p]);
+              cg[p] = __fmaf_rn(t[p], a.background[1], cg[p]);
+              cb[p] = __fmaf_rn(t[p], a.background[2], cb[p]);
+              t[p] = 0.0f;
+            } else {
+              cr[p] = __fmaf_rn(g.red, w, cr[p]);
+              cg[p] = __fmaf_rn(g.green, w, cg[p]);
+              cb[p] = __fmaf_rn(g.blue, w, cb[p]);
+              t[p] = next_t;
+            }
+          }
+        }
+      } else {
+        // The whole strip lies beyond the rows this Gaussian can reach: a warp-uniform skip.
+        if (fabsf(strip_mid_y - g.mean_y) > g.reach_y + strip_half_h) continue;
+        // Per lane, the columns' and rows' parts of u and v, so a pixel costs two adds and a
+        // square-sum, rounded as the CPU rounds, term for term.
+        float ux[kLanePixelsX], vx[kLanePixelsX], uy[ROWS], vy[ROWS];
+#pragma unroll
+        for (int c = 0; c < kLanePixelsX; ++c) {
+          const float dx = static_cast<float>(x0 + c) - g.mean_x;
+          ux[c] = g.w0 * dx;
+          vx[c] = g.w2 * dx;
+        }
+#pragma unroll
+        for (int r = 0; r < ROWS; ++r) {
+          const float dy = static_cast<float>(y0 + r) - g.mean_y;
+          uy[r] = g.w1 * dy;
+          vy[r] = g.w3 * dy;
+        }
+#pragma unroll
+        for (int p = 0; p < kPixels; ++p) {
+          if (!(live & (1u << p))) continue;
+          const int c = p % kLanePixelsX, r = p / kLanePixelsX;
+          const float u = ux[c] + uy[r], v = vx[c] + vy[r];
           const float power = -0.5f * (u * u + v * v);
-          alpha = fminf(gm::kAlphaMax, g.opacity * expf(power));
+          const float alpha = fminf(gm::kAlphaMax, g.opacity * expf(power));
           if (alpha < gm::kAlphaMin) continue;
+          const float next_t = t[p] * (1.0f - alpha);
+          if (next_t < gm::kTransmittanceMin) {
+            live &= ~(1u << p);
+            continue;
+          }
+          const float w = alpha * t[p];
+          cr[p] += g.red * w;
+          cg[p] += g.green * w;
+          cb[p] += g.blue * w;
+          t[p] = next_t;
         }
-        const float next_t = t[p] * (1.0f - alpha);
-        if (next_t < gm::kTransmittanceMin) {
-          live &= ~(1u << p);
-          continue;
-        }
-        const float w = alpha * t[p];
-        cr[p] += g.red * w;
-        cg[p] += g.green * w;
-        cb[p] += g.blue * w;
-        t[p] = next_t;
       }
     }
   }

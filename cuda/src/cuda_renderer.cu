@@ -2,6 +2,7 @@
 #include <cuda_runtime.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -110,6 +111,29 @@ int bits_for(std::uint64_t values) {  // bits to hold 0 .. values - 1
   return bits;
 }
 
+std::uint32_t float_exponent(float v) {  // biased exponent field of a positive float
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, 4);
+  return bits >> 23;
+}
+
+// The 32-bit key format for a frame of `tiles` tiles whose visible depths lie in
+// (near plane, max_depth]: the exponents that range spans, then as many mantissa bits as fit.
+// Returns the 64-bit format (depth_bits 0) when the tiles leave too few bits for depth.
+cuda::KeyFormat compact_key_format(std::uint64_t tiles, double max_depth) {
+  cuda::KeyFormat k;
+  const int tile_bits = std::max(bits_for(tiles), 1);
+  const int depth_bits = 32 - tile_bits;
+  if (depth_bits < 8) return k;
+  const float far = static_cast<float>(std::min(std::max(max_depth, double{gm::kNearZ}), 1e30));
+  const std::uint32_t lo = float_exponent(gm::kNearZ), hi = float_exponent(far);
+  const int exponent_bits = bits_for(hi - lo + 1);
+  k.depth_bits = std::min(depth_bits, exponent_bits + 23);
+  k.mantissa_bits = std::max(0, std::min(23, k.depth_bits - exponent_bits));
+  k.exponent_base = lo;
+  return k;
+}
+
 class CudaRendererImpl final : public CudaRenderer {
  public:
   CudaRendererImpl() {
@@ -201,6 +225,7 @@ class CudaRendererImpl final : public CudaRenderer {
     device_scene_.scale_dc_r = scene_scale_.as<float4>();
     device_scene_.dc_gb = scene_dc_.as<float2>();
     device_scene_.sh_rest = scene_rest_.as<float4>();
+    compute_bounds(*scene);
     scene_ = std::move(scene);
     last_tiles_ = 0;
   }
@@ -231,12 +256,55 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &image_, &cub_temp_, &huge_footprints_, &huge_ids_};
+            &values_[1], &ranges_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
   }
   std::vector<DeviceBuffer*> scene_buffers() { return {&scene_pos_, &scene_rot_, &scene_scale_, &scene_dc_, &scene_rest_}; }
 
+  // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
+  // distance to its centre plus its radius.
+  void compute_bounds(const Scene& scene) {
+    const std::size_t n = scene.size();
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < n; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const double v = scene.positions[i * 3 + a];
+        lo[a] = i == 0 ? v : std::min(lo[a], v);
+        hi[a] = i == 0 ? v : std::max(hi[a], v);
+      }
+    double radius2 = 0;
+    for (int a = 0; a < 3; ++a) bounds_centre_[a] = 0.5 * (lo[a] + hi[a]);
+    for (std::size_t i = 0; i < n; ++i) {
+      double d2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double d = scene.positions[i * 3 + a] - bounds_centre_[a];
+        d2 += d * d;
+      }
+      radius2 = std::max(radius2, d2);
+    }
+    bounds_radius_ = std::sqrt(radius2);
+  }
+
+  double max_depth_from(const gm::CameraParams& cam) const {
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double d = cam.position[a] - bounds_centre_[a];
+      d2 += d * d;
+    }
+    return std::sqrt(d2) + bounds_radius_;
+  }
+
+  static cuda::DeferredList deferred_list(const DeviceBuffer& footprints, const DeviceBuffer& ids) {
+    cuda::DeferredList list;
+    list.footprints = footprints.as<gm::Footprint>();
+    list.ids = ids.as<std::uint32_t>();
+    list.capacity = static_cast<std::uint32_t>(
+        std::min(footprints.bytes() / sizeof(gm::Footprint), ids.bytes() / sizeof(std::uint32_t)));
+    return list;
+  }
+
   cuda::FrameBuffers frame_buffers() const {
     cuda::FrameBuffers b;
+    b.key_format = key_format_;
     b.blend = blend_.as<cuda::BlendGaussian>();
     b.footprints = footprints_.as<gm::Footprint>();
     b.pair_counts = pair_counts_.as<std::uint32_t>();
@@ -246,10 +314,8 @@ class CudaRendererImpl final : public CudaRenderer {
       b.values[k] = values_[k].as<std::uint32_t>();
     }
     b.pair_capacity = pair_capacity_;
-    b.huge_footprints = huge_footprints_.as<gm::Footprint>();
-    b.huge_ids = huge_ids_.as<std::uint32_t>();
-    b.huge_capacity = static_cast<std::uint32_t>(
-        std::min(huge_footprints_.bytes() / sizeof(gm::Footprint), huge_ids_.bytes() / sizeof(std::uint32_t)));
+    b.large = deferred_list(large_footprints_, large_ids_);
+    b.huge = deferred_list(huge_footprints_, huge_ids_);
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
     b.image_rgb = image_.as<float>();
@@ -296,13 +362,21 @@ class CudaRendererImpl final : public CudaRenderer {
     const std::size_t n = device_scene_.count;
     const bool baseline = options.is_baseline();
     const bool fused = !baseline && options.fused_emit;
+    // 3DGS sorts 64-bit keys over 32 + bits(tiles); flash packs tile and depth bin in 32 bits;
+    // with the switch off, all 64 bits are sorted, to show what the switch buys.
+    const bool compact_keys = !baseline && options.minimal_sort_bits;
+    key_format_ = compact_keys ? compact_key_format(tiles, max_depth_from(cam)) : cuda::KeyFormat{};
 
     ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     if (fused && !baseline && options.warp_cooperative_emit) {
-      const std::size_t cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 4096 + n / 64);
-      huge_footprints_.reserve(cap * sizeof(gm::Footprint), "huge-Gaussian footprints");
-      huge_ids_.reserve(cap * sizeof(std::uint32_t), "huge-Gaussian ids");
+      // Lists of deferred Gaussians; a frame with more emits the rest in the preprocess kernel.
+      const std::size_t large_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 8192 + n / 8);
+      large_footprints_.reserve(large_cap * sizeof(gm::Footprint), "large-Gaussian footprints");
+      large_ids_.reserve(large_cap * sizeof(std::uint32_t), "large-Gaussian ids");
+      const std::size_t huge_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 4096 + n / 64);
+      huge_footprints_.reserve(huge_cap * sizeof(gm::Footprint), "huge-Gaussian footprints");
+      huge_ids_.reserve(huge_cap * sizeof(std::uint32_t), "huge-Gaussian ids");
     }
     if (!fused) {
       footprints_.reserve(std::max<std::size_t>(n, 1) * sizeof(gm::Footprint), "per-Gaussian footprints");
@@ -351,13 +425,14 @@ class CudaRendererImpl final : public CudaRenderer {
     if (!fused) cuda::launch_duplicate(n, b, cam, args.exact_tile_test, stream_);
     check_cuda(cudaEventRecord(events_[kEmitted], stream_), "event record");
 
-    // 3DGS itself sorts 32 + bits(tiles); the flash switch turns that off to show its value.
     const int tile_bits = std::max(bits_for(tiles), 1);
-    const int end_bit = (baseline || options.minimal_sort_bits) ? std::min(64, 32 + tile_bits) : 64;
+    int end_bit = 64;
+    if (key_format_.depth_bits > 0) end_bit = tile_bits + key_format_.depth_bits;
+    else if (baseline || options.minimal_sort_bits) end_bit = std::min(64, 32 + tile_bits);
     check_cuda(cudaEventRecord(events_[kSortBegin], stream_), "event record");
     const int which = cuda::launch_sort(pairs, end_bit, b, stream_);
     check_cuda(cudaEventRecord(events_[kSorted], stream_), "event record");
-    cuda::launch_ranges(pairs, tiles, b.keys[which], b.values[which], b.tile_ranges, stream_);
+    cuda::launch_ranges(pairs, tiles, b, which, stream_);
     check_cuda(cudaEventRecord(events_[kRanged], stream_), "event record");
 
     cuda::BlendArgs blend{};
@@ -430,11 +505,14 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t pair_capacity_ = 0;
   std::size_t last_tiles_ = 0;
   int lane_rows_ = 1;
+  cuda::KeyFormat key_format_;           // this frame's
+  double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
+  double bounds_radius_ = 0;
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_;
   // Working memory.
   DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, image_,
-      cub_temp_, huge_footprints_, huge_ids_;
+      cub_temp_, large_footprints_, large_ids_, huge_footprints_, huge_ids_;
 };
 
 }  // namespace

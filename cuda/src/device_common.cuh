@@ -23,18 +23,26 @@ __device__ __forceinline__ unsigned warp_inclusive_sum(unsigned v) {
   return v;
 }
 
-// The 64-bit sort key: tile in the high word, the depth's float bits (positive, so they
-// order like the depths) in the low word.
-__device__ __forceinline__ std::uint64_t make_key(std::uint32_t tile, std::uint32_t depth_bits) {
-  return (static_cast<std::uint64_t>(tile) << 32) | depth_bits;
+// The depth part of a Gaussian's sort keys in format k (see KeyFormat): the float's bits
+// (positive floats order like their bit patterns), or its clamped bin.
+__device__ __forceinline__ std::uint32_t sort_depth(const KeyFormat& k, float depth) {
+  const std::uint32_t bits = __float_as_uint(depth);
+  if (k.depth_bits == 0) return bits;
+  const long long bin = static_cast<long long>(bits >> (23 - k.mantissa_bits)) -
+                        (static_cast<long long>(k.exponent_base) << k.mantissa_bits);
+  const long long last = (1ll << k.depth_bits) - 1;
+  return static_cast<std::uint32_t>(bin < 0 ? 0 : (bin > last ? last : bin));
 }
 
 // Stores one pair if it fits: an offset at or past the capacity writes nothing; the host
 // sees the wanted total in FrameCounters::pairs, grows the buffers and runs the frame again.
 __device__ __forceinline__ void store_pair(const FrameBuffers& b, unsigned long long offset, std::uint32_t tile,
-                                           std::uint32_t depth_bits, std::uint32_t gaussian) {
+                                           std::uint32_t depth, std::uint32_t gaussian) {
   if (offset < b.pair_capacity) {
-    b.keys[0][offset] = make_key(tile, depth_bits);
+    if (b.key_format.depth_bits > 0)
+      reinterpret_cast<std::uint32_t*>(b.keys[0])[offset] = (tile << b.key_format.depth_bits) | depth;
+    else
+      b.keys[0][offset] = (static_cast<std::uint64_t>(tile) << 32) | depth;
     b.values[0][offset] = gaussian;
   }
 }

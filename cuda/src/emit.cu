@@ -17,7 +17,7 @@ __global__ void __launch_bounds__(kBlock) duplicate_kernel(std::size_t gaussians
   const unsigned count = buf.pair_counts[i];
   if (count == 0) return;
   const gm::Footprint f = buf.footprints[i];
-  const std::uint32_t depth_bits = gm::depth_bits(f.depth);
+  const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
   unsigned long long offset = buf.pair_offsets[i] - count;
   const unsigned long long end = offset + count;
   for (int ty = f.tile_y0; ty < f.tile_y1 && offset < end; ++ty)

@@ -42,7 +42,20 @@ struct DeviceScene {
 struct alignas(16) BlendGaussian {
   float mean_x, mean_y, w0, w1;
   float w2, w3, opacity, red;
-  float green, blue, reach_y, pad0;  // reach_y: |dy| beyond which alpha < 1/255 for sure
+  float green, blue, reach_y, depth;  // reach_y: |dy| beyond which alpha < 1/255 for sure;
+                                       // depth: view-space z, for the ranges pass's tie order
+};
+
+// How a pair's sort key is packed. depth_bits == 0: 64 bits, tile << 32 | the depth's float
+// bits (3DGS). Otherwise 32 bits, tile << depth_bits | a depth bin: the float's exponent
+// (from exponent_base, the near plane's) and its top mantissa_bits, clamped to depth_bits.
+// Bins are monotonic in depth, so sorting them orders every pair but those of one tile
+// sharing a bin, which the ranges pass orders by exact depth: half the key bytes and two
+// fewer radix passes than the 64-bit key, with the same final order.
+struct KeyFormat {
+  int depth_bits = 0;
+  int mantissa_bits = 0;
+  std::uint32_t exponent_base = 0;
 };
 
 // Counters one frame accumulates on the device; copied to the host once per frame.
@@ -53,7 +66,16 @@ struct FrameCounters {
   unsigned int culled_offscreen;   // box or ellipse missed every tile
   unsigned int culled_low_opacity;
   unsigned int culled_degenerate;
+  unsigned int large;             // Gaussians deferred to the large-emission kernel
   unsigned int huge;              // Gaussians deferred to the huge-emission kernel
+};
+
+// Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
+// tile loops are spread over the whole GPU instead of holding the warp that met them.
+struct DeferredList {
+  gm::Footprint* footprints = nullptr;  // [capacity]
+  std::uint32_t* ids = nullptr;         // [capacity] Gaussian id
+  std::uint32_t capacity = 0;           // beyond it, the preprocess kernel emits them itself
 };
 
 // Buffers of the frame pipeline; every size is a high-water mark (grown, never shrunk).
@@ -63,11 +85,13 @@ struct FrameBuffers {
   gm::Footprint* footprints = nullptr;    // [gaussians] separate-emission path only
   std::uint32_t* pair_counts = nullptr;   // [gaussians] pairs per Gaussian (separate path)
   std::uint32_t* pair_offsets = nullptr;  // [gaussians] inclusive prefix sum of pair_counts
-  // Huge Gaussians deferred by the fused kernel (beyond the capacity they are emitted there).
-  gm::Footprint* huge_footprints = nullptr;  // [huge_capacity]
-  std::uint32_t* huge_ids = nullptr;         // [huge_capacity] Gaussian id
-  std::uint32_t huge_capacity = 0;
-  // Per pair: key = tile << 32 | depth bits, value = Gaussian id; two of each for the sort.
+  // Deferred by the fused kernel: boxes of more than kLargeBoxTiles (a warp per Gaussian) and
+  // of more than kHugeBoxTiles tiles (a block per Gaussian).
+  DeferredList large;
+  DeferredList huge;
+  // Per pair: key (see KeyFormat; 32-bit keys use the front half), value = Gaussian id; two of
+  // each for the sort.
+  KeyFormat key_format;
   std::uint64_t* keys[2] = {nullptr, nullptr};    // [pair_capacity]
   std::uint32_t* values[2] = {nullptr, nullptr};  // [pair_capacity]
   std::uint64_t pair_capacity = 0;
@@ -102,11 +126,13 @@ void launch_duplicate(std::size_t gaussians, const FrameBuffers& buffers, const 
 std::size_t cub_temp_bytes_needed(std::size_t gaussians, std::uint64_t pairs);
 // Inclusive scan pair_counts -> pair_offsets.
 void launch_scan(std::size_t gaussians, const FrameBuffers& buffers, cudaStream_t stream);
-// Radix sort of `pairs` keys over bits [0, end_bit); returns which buffer (0/1) holds the result.
+// Radix sort of `pairs` keys (in buffers.key_format) over bits [0, end_bit); returns which
+// buffer (0/1) holds the result.
 int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, cudaStream_t stream);
-// Tile ranges from the sorted keys, and the equal-key runs put in Gaussian-id order.
-void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const std::uint64_t* keys, std::uint32_t* values,
-                   uint2* tile_ranges, cudaStream_t stream);
+// Tile ranges from the sorted keys in buffer `which`, and runs of equal keys put in (depth,
+// Gaussian id) order.
+void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers& buffers, int which,
+                   cudaStream_t stream);
 
 enum class BlendKernel { per_pixel, warp_tile, warp_tile_pipelined };
 struct BlendArgs {

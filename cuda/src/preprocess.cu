@@ -2,6 +2,8 @@
 // the Gaussian-tile keys, all in one pass over the scene.
 #include <math.h>
 
+#include <cub/block/block_scan.cuh>
+
 #include "device_common.cuh"
 #include "flashgs/gaussian_math.h"
 #include "pipeline.h"
@@ -11,6 +13,9 @@ namespace cuda {
 namespace {
 
 constexpr int kBlock = 256;
+// Blocks of the deferred-emission kernels: enough to fill an H100 several times; the ones past
+// the frame's deferred count return at once.
+constexpr unsigned kDeferredEmitBlocks = 1024;
 constexpr float kLog2e = 1.4426950408889634f;
 
 // Higher SH bands of Gaussian i into registers: only the float4s that DEGREE needs are read,
@@ -55,6 +60,45 @@ __device__ __forceinline__ bool touches(const gm::Footprint& f, int tx, int ty, 
   return !exact || gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height);
 }
 
+// The pairs of one Gaussian's box, emitted by the whole warp (all lanes call with the same
+// footprint); returns how many were wanted.
+__device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g, std::uint32_t depth_bits,
+                                  unsigned id, const gm::CameraParams& cam, bool exact) {
+  const unsigned lane = lane_id();
+  const unsigned lanes_below = (1u << lane) - 1u;
+  const unsigned box_w = static_cast<unsigned>(g.tile_x1 - g.tile_x0);
+  const unsigned box = box_w * static_cast<unsigned>(g.tile_y1 - g.tile_y0);
+  unsigned total = 0;
+  for (unsigned s0 = 0; s0 < box; s0 += kWarp * kWarp) {
+    const unsigned chunks = min(static_cast<unsigned>(kWarp), (box - s0 + kWarp - 1) / kWarp);
+    unsigned my_ballot = 0;  // lane c: chunk c of this segment
+    for (unsigned c = 0; c < chunks; ++c) {
+      const unsigned t = s0 + c * kWarp + lane;
+      const bool pass = t < box && touches(g, g.tile_x0 + t % box_w, g.tile_y0 + t / box_w, cam, exact);
+      const unsigned ballot = __ballot_sync(kFullMask, pass);
+      if (lane == c) my_ballot = ballot;
+    }
+    const unsigned my_count = __popc(my_ballot);
+    const unsigned inclusive = warp_inclusive_sum(my_count);
+    const unsigned segment_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
+    if (segment_total == 0) continue;
+    unsigned long long base = 0;
+    if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
+    base = __shfl_sync(kFullMask, base, 0) + (inclusive - my_count);  // lane c: chunk c's offset
+    for (unsigned c = 0; c < chunks; ++c) {
+      const unsigned ballot = __shfl_sync(kFullMask, my_ballot, c);
+      const unsigned long long chunk_base = __shfl_sync(kFullMask, base, c);
+      if (ballot & (1u << lane)) {
+        const unsigned t = s0 + c * kWarp + lane;
+        store_pair(buf, chunk_base + __popc(ballot & lanes_below),
+                   (g.tile_y0 + t / box_w) * cam.tiles_x + g.tile_x0 + t % box_w, depth_bits, id);
+      }
+    }
+    total += segment_total;
+  }
+  return total;
+}
+
 // One thread per Gaussian. FUSED: keys are written here (FlashGS); otherwise the footprint
 // and the pair count are stored for the separate prefix sum + duplicate pass (3DGS).
 template <int DEGREE, bool FUSED>
@@ -73,8 +117,8 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   int reason = gm::kCulledDegenerate;
   unsigned count = 0;          // pairs of this Gaussian (small path / separate path)
   unsigned passed_mask = 0;    // tiles of a box of <= 32 tiles that passed the exact test
-  bool large = false;          // emitted by the whole warp below
-  bool huge = false;           // emitted by huge_emit_kernel (counted there too)
+  bool large = false;          // emitted by a whole warp (large_emit_kernel, or below)
+  bool deferred = false;       // emitted and counted by large_emit_kernel or huge_emit_kernel
   if (valid) {
     const float4 po = __ldg(scene.position_opacity + i);
     const float4 q = __ldg(scene.rotation + i);
@@ -106,16 +150,16 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
       const float conic_a = f.whiten[0] * f.whiten[0] + f.whiten[2] * f.whiten[2];
       float reach_y = q_cut > 0.0f ? sqrtf(q_cut * conic_a) / fabsf(det_w) + 0.01f : -1.0f;
       if (!(reach_y < 1e30f) && q_cut > 0.0f) reach_y = 1e30f;  // degenerate: never skip
-      out[2] = make_float4(rgb[1], rgb[2], reach_y, 0.0f);
+      out[2] = make_float4(rgb[1], rgb[2], reach_y, f.depth);
 
       const int box_w = f.tile_x1 - f.tile_x0;
       const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
       if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kHugeBoxTiles)) {
         const unsigned slot = atomicAdd(&buf.counters->huge, 1u);
-        if (slot < buf.huge_capacity) {
-          buf.huge_footprints[slot] = f;
-          buf.huge_ids[slot] = i;
-          huge = true;
+        if (slot < buf.huge.capacity) {
+          buf.huge.footprints[slot] = f;
+          buf.huge.ids[slot] = i;
+          deferred = true;
         } else {
           large = true;
         }
@@ -136,7 +180,7 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   }
 
   if constexpr (FUSED) {
-    const std::uint32_t depth_bits = gm::depth_bits(f.depth);
+    const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
     // Thread-emitted Gaussians: one atomic per warp reserves all their pairs.
     const unsigned inclusive = warp_inclusive_sum(count);
     const unsigned warp_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -160,32 +204,31 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
               store_pair(buf, offset++, static_cast<unsigned>(ty) * cam.tiles_x + tx, depth_bits, i);
       }
     }
-    // Large Gaussians: the warp tests 32 tiles at a time and writes the hits with ballot +
-    // popc offsets after one atomic per chunk (FlashGS section 4.3).
-    unsigned pending = __ballot_sync(kFullMask, large);
+    // Large Gaussians: the warp tests 32 tiles at a time (FlashGS section 4.3). Lane c keeps
+    // chunk c's ballot, so a segment of up to 32 chunks is reserved with one atomic and then
+    // written without testing again: a serial atomic per chunk made this loop latency-bound.
+    const unsigned large_ballot = __ballot_sync(kFullMask, large);
+    if (large_ballot) {  // to large_emit_kernel, one atomic per warp
+      const int leader = __ffs(large_ballot) - 1;
+      unsigned base = 0;
+      if (static_cast<int>(lane) == leader) base = atomicAdd(&buf.counters->large, __popc(large_ballot));
+      base = __shfl_sync(kFullMask, base, leader);
+      const unsigned slot = base + __popc(large_ballot & ((1u << lane) - 1u));
+      if (large && slot < buf.large.capacity) {
+        buf.large.footprints[slot] = f;
+        buf.large.ids[slot] = i;
+        large = false;
+        deferred = true;
+      }
+    }
+    unsigned pending = __ballot_sync(kFullMask, large);  // the list was full: emitted here
     while (pending) {
       const int src = __ffs(pending) - 1;
       pending &= pending - 1;
       const gm::Footprint g = shfl_footprint(f, src);
       const std::uint32_t g_depth = __shfl_sync(kFullMask, depth_bits, src);
       const unsigned g_id = __shfl_sync(kFullMask, i, src);
-      const unsigned box_w = static_cast<unsigned>(g.tile_x1 - g.tile_x0);
-      const unsigned box = box_w * static_cast<unsigned>(g.tile_y1 - g.tile_y0);
-      // One pass: each 32-tile chunk is tested, then reserved with one atomic for its hits.
-      const unsigned lanes_below = (1u << lane) - 1u;
-      unsigned total = 0;
-      for (unsigned t0 = 0; t0 < box; t0 += kWarp) {
-        const unsigned t = t0 + lane;
-        const unsigned tx = g.tile_x0 + t % box_w, ty = g.tile_y0 + t / box_w;
-        const bool pass = t < box && touches(g, tx, ty, cam, args.exact_tile_test);
-        const unsigned ballot = __ballot_sync(kFullMask, pass);
-        if (!ballot) continue;
-        unsigned long long chunk_base = 0;
-        if (lane == 0) chunk_base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(__popc(ballot)));
-        chunk_base = __shfl_sync(kFullMask, chunk_base, 0);
-        if (pass) store_pair(buf, chunk_base + __popc(ballot & lanes_below), ty * cam.tiles_x + tx, g_depth, g_id);
-        total += __popc(ballot);
-      }
+      const unsigned total = warp_emit_box(buf, g, g_depth, g_id, cam, args.exact_tile_test);
       if (static_cast<int>(lane) == src) count = total;
     }
   } else {
@@ -197,7 +240,7 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
     if (lane == 0 && warp_total > 0) atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(warp_total));
   }
 
-  if (valid && !huge) {
+  if (valid && !deferred) {
     int slot;
     if (reason == gm::kVisible) slot = count > 0 ? 0 : 2;  // box met the image, the ellipse did not
     else if (reason == gm::kCulledNear) slot = 1;
@@ -213,37 +256,87 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   }
 }
 
-// The deferred huge Gaussians: a block per Gaussian, each warp a 32-tile chunk at a time,
-// one atomic per chunk with hits; visibility is decided here from the block's total.
+// The deferred large Gaussians: a warp per Gaussian, spread over every warp of the grid.
+__global__ void __launch_bounds__(kBlock) large_emit_kernel(FrameBuffers buf, gm::CameraParams cam, bool exact) {
+  const unsigned count = min(buf.counters->large, buf.large.capacity);
+  constexpr unsigned kWarps = kBlock / kWarp;
+  const unsigned first = blockIdx.x * kWarps + threadIdx.x / kWarp;
+  unsigned visible = 0, offscreen = 0;
+  for (unsigned k = first; k < count; k += gridDim.x * kWarps) {
+    const gm::Footprint f = buf.large.footprints[k];
+    const unsigned total = warp_emit_box(buf, f, sort_depth(buf.key_format, f.depth), buf.large.ids[k], cam, exact);
+    if (total > 0) ++visible;
+    else ++offscreen;
+  }
+  if (lane_id() == 0) {
+    if (visible) atomicAdd(&buf.counters->visible, visible);
+    if (offscreen) atomicAdd(&buf.counters->culled_offscreen, offscreen);
+  }
+}
+
+// The deferred huge Gaussians: a block per Gaussian. Its warps test 32-tile chunks and keep
+// the ballots in shared memory; a block scan gives each chunk its offset, so a segment of up
+// to kSegmentChunks chunks costs one atomic. Visibility is decided from the block's total.
+constexpr int kSegmentChunks = 1024;                // 32768 tiles: a whole 4K frame in one
+constexpr int kChunksPerThread = kSegmentChunks / kBlock;
 __global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm::CameraParams cam, bool exact) {
-  __shared__ unsigned block_total;
-  const unsigned count = min(buf.counters->huge, buf.huge_capacity);
+  using BlockScan = cub::BlockScan<unsigned, kBlock>;
+  __shared__ typename BlockScan::TempStorage scan_storage;
+  __shared__ unsigned ballots[kSegmentChunks];
+  __shared__ unsigned chunk_offsets[kSegmentChunks];
+  __shared__ unsigned long long segment_base;
+  const unsigned count = min(buf.counters->huge, buf.huge.capacity);
   const unsigned lane = lane_id(), warp = threadIdx.x / kWarp;
+  constexpr unsigned kWarps = kBlock / kWarp;
   const unsigned lanes_below = (1u << lane) - 1u;
   for (unsigned h = blockIdx.x; h < count; h += gridDim.x) {
-    if (threadIdx.x == 0) block_total = 0;
-    __syncthreads();
-    const gm::Footprint f = buf.huge_footprints[h];
-    const unsigned id = buf.huge_ids[h];
-    const std::uint32_t depth_bits = gm::depth_bits(f.depth);
+    const gm::Footprint f = buf.huge.footprints[h];
+    const unsigned id = buf.huge.ids[h];
+    const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
     const unsigned box_w = static_cast<unsigned>(f.tile_x1 - f.tile_x0);
     const unsigned box = box_w * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
-    unsigned warp_total = 0;
-    for (unsigned t0 = warp * kWarp; t0 < box; t0 += kBlock) {
-      const unsigned t = t0 + lane;
-      const unsigned tx = f.tile_x0 + t % box_w, ty = f.tile_y0 + t / box_w;
-      const bool pass = t < box && touches(f, tx, ty, cam, exact);
-      const unsigned ballot = __ballot_sync(kFullMask, pass);
-      if (!ballot) continue;
-      unsigned long long base = 0;
-      if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(__popc(ballot)));
-      base = __shfl_sync(kFullMask, base, 0);
-      if (pass) store_pair(buf, base + __popc(ballot & lanes_below), ty * cam.tiles_x + tx, depth_bits, id);
-      warp_total += __popc(ballot);
+    unsigned gaussian_total = 0;
+    for (unsigned s0 = 0; s0 < box; s0 += kSegmentChunks * kWarp) {
+      const unsigned chunks = min(static_cast<unsigned>(kSegmentChunks), (box - s0 + kWarp - 1) / kWarp);
+      for (unsigned c = warp; c < chunks; c += kWarps) {
+        const unsigned t = s0 + c * kWarp + lane;
+        const bool pass = t < box && touches(f, f.tile_x0 + t % box_w, f.tile_y0 + t / box_w, cam, exact);
+        const unsigned ballot = __ballot_sync(kFullMask, pass);
+        if (lane == 0) ballots[c] = ballot;
+      }
+      __syncthreads();
+      unsigned counts[kChunksPerThread], sum = 0;
+#pragma unroll
+      for (int k = 0; k < kChunksPerThread; ++k) {
+        const unsigned c = threadIdx.x * kChunksPerThread + k;
+        counts[k] = c < chunks ? __popc(ballots[c]) : 0u;
+        sum += counts[k];
+      }
+      unsigned offset = 0, segment_total = 0;
+      BlockScan(scan_storage).ExclusiveSum(sum, offset, segment_total);
+#pragma unroll
+      for (int k = 0; k < kChunksPerThread; ++k) {
+        const unsigned c = threadIdx.x * kChunksPerThread + k;
+        if (c < chunks) chunk_offsets[c] = offset;
+        offset += counts[k];
+      }
+      if (threadIdx.x == 0 && segment_total > 0)
+        segment_base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
+      __syncthreads();
+      if (segment_total > 0) {
+        for (unsigned c = warp; c < chunks; c += kWarps) {
+          const unsigned ballot = ballots[c];
+          if (ballot & (1u << lane)) {
+            const unsigned t = s0 + c * kWarp + lane;
+            store_pair(buf, segment_base + chunk_offsets[c] + __popc(ballot & lanes_below),
+                       (f.tile_y0 + t / box_w) * cam.tiles_x + f.tile_x0 + t % box_w, depth_bits, id);
+          }
+        }
+      }
+      gaussian_total += segment_total;
+      __syncthreads();  // the shared arrays are reused by the next segment or Gaussian
     }
-    if (lane == 0 && warp_total) atomicAdd(&block_total, warp_total);
-    __syncthreads();
-    if (threadIdx.x == 0) atomicAdd(block_total > 0 ? &buf.counters->visible : &buf.counters->culled_offscreen, 1u);
+    if (threadIdx.x == 0) atomicAdd(gaussian_total > 0 ? &buf.counters->visible : &buf.counters->culled_offscreen, 1u);
   }
 }
 
@@ -266,8 +359,10 @@ void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, co
   if (scene.count == 0) return;
   if (fused) {
     launch_for_degree<true>(scene, buffers, args, stream);
-    if (args.warp_cooperative && buffers.huge_capacity > 0)
-      huge_emit_kernel<<<264, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test);
+    if (args.warp_cooperative && buffers.large.capacity > 0)
+      large_emit_kernel<<<kDeferredEmitBlocks, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test);
+    if (args.warp_cooperative && buffers.huge.capacity > 0)
+      huge_emit_kernel<<<kDeferredEmitBlocks, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test);
   } else {
     launch_for_degree<false>(scene, buffers, args, stream);
   }

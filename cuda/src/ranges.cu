@@ -1,5 +1,7 @@
-// Stage `ranges`: each tile's [start, end) in the sorted pairs, and runs of equal
-// (tile, depth) keys put in Gaussian-id order so the blend order is exactly the CPU's.
+// Stage `ranges`: each tile's [start, end) in the sorted pairs, and runs of equal keys put in
+// (depth, Gaussian id) order, so the blend order is exactly the CPU's whatever the key format:
+// equal 64-bit keys share their depth (the atomics of emission shuffled their ids), equal
+// compact keys share a quantised depth bin.
 #include "device_common.cuh"
 #include "pipeline.h"
 
@@ -9,24 +11,30 @@ namespace {
 
 constexpr int kBlock = 256;
 
-// Heap sort of a short array in place: a run of equal keys is normally 2 long, but a planar
-// scene seen head-on can give thousands, where insertion sort would be quadratic.
-__device__ void sort_run(std::uint32_t* v, unsigned n) {
+// The blend order of a pair: its Gaussian's exact depth bits, then its id.
+__device__ __forceinline__ std::uint64_t blend_order(const BlendGaussian* gaussians, std::uint32_t id) {
+  return (static_cast<std::uint64_t>(__float_as_uint(gaussians[id].depth)) << 32) | id;
+}
+
+// Sorts a run of ids in place by blend_order: insertion sort for the usual run of 2-3, heap
+// sort for the long runs of a planar scene seen head-on, where insertion would be quadratic.
+__device__ void sort_run(std::uint32_t* v, unsigned n, const BlendGaussian* gaussians) {
   if (n <= 16) {
     for (unsigned a = 1; a < n; ++a) {
       const std::uint32_t x = v[a];
+      const std::uint64_t key = blend_order(gaussians, x);
       unsigned b = a;
-      for (; b > 0 && v[b - 1] > x; --b) v[b] = v[b - 1];
+      for (; b > 0 && blend_order(gaussians, v[b - 1]) > key; --b) v[b] = v[b - 1];
       v[b] = x;
     }
     return;
   }
-  auto sift = [v](unsigned root, unsigned size) {
+  auto sift = [v, gaussians](unsigned root, unsigned size) {
     for (;;) {
       unsigned child = 2 * root + 1;
       if (child >= size) return;
-      if (child + 1 < size && v[child + 1] > v[child]) ++child;
-      if (v[root] >= v[child]) return;
+      if (child + 1 < size && blend_order(gaussians, v[child + 1]) > blend_order(gaussians, v[child])) ++child;
+      if (blend_order(gaussians, v[root]) >= blend_order(gaussians, v[child])) return;
       const std::uint32_t t = v[root];
       v[root] = v[child];
       v[child] = t;
@@ -42,32 +50,42 @@ __device__ void sort_run(std::uint32_t* v, unsigned n) {
   }
 }
 
-__global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, const std::uint64_t* __restrict__ keys,
-                                                        std::uint32_t* __restrict__ values, uint2* tile_ranges) {
+// KEY: std::uint64_t (tile << 32 | depth bits) or std::uint32_t (tile << depth_bits | bin).
+template <typename KEY>
+__global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, const KEY* __restrict__ keys,
+                                                        int tile_shift, std::uint32_t* __restrict__ values,
+                                                        const BlendGaussian* __restrict__ gaussians,
+                                                        uint2* tile_ranges) {
   const std::uint64_t i = static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x;
   if (i >= pairs) return;
-  const std::uint64_t key = keys[i];
-  const std::uint32_t tile = static_cast<std::uint32_t>(key >> 32);
-  const bool run_start = i == 0 || keys[i - 1] != key;
-  if (i == 0 || static_cast<std::uint32_t>(keys[i - 1] >> 32) != tile) tile_ranges[tile].x = static_cast<unsigned>(i);
-  if (i + 1 == pairs || static_cast<std::uint32_t>(keys[i + 1] >> 32) != tile)
+  const KEY key = keys[i];
+  const std::uint32_t tile = static_cast<std::uint32_t>(key >> tile_shift);
+  if (i == 0 || static_cast<std::uint32_t>(keys[i - 1] >> tile_shift) != tile)
+    tile_ranges[tile].x = static_cast<unsigned>(i);
+  if (i + 1 == pairs || static_cast<std::uint32_t>(keys[i + 1] >> tile_shift) != tile)
     tile_ranges[tile].y = static_cast<unsigned>(i + 1);
-  // Atomics made the emission order, hence the order of equal keys, vary from run to run.
+  const bool run_start = i == 0 || keys[i - 1] != key;
   if (run_start && i + 1 < pairs && keys[i + 1] == key) {
     std::uint64_t end = i + 2;
     while (end < pairs && keys[end] == key) ++end;
-    sort_run(values + i, static_cast<unsigned>(end - i));
+    sort_run(values + i, static_cast<unsigned>(end - i), gaussians);
   }
 }
 
 }  // namespace
 
-void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const std::uint64_t* keys, std::uint32_t* values,
-                   uint2* tile_ranges, cudaStream_t stream) {
-  check_cuda(cudaMemsetAsync(tile_ranges, 0, tiles * sizeof(uint2), stream), "tile range reset");
+void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers& b, int which,
+                   cudaStream_t stream) {
+  check_cuda(cudaMemsetAsync(b.tile_ranges, 0, tiles * sizeof(uint2), stream), "tile range reset");
   if (pairs == 0) return;
   const unsigned blocks = static_cast<unsigned>((pairs + kBlock - 1) / kBlock);
-  ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, keys, values, tile_ranges);
+  if (b.key_format.depth_bits > 0)
+    ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, reinterpret_cast<const std::uint32_t*>(b.keys[which]),
+                                                 b.key_format.depth_bits, b.values[which], b.blend,
+                                                 b.tile_ranges);
+  else
+    ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, b.keys[which], 32, b.values[which], b.blend,
+                                                 b.tile_ranges);
   check_cuda(cudaGetLastError(), "ranges kernel launch");
 }
 

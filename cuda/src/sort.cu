@@ -19,10 +19,15 @@ std::size_t cub_temp_bytes_needed(std::size_t gaussians, std::uint64_t pairs) {
                                            static_cast<std::uint32_t*>(nullptr), static_cast<int>(gaussians)),
              "cub scan size query");
   cub::DoubleBuffer<std::uint64_t> keys(nullptr, nullptr);
+  cub::DoubleBuffer<std::uint32_t> compact_keys(nullptr, nullptr);
   cub::DoubleBuffer<std::uint32_t> values(nullptr, nullptr);
   check_cuda(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, keys, values, static_cast<int>(pairs), 0, 64),
              "cub sort size query");
-  return std::max(scan_bytes, sort_bytes);
+  std::size_t compact_bytes = 0;
+  check_cuda(cub::DeviceRadixSort::SortPairs(nullptr, compact_bytes, compact_keys, values, static_cast<int>(pairs),
+                                             0, 32),
+             "cub sort size query");
+  return std::max({scan_bytes, sort_bytes, compact_bytes});
 }
 
 void launch_scan(std::size_t gaussians, const FrameBuffers& b, cudaStream_t stream) {
@@ -33,11 +38,11 @@ void launch_scan(std::size_t gaussians, const FrameBuffers& b, cudaStream_t stre
              "cub inclusive scan");
 }
 
-int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& b, cudaStream_t stream) {
-  if (pairs == 0) return 0;
-  if (pairs > static_cast<std::uint64_t>(INT_MAX))
-    throw Error("cuda renderer: " + std::to_string(pairs) + " Gaussian-tile pairs exceed the sort's limit");
-  cub::DoubleBuffer<std::uint64_t> keys(b.keys[0], b.keys[1]);
+namespace {
+
+template <typename KEY>
+int sort_pairs(std::uint64_t pairs, int end_bit, const FrameBuffers& b, cudaStream_t stream) {
+  cub::DoubleBuffer<KEY> keys(reinterpret_cast<KEY*>(b.keys[0]), reinterpret_cast<KEY*>(b.keys[1]));
   cub::DoubleBuffer<std::uint32_t> values(b.values[0], b.values[1]);
   std::size_t needed = 0;
   check_cuda(cub::DeviceRadixSort::SortPairs(nullptr, needed, keys, values, static_cast<int>(pairs), 0, end_bit),
@@ -48,6 +53,16 @@ int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& b, cudaStr
                                              stream),
              "cub radix sort");
   return keys.selector;
+}
+
+}  // namespace
+
+int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& b, cudaStream_t stream) {
+  if (pairs == 0) return 0;
+  if (pairs > static_cast<std::uint64_t>(INT_MAX))
+    throw Error("cuda renderer: " + std::to_string(pairs) + " Gaussian-tile pairs exceed the sort's limit");
+  if (b.key_format.depth_bits > 0) return sort_pairs<std::uint32_t>(pairs, end_bit, b, stream);
+  return sort_pairs<std::uint64_t>(pairs, end_bit, b, stream);
 }
 
 }  // namespace cuda

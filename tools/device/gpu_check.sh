@@ -54,7 +54,7 @@ tests() {
   log "gpu tests rc=${PIPESTATUS[0]}"
   if [ -x "$BIN/test_stress_gpu" ]; then
     log "stress gpu tests"
-    "$BIN/test_stress_gpu" 2>&1 | tee "$OUT/stress_gpu.log" | grep -E "^\[  (FAILED|PASSED) |Failure" | head -20
+    "$BIN/test_stress_gpu" 2>&1 | tee "$OUT/stress_gpu.log" | grep -E -A6 "^\[  (FAILED|PASSED) |Failure" | head -60
     log "stress gpu rc=${PIPESTATUS[0]}"
   fi
 }
@@ -81,11 +81,11 @@ bench_quick() {
   bench_scene "$SCENES/pc_biker" bench_biker_quick --backend cuda -r 1920x1080 --configs baseline,flash --warmup 2 --repeat 5
 }
 
-bench_rows() {  # warp-blend pixel rows per lane: 1, 2, 4
-  for rows in 1 2 4; do
+bench_rows() {  # warp-blend pixel rows per lane: ROWS (default 1 2 4)
+  for rows in ${ROWS:-1 2 4}; do
     log "bench rows=$rows"
     for scene in pc_biker pc_playbot; do
-      FLASHGS_BLEND_ROWS=$rows bench_scene "$SCENES/$scene" bench_rows${rows}_$scene --backend cuda \
+      FLASHGS_BLEND_ROWS=$rows bench_scene "$SCENES/$scene" ${TAG:-}bench_rows${rows}_$scene --backend cuda \
         -r 1920x1080,3840x2160 --configs flash --warmup 2 --repeat 5 | grep -E "^[0-9]+x"
     done
   done
@@ -106,11 +106,11 @@ bench_cpu() {
   bench_scene "$SCENES/pc_playbot" bench_playbot_cpu --backend cpu -r 1920x1080 --warmup 1 --repeat 3
 }
 
-profile() {
-  log "ncu"
-  timeout 240 ncu --set basic -k regex:'preprocess|blend|ranges|duplicate' --launch-skip 20 --launch-count 8 \
-    "$FLASHGS" render "$SCENES/pc_playbot/point_cloud.ply" --backend cuda -c 10 -r 3840x2160 --repeat 6 -o /tmp/p.ppm \
-    > "$OUT/ncu.txt" 2>&1
+profile() {  # PROFILE_SCENE (pc_playbot), PROFILE_RES (3840x2160)
+  log "ncu ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-3840x2160}"
+  timeout 240 ncu --set basic -k regex:'preprocess|emit|blend|ranges|duplicate|Onesweep' --launch-skip 20 \
+    --launch-count 12 "$FLASHGS" render "$SCENES/${PROFILE_SCENE:-pc_playbot}/point_cloud.ply" --backend cuda -c 10 \
+    -r "${PROFILE_RES:-3840x2160}" --repeat 6 -o /tmp/p.ppm > "$OUT/ncu.txt" 2>&1
   log "ncu rc=$?"
   grep -E "^  [a-z_].*\(|Duration|Memory Throughput|Compute \(SM\) Throughput|Registers Per|Achieved Occupancy" "$OUT/ncu.txt" | head -60
 }
@@ -128,6 +128,7 @@ for step in "$@"; do
     bench-quick) bench_quick ;;
     bench) bench ;;
     bench-rows) bench_rows ;;
+    bench-prev) (FLASHGS=$BIN/flashgs_prev TAG=prev_ bench_rows) ;;  # a carried earlier build, to compare
     bench-cpu) bench_cpu ;;
     profile) profile ;;
     *) echo "unknown step $step" ;;
@@ -135,5 +136,6 @@ for step in "$@"; do
 done
 log "done"
 # At most 8 files come back: everything but the summary goes into one archive.
-(cd "$OUT" && tar czf logs.tgz --exclude=logs.tgz --exclude=summary.txt --exclude='*.ppm' . 2>/dev/null &&
-  find . -maxdepth 1 -type f ! -name logs.tgz ! -name summary.txt -delete)
+# (written outside $OUT first: tar fails on an archive that grows inside the folder it reads)
+(cd "$OUT" && tar czf /tmp/flashgs_logs.tgz --exclude=summary.txt --exclude='*.ppm' . 2>/dev/null;
+  find . -maxdepth 1 -type f ! -name summary.txt -delete && mv /tmp/flashgs_logs.tgz logs.tgz)
