@@ -3,6 +3,8 @@
 // per tile, each lane owning a 2x4 pixel block, batches prefetched one ahead).
 #include <math.h>
 
+#include <type_traits>
+
 #include "device_common.cuh"
 #include "flashgs/gaussian_math.h"
 #include "pipeline.h"
@@ -98,6 +100,14 @@ __device__ __forceinline__ float exp2_approx(float x) {
   return y;
 }
 
+// A Gaussian as the EXP2 loop reads it from shared memory: u and v at the strip's first pixel
+// (computed once by the lane that loaded it), so a lane's pixel costs one FMA for each.
+struct alignas(16) StripGaussian {
+  float u0, v0, w0, w1;
+  float w2, w3, log2_opacity, red;
+  float green, blue, pad0, pad1;
+};
+
 // FlashGS render kernel: a warp per strip of 4 x ROWS rows of a tile (ROWS = 4: a warp per
 // tile, each lane a 2x4 pixel block, as in FlashGS; ROWS = 1: four warps per tile, each lane
 // 2x1 pixels, four times the parallelism on the heavy tiles that set the kernel's length).
@@ -115,7 +125,8 @@ template <int ROWS, bool PIPELINED, bool EXP2, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
   constexpr int kPixels = kLanePixelsX * ROWS;
   constexpr unsigned kStripsPerTile = 4 / ROWS;
-  __shared__ BlendGaussian batch[kWarpsPerBlock][kWarp];
+  using Staged = std::conditional_t<EXP2, StripGaussian, BlendGaussian>;
+  __shared__ Staged batch[kWarpsPerBlock][kWarp];
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   const unsigned strip = blockIdx.x * kWarpsPerBlock + warp;
   const unsigned tile = strip / kStripsPerTile;
@@ -140,6 +151,11 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const float strip_x0 = static_cast<float>(tx * kTile), strip_y0 = strip_mid_y - strip_half_h;
   const float strip_x1 = fminf(strip_x0 + (kTile - 1), static_cast<float>(a.width - 1));
   const float strip_y1 = fminf(strip_y0 + (4 * ROWS - 1), static_cast<float>(a.height - 1));
+  float lane_x[kLanePixelsX], lane_y[ROWS];  // this lane's pixels relative to the strip's first
+#pragma unroll
+  for (int c = 0; c < kLanePixelsX; ++c) lane_x[c] = static_cast<float>(x0 + c) - strip_x0;
+#pragma unroll
+  for (int r = 0; r < ROWS; ++r) lane_y[r] = static_cast<float>(y0 + r) - strip_y0;
   const uint2 range = a.tile_ranges[tile];
   BlendGaussian next{};
   if (PIPELINED && range.x + lane < range.y) next = load_gaussian(a.gaussians + a.values[range.x + lane]);
@@ -152,7 +168,14 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     if (!__any_sync(kFullMask, live)) break;
     if (!PIPELINED && base + lane < range.y) next = load_gaussian(a.gaussians + a.values[base + lane]);
     __syncwarp();
-    batch[warp][lane] = next;
+    if constexpr (EXP2) {
+      const float ox = next.mean_x - strip_x0, oy = next.mean_y - strip_y0;
+      batch[warp][lane] = StripGaussian{-__fmaf_rn(next.w0, ox, next.w1 * oy), -__fmaf_rn(next.w2, ox, next.w3 * oy),
+                                        next.w0, next.w1, next.w2, next.w3, next.opacity, next.red, next.green,
+                                        next.blue, 0.0f, 0.0f};
+    } else {
+      batch[warp][lane] = next;
+    }
     // EXP2: each lane tests its own Gaussian's alpha >= 1/255 ellipse against the strip (the
     // exact ellipse-rectangle test, with a margin over the blend's rounding), so the loop
     // below visits only the Gaussians that can change a pixel of this strip: 32 tests in
@@ -174,22 +197,19 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     const unsigned n = min(static_cast<unsigned>(kWarp), range.y - base);
     if (n < kWarp) relevant &= (1u << n) - 1u;
     for (unsigned m = relevant; m && (EXP2 || live); m &= m - 1) {
-      const BlendGaussian& g = batch[warp][__ffs(m) - 1];
+      const Staged& g = batch[warp][__ffs(m) - 1];
       if constexpr (EXP2) {
-        float dx[kLanePixelsX], uy[ROWS], vy[ROWS];
-#pragma unroll
-        for (int c = 0; c < kLanePixelsX; ++c) dx[c] = static_cast<float>(x0 + c) - g.mean_x;
+        float uy[ROWS], vy[ROWS];
 #pragma unroll
         for (int r = 0; r < ROWS; ++r) {
-          const float dy = static_cast<float>(y0 + r) - g.mean_y;
-          uy[r] = g.w1 * dy;
-          vy[r] = g.w3 * dy;
+          uy[r] = __fmaf_rn(g.w1, lane_y[r], g.u0);
+          vy[r] = __fmaf_rn(g.w3, lane_y[r], g.v0);
         }
 #pragma unroll
         for (int p = 0; p < kPixels; ++p) {
           const int c = p % kLanePixelsX, r = p / kLanePixelsX;
-          const float u = __fmaf_rn(g.w0, dx[c], uy[r]), v = __fmaf_rn(g.w2, dx[c], vy[r]);
-          const float e = __fmaf_rn(-u, u, __fmaf_rn(-v, v, g.opacity));  // log2 alpha
+          const float u = __fmaf_rn(g.w0, lane_x[c], uy[r]), v = __fmaf_rn(g.w2, lane_x[c], vy[r]);
+          const float e = __fmaf_rn(-u, u, __fmaf_rn(-v, v, g.log2_opacity));  // log2 alpha
           if (e >= kLog2AlphaMin) {
             // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the
             // FMA gives T (1 - alpha) with one rounding: with 1 - alpha exact (alpha >= 1/2),
