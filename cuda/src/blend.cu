@@ -1,6 +1,6 @@
 // Stage `blend`: front-to-back compositing of each tile's depth-sorted Gaussians, either the
-// 3DGS way (a thread per pixel, 256-Gaussian shared-memory batches) or the FlashGS way (a warp
-// per tile, each lane owning a 2x4 pixel block, batches prefetched one ahead).
+// 3DGS way (a thread per pixel, 256-Gaussian shared-memory batches) or the FlashGS way (warps
+// walking a tile's list with 32-Gaussian batches prefetched one ahead).
 #include <math.h>
 
 #include <type_traits>
@@ -90,7 +90,8 @@ __global__ void __launch_bounds__(kTile * kTile) blend_per_pixel_kernel(BlendArg
 }
 
 constexpr int kWarpsPerBlock = 4;
-constexpr int kLanePixelsX = 2;  // 8 lanes across x 2 pixels = the tile's 16 columns
+constexpr int kLanePixelsX = 2;      // pixels per lane, side by side in a row
+constexpr int kRegionsPerTile = 4;   // 64-pixel regions, a warp each
 
 // 2^x by the hardware unit alone: x >= log2(1/255) here, so no denormal handling is needed
 // (exp2f adds a range check and two scalings around the same instruction).
@@ -100,62 +101,63 @@ __device__ __forceinline__ float exp2_approx(float x) {
   return y;
 }
 
-// A Gaussian as the EXP2 loop reads it from shared memory: u and v at the strip's first pixel
-// (computed once by the lane that loaded it), so a lane's pixel costs one FMA for each.
-struct alignas(16) StripGaussian {
+// A Gaussian as the EXP2 loop reads it from shared memory: u and v at the region's first
+// pixel (computed once by the lane that loaded it), so a lane's pixel costs one FMA for each.
+struct alignas(16) RegionGaussian {
   float u0, v0, w0, w1;
   float w2, w3, log2_opacity, red;
   float green, blue, pad0, pad1;
 };
 
-// FlashGS render kernel: a warp per strip of 4 x ROWS rows of a tile (ROWS = 4: a warp per
-// tile, each lane a 2x4 pixel block, as in FlashGS; ROWS = 1: four warps per tile, each lane
-// 2x1 pixels, four times the parallelism on the heavy tiles that set the kernel's length).
-// Each warp walks its tile's list on its own, so it stops as soon as its own pixels are
-// opaque, with no block barrier. Lanes load 32 Gaussians at once (coalesced id reads,
-// independent attribute loads), stage them in shared memory and read them back as
-// broadcasts. PIPELINED issues the next batch's loads before blending the current one, so
-// their latency hides behind the current batch.
-// EXP2 (the FlashGS arithmetic, the kernel is issue-bound): alpha = exp2(log2 o - q') from
-// the pre-scaled whitened rows, the 1/255 cut made on the exponent, FMAs throughout, and a
-// finished pixel folds the background in and sets T = 0, so later Gaussians add exactly
-// nothing to it and no per-pixel liveness test is needed. Otherwise the arithmetic is the
-// CPU's, operation for operation.
-template <int ROWS, bool PIPELINED, bool EXP2, bool SURFACE>
+// FlashGS render kernel, a warp per 64-pixel region of a tile: REGION_W x (64 / REGION_W)
+// pixels (16 x 4 strips or 8 x 8 quadrants, four warps per tile), each lane a pair of pixels
+// in a row. Four warps per tile rather than FlashGS's one: the heaviest tiles (thousands of
+// pairs) set the kernel's length, and a warp walks its list serially. Each warp walks its
+// tile's list on its own, so it stops as soon as its own pixels are opaque, with no block
+// barrier. Lanes load 32 Gaussians at once (coalesced id reads, independent attribute loads),
+// stage them in shared memory and read them back as broadcasts. PIPELINED issues the next
+// batch's loads before blending the current one, so their latency hides behind it.
+// EXP2 (the FlashGS arithmetic; the kernel is issue-bound): each lane first tests the
+// Gaussian it loaded against the region (exact ellipse-rectangle test of the alpha >= 1/255
+// ellipse, with a margin over the blend's rounding), so the loop visits only Gaussians that
+// can change one of the region's pixels; alpha = exp2(log2 o - q') from the pre-scaled
+// whitened rows, the 1/255 cut made on the exponent, FMAs throughout; a finished pixel folds
+// the background in and sets T = 0, so later Gaussians add exactly nothing to it and no
+// per-pixel liveness test is needed. Otherwise the arithmetic is the CPU's, term for term.
+template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
-  constexpr int kPixels = kLanePixelsX * ROWS;
-  constexpr unsigned kStripsPerTile = 4 / ROWS;
-  using Staged = std::conditional_t<EXP2, StripGaussian, BlendGaussian>;
+  constexpr int kRegionH = 64 / REGION_W;
+  constexpr int kLanesX = REGION_W / kLanePixelsX;
+  constexpr int kRegionsX = kTile / REGION_W;
+  using Staged = std::conditional_t<EXP2, RegionGaussian, BlendGaussian>;
   __shared__ Staged batch[kWarpsPerBlock][kWarp];
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
-  const unsigned strip = blockIdx.x * kWarpsPerBlock + warp;
-  const unsigned tile = strip / kStripsPerTile;
+  const unsigned region = blockIdx.x * kWarpsPerBlock + warp;
+  const unsigned tile = region / kRegionsPerTile;
   if (tile >= static_cast<unsigned>(a.tiles_x) * static_cast<unsigned>(a.tiles_y)) return;  // whole warp
   const int tx = static_cast<int>(tile % a.tiles_x), ty = static_cast<int>(tile / a.tiles_x);
-  const int x0 = tx * kTile + static_cast<int>(lane % 8) * kLanePixelsX;
-  const int y0 = ty * kTile + static_cast<int>(strip % kStripsPerTile) * 4 * ROWS + static_cast<int>(lane / 8) * ROWS;
-  const float strip_half_h = 0.5f * (4 * ROWS - 1);
-  const float strip_mid_y =
-      static_cast<float>(ty * kTile + static_cast<int>(strip % kStripsPerTile) * 4 * ROWS) + strip_half_h;
-  float t[kPixels], cr[kPixels], cg[kPixels], cb[kPixels];
+  const int region_in_tile = static_cast<int>(region % kRegionsPerTile);
+  // The region's pixel-centre rectangle, clipped to the image, and this lane's pixels.
+  const float region_x0 = static_cast<float>(tx * kTile + (region_in_tile % kRegionsX) * REGION_W);
+  const float region_y0 = static_cast<float>(ty * kTile + (region_in_tile / kRegionsX) * kRegionH);
+  const float region_x1 = fminf(region_x0 + (REGION_W - 1), static_cast<float>(a.width - 1));
+  const float region_y1 = fminf(region_y0 + (kRegionH - 1), static_cast<float>(a.height - 1));
+  const float region_mid_y = region_y0 + 0.5f * (kRegionH - 1), region_half_h = 0.5f * (kRegionH - 1);
+  const int x0 = static_cast<int>(region_x0) + static_cast<int>(lane % kLanesX) * kLanePixelsX;
+  const int y = static_cast<int>(region_y0) + static_cast<int>(lane / kLanesX);
+  float lane_x[kLanePixelsX];  // relative to the region's first pixel
+#pragma unroll
+  for (int c = 0; c < kLanePixelsX; ++c) lane_x[c] = static_cast<float>(x0 + c) - region_x0;
+  const float lane_y = static_cast<float>(y) - region_y0;
+  float t[kLanePixelsX], cr[kLanePixelsX], cg[kLanePixelsX], cb[kLanePixelsX];
   unsigned live = 0;  // bit p: pixel p still blending
 #pragma unroll
-  for (int p = 0; p < kPixels; ++p) {
+  for (int p = 0; p < kLanePixelsX; ++p) {
     cr[p] = cg[p] = cb[p] = 0.0f;
-    const int x = x0 + p % kLanePixelsX, y = y0 + p / kLanePixelsX;
-    if (x < a.width && y < a.height) live |= 1u << p;
+    if (x0 + p < a.width && y < a.height) live |= 1u << p;
     t[p] = (!EXP2 || (live & (1u << p))) ? 1.0f : 0.0f;
   }
   const unsigned inside = live;
-  // The strip's pixel-centre rectangle, clipped to the image (for the EXP2 cull below).
-  const float strip_x0 = static_cast<float>(tx * kTile), strip_y0 = strip_mid_y - strip_half_h;
-  const float strip_x1 = fminf(strip_x0 + (kTile - 1), static_cast<float>(a.width - 1));
-  const float strip_y1 = fminf(strip_y0 + (4 * ROWS - 1), static_cast<float>(a.height - 1));
-  float lane_x[kLanePixelsX], lane_y[ROWS];  // this lane's pixels relative to the strip's first
-#pragma unroll
-  for (int c = 0; c < kLanePixelsX; ++c) lane_x[c] = static_cast<float>(x0 + c) - strip_x0;
-#pragma unroll
-  for (int r = 0; r < ROWS; ++r) lane_y[r] = static_cast<float>(y0 + r) - strip_y0;
   const uint2 range = a.tile_ranges[tile];
   BlendGaussian next{};
   if (PIPELINED && range.x + lane < range.y) next = load_gaussian(a.gaussians + a.values[range.x + lane]);
@@ -163,33 +165,27 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     if constexpr (EXP2) {
       live = 0;
 #pragma unroll
-      for (int p = 0; p < kPixels; ++p) live |= t[p] > 0.0f ? 1u : 0u;
+      for (int p = 0; p < kLanePixelsX; ++p) live |= t[p] > 0.0f ? 1u : 0u;
     }
     if (!__any_sync(kFullMask, live)) break;
     if (!PIPELINED && base + lane < range.y) next = load_gaussian(a.gaussians + a.values[base + lane]);
     __syncwarp();
-    if constexpr (EXP2) {
-      const float ox = next.mean_x - strip_x0, oy = next.mean_y - strip_y0;
-      batch[warp][lane] = StripGaussian{-__fmaf_rn(next.w0, ox, next.w1 * oy), -__fmaf_rn(next.w2, ox, next.w3 * oy),
-                                        next.w0, next.w1, next.w2, next.w3, next.opacity, next.red, next.green,
-                                        next.blue, 0.0f, 0.0f};
-    } else {
-      batch[warp][lane] = next;
-    }
-    // EXP2: each lane tests its own Gaussian's alpha >= 1/255 ellipse against the strip (the
-    // exact ellipse-rectangle test, with a margin over the blend's rounding), so the loop
-    // below visits only the Gaussians that can change a pixel of this strip: 32 tests in
-    // parallel instead of a uniform test per Gaussian.
     unsigned relevant = 0xffffffffu;
     if constexpr (EXP2) {
+      const float ox = next.mean_x - region_x0, oy = next.mean_y - region_y0;
+      batch[warp][lane] = RegionGaussian{-__fmaf_rn(next.w0, ox, next.w1 * oy), -__fmaf_rn(next.w2, ox, next.w3 * oy),
+                                         next.w0, next.w1, next.w2, next.w3, next.opacity, next.red, next.green,
+                                         next.blue, 0.0f, 0.0f};
       bool meets = false;
       const float cut = (next.opacity - kLog2AlphaMin) * 1.00001f + 1e-4f;  // q' of alpha = 1/255
       if (base + lane < range.y && cut > 0.0f) {
         const float w[4] = {next.w0, next.w1, next.w2, next.w3};
-        meets = gm::whitened_ellipse_meets_rect(w, cut, strip_x0 - next.mean_x, strip_x1 - next.mean_x,
-                                                strip_y0 - next.mean_y, strip_y1 - next.mean_y);
+        meets = gm::whitened_ellipse_meets_rect(w, cut, region_x0 - next.mean_x, region_x1 - next.mean_x,
+                                                region_y0 - next.mean_y, region_y1 - next.mean_y);
       }
       relevant = __ballot_sync(kFullMask, meets);
+    } else {
+      batch[warp][lane] = next;
     }
     __syncwarp();
     if (PIPELINED && base + kWarp + lane < range.y)
@@ -199,16 +195,10 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     for (unsigned m = relevant; m && (EXP2 || live); m &= m - 1) {
       const Staged& g = batch[warp][__ffs(m) - 1];
       if constexpr (EXP2) {
-        float uy[ROWS], vy[ROWS];
+        const float uy = __fmaf_rn(g.w1, lane_y, g.u0), vy = __fmaf_rn(g.w3, lane_y, g.v0);
 #pragma unroll
-        for (int r = 0; r < ROWS; ++r) {
-          uy[r] = __fmaf_rn(g.w1, lane_y[r], g.u0);
-          vy[r] = __fmaf_rn(g.w3, lane_y[r], g.v0);
-        }
-#pragma unroll
-        for (int p = 0; p < kPixels; ++p) {
-          const int c = p % kLanePixelsX, r = p / kLanePixelsX;
-          const float u = __fmaf_rn(g.w0, lane_x[c], uy[r]), v = __fmaf_rn(g.w2, lane_x[c], vy[r]);
+        for (int p = 0; p < kLanePixelsX; ++p) {
+          const float u = __fmaf_rn(g.w0, lane_x[p], uy), v = __fmaf_rn(g.w2, lane_x[p], vy);
           const float e = __fmaf_rn(-u, u, __fmaf_rn(-v, v, g.log2_opacity));  // log2 alpha
           if (e >= kLog2AlphaMin) {
             // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the
@@ -231,28 +221,15 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
           }
         }
       } else {
-        // The whole strip lies beyond the rows this Gaussian can reach: a warp-uniform skip.
-        if (fabsf(strip_mid_y - g.mean_y) > g.reach_y + strip_half_h) continue;
-        // Per lane, the columns' and rows' parts of u and v, so a pixel costs two adds and a
-        // square-sum, rounded as the CPU rounds, term for term.
-        float ux[kLanePixelsX], vx[kLanePixelsX], uy[ROWS], vy[ROWS];
+        // The whole region lies beyond the rows this Gaussian can reach: a warp-uniform skip.
+        if (fabsf(region_mid_y - g.mean_y) > g.reach_y + region_half_h) continue;
+        const float dy = static_cast<float>(y) - g.mean_y;
+        const float uy = g.w1 * dy, vy = g.w3 * dy;
 #pragma unroll
-        for (int c = 0; c < kLanePixelsX; ++c) {
-          const float dx = static_cast<float>(x0 + c) - g.mean_x;
-          ux[c] = g.w0 * dx;
-          vx[c] = g.w2 * dx;
-        }
-#pragma unroll
-        for (int r = 0; r < ROWS; ++r) {
-          const float dy = static_cast<float>(y0 + r) - g.mean_y;
-          uy[r] = g.w1 * dy;
-          vy[r] = g.w3 * dy;
-        }
-#pragma unroll
-        for (int p = 0; p < kPixels; ++p) {
+        for (int p = 0; p < kLanePixelsX; ++p) {
           if (!(live & (1u << p))) continue;
-          const int c = p % kLanePixelsX, r = p / kLanePixelsX;
-          const float u = ux[c] + uy[r], v = vx[c] + vy[r];
+          const float dx = static_cast<float>(x0 + p) - g.mean_x;
+          const float u = g.w0 * dx + uy, v = g.w2 * dx + vy;
           const float power = -0.5f * (u * u + v * v);
           const float alpha = fminf(gm::kAlphaMax, g.opacity * expf(power));
           if (alpha < gm::kAlphaMin) continue;
@@ -271,22 +248,22 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     }
   }
 #pragma unroll
-  for (int p = 0; p < kPixels; ++p)
+  for (int p = 0; p < kLanePixelsX; ++p)
     if (inside & (1u << p))
-      write_pixel<SURFACE>(a, x0 + p % kLanePixelsX, y0 + p / kLanePixelsX, cr[p] + t[p] * a.background[0],
-                           cg[p] + t[p] * a.background[1], cb[p] + t[p] * a.background[2]);
+      write_pixel<SURFACE>(a, x0 + p, y, cr[p] + t[p] * a.background[0], cg[p] + t[p] * a.background[1],
+                           cb[p] + t[p] * a.background[2]);
 }
 
-template <int ROWS, bool SURFACE>
+template <int REGION_W, bool SURFACE>
 void launch_warp_tile(const BlendArgs& a, unsigned tiles, cudaStream_t stream) {
-  const unsigned strips = tiles * (4 / ROWS);
-  const unsigned blocks = (strips + kWarpsPerBlock - 1) / kWarpsPerBlock;
+  const unsigned regions = tiles * kRegionsPerTile;
+  const unsigned blocks = (regions + kWarpsPerBlock - 1) / kWarpsPerBlock;
   const unsigned threads = kWarpsPerBlock * kWarp;
   const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
-  if (pipelined && a.exp2_alpha) blend_warp_tile_kernel<ROWS, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (pipelined) blend_warp_tile_kernel<ROWS, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (a.exp2_alpha) blend_warp_tile_kernel<ROWS, false, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else blend_warp_tile_kernel<ROWS, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  if (pipelined && a.exp2_alpha) blend_warp_tile_kernel<REGION_W, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else if (pipelined) blend_warp_tile_kernel<REGION_W, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else if (a.exp2_alpha) blend_warp_tile_kernel<REGION_W, false, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else blend_warp_tile_kernel<REGION_W, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
 }
 
 template <bool SURFACE>
@@ -296,11 +273,8 @@ void launch_for_output(const BlendArgs& a, cudaStream_t stream) {
     blend_per_pixel_kernel<SURFACE><<<tiles, kTile * kTile, 0, stream>>>(a);
     return;
   }
-  switch (a.lane_rows) {
-    case 4: launch_warp_tile<4, SURFACE>(a, tiles, stream); break;
-    case 2: launch_warp_tile<2, SURFACE>(a, tiles, stream); break;
-    default: launch_warp_tile<1, SURFACE>(a, tiles, stream); break;
-  }
+  if (a.region_width == 16) launch_warp_tile<16, SURFACE>(a, tiles, stream);
+  else launch_warp_tile<8, SURFACE>(a, tiles, stream);
 }
 
 }  // namespace

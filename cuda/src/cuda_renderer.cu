@@ -118,15 +118,17 @@ std::uint32_t float_exponent(float v) {  // biased exponent field of a positive 
 }
 
 // The 32-bit key format for a frame of `tiles` tiles whose visible depths lie in
-// (near plane, max_depth]: the exponents that range spans, then as many mantissa bits as fit.
+// [min_depth, max_depth]: the exponents that range spans, then as many mantissa bits as fit
+// (a tighter range leaves fewer Gaussians sharing a bin for the ranges pass to order).
 // Returns the 64-bit format (depth_bits 0) when the tiles leave too few bits for depth.
-cuda::KeyFormat compact_key_format(std::uint64_t tiles, double max_depth) {
+cuda::KeyFormat compact_key_format(std::uint64_t tiles, double min_depth, double max_depth) {
   cuda::KeyFormat k;
   const int tile_bits = std::max(bits_for(tiles), 1);
   const int depth_bits = 32 - tile_bits;
   if (depth_bits < 8) return k;
-  const float far = static_cast<float>(std::min(std::max(max_depth, double{gm::kNearZ}), 1e30));
-  const std::uint32_t lo = float_exponent(gm::kNearZ), hi = float_exponent(far);
+  const double near = std::max(min_depth, double{gm::kNearZ});
+  const float far = static_cast<float>(std::min(std::max(max_depth, near), 1e30));
+  const std::uint32_t lo = float_exponent(static_cast<float>(std::min(near, 1e30))), hi = float_exponent(far);
   const int exponent_bits = bits_for(hi - lo + 1);
   k.depth_bits = std::min(depth_bits, exponent_bits + 23);
   k.mantissa_bits = std::max(0, std::min(23, k.depth_bits - exponent_bits));
@@ -142,8 +144,8 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaGetDeviceProperties(&prop, device_), "cudaGetDeviceProperties");
     device_name_ = prop.name;
     check_cuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "stream creation");
-    // Tuning knob for the benchmark script (rows of pixels per lane in the warp blend).
-    if (const char* rows = std::getenv("FLASHGS_BLEND_ROWS")) lane_rows_ = std::atoi(rows);
+    // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
+    if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
     for (cudaEvent_t& e : events_) check_cuda(cudaEventCreate(&e), "event creation");
     check_cuda(cudaMallocHost(&host_counters_, sizeof(cuda::FrameCounters)), "pinned counter allocation");
     for (DeviceBuffer* b : working_buffers()) b->bind(&working_bytes_, &peak_bytes_);
@@ -284,13 +286,13 @@ class CudaRendererImpl final : public CudaRenderer {
     bounds_radius_ = std::sqrt(radius2);
   }
 
-  double max_depth_from(const gm::CameraParams& cam) const {
+  double distance_to_bounds_centre(const gm::CameraParams& cam) const {
     double d2 = 0;
     for (int a = 0; a < 3; ++a) {
       const double d = cam.position[a] - bounds_centre_[a];
       d2 += d * d;
     }
-    return std::sqrt(d2) + bounds_radius_;
+    return std::sqrt(d2);
   }
 
   static cuda::DeferredList deferred_list(const DeviceBuffer& footprints, const DeviceBuffer& ids) {
@@ -365,7 +367,20 @@ class CudaRendererImpl final : public CudaRenderer {
     // 3DGS sorts 64-bit keys over 32 + bits(tiles); flash packs tile and depth bin in 32 bits;
     // with the switch off, all 64 bits are sorted, to show what the switch buys.
     const bool compact_keys = !baseline && options.minimal_sort_bits;
-    key_format_ = compact_keys ? compact_key_format(tiles, max_depth_from(cam)) : cuda::KeyFormat{};
+    if (compact_keys) {
+      // A centre inside the view cone at distance d from the camera has depth in
+      // [d cos(half-diagonal angle), d]; the bounding sphere bounds d. Centres just outside
+      // the cone (a Gaussian reaching into the frame) get clamped bins; the order stays exact
+      // either way, only the ranges pass has more ties to order.
+      const double distance = distance_to_bounds_centre(cam);
+      const double tan_x = std::max(cam.cx, cam.width - cam.cx) / cam.fx;
+      const double tan_y = std::max(cam.cy, cam.height - cam.cy) / cam.fy;
+      const double cos_half_diagonal = 1.0 / std::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
+      key_format_ = compact_key_format(tiles, (distance - bounds_radius_) * cos_half_diagonal,
+                                       distance + bounds_radius_);
+    } else {
+      key_format_ = cuda::KeyFormat{};
+    }
 
     ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
@@ -445,7 +460,7 @@ class CudaRendererImpl final : public CudaRenderer {
                             : (options.pipelined_blend ? cuda::BlendKernel::warp_tile_pipelined
                                                        : cuda::BlendKernel::warp_tile);
     blend.exp2_alpha = args.exp2_alpha;
-    blend.lane_rows = lane_rows_;
+    blend.region_width = region_width_;
     blend.values = b.values[which];
     blend.tile_ranges = b.tile_ranges;
     blend.gaussians = b.blend;
@@ -504,7 +519,7 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;
   std::uint64_t pair_capacity_ = 0;
   std::size_t last_tiles_ = 0;
-  int lane_rows_ = 1;
+  int region_width_ = 8;
   cuda::KeyFormat key_format_;           // this frame's
   double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
   double bounds_radius_ = 0;

@@ -140,7 +140,7 @@ struct BlendArgs {
   float background[3];
   BlendKernel kernel;
   bool exp2_alpha;
-  int lane_rows;                 // warp blend: pixel rows per lane (1, 2 or 4)
+  int region_width;              // warp blend: a warp's region, 16 x 4 or 8 x 8 pixels
   const std::uint32_t* values;   // sorted Gaussian ids
   const uint2* tile_ranges;
   const BlendGaussian* gaussians;

@@ -2,7 +2,8 @@
 # GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench
-#                                       bench-cpu profile build-bg wait-build
+#                                       bench-regions bench-prev bench-cpu profile profile-blend
+#                                       build-bg wait-build
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
 # cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
 # there; `build` builds everything on the machine instead, into build-dev).
@@ -81,11 +82,11 @@ bench_quick() {
   bench_scene "$SCENES/pc_biker" bench_biker_quick --backend cuda -r 1920x1080 --configs baseline,flash --warmup 2 --repeat 5
 }
 
-bench_rows() {  # warp-blend pixel rows per lane: ROWS (default 1 2 4)
-  for rows in ${ROWS:-1 2 4}; do
-    log "bench rows=$rows"
+bench_regions() {  # warp-blend region widths: WIDTHS (default 8 16)
+  for width in ${WIDTHS:-8 16}; do
+    log "bench region width=$width"
     for scene in pc_biker pc_playbot; do
-      FLASHGS_BLEND_ROWS=$rows bench_scene "$SCENES/$scene" ${TAG:-}bench_rows${rows}_$scene --backend cuda \
+      FLASHGS_BLEND_REGION_WIDTH=$width bench_scene "$SCENES/$scene" ${TAG:-}bench_w${width}_$scene --backend cuda \
         -r 1920x1080,3840x2160 --configs flash --warmup 2 --repeat 5 | grep -E "^[0-9]+x"
     done
   done
@@ -115,6 +116,16 @@ profile() {  # PROFILE_SCENE (pc_playbot), PROFILE_RES (3840x2160)
   grep -E "^  [a-z_].*\(|Duration|Memory Throughput|Compute \(SM\) Throughput|Registers Per|Achieved Occupancy" "$OUT/ncu.txt" | head -60
 }
 
+profile_blend() {  # one blend kernel in detail: stall reasons, instruction mix, hot lines
+  log "ncu blend ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-1920x1080}"
+  timeout 240 ncu --section SpeedOfLight --section WarpStateStats --section SchedulerStats --section InstructionStats \
+    --section Occupancy --section LaunchStats -k regex:blend_warp --launch-skip 3 --launch-count 1 \
+    "$FLASHGS" render "$SCENES/${PROFILE_SCENE:-pc_playbot}/point_cloud.ply" --backend cuda -c 10 \
+    -r "${PROFILE_RES:-1920x1080}" --repeat 5 -o /tmp/p.ppm > "$OUT/ncu_blend.txt" 2>&1
+  log "ncu rc=$?"
+  grep -vE "^==|^\s*$|----" "$OUT/ncu_blend.txt" | tail -75
+}
+
 FLASHGS=$BIN/flashgs
 TESTS=$BIN/test_cuda_render
 for step in "$@"; do
@@ -127,10 +138,11 @@ for step in "$@"; do
     sanitize) sanitize ;;
     bench-quick) bench_quick ;;
     bench) bench ;;
-    bench-rows) bench_rows ;;
-    bench-prev) (FLASHGS=$BIN/flashgs_prev TAG=prev_ bench_rows) ;;  # a carried earlier build, to compare
+    bench-regions) bench_regions ;;
+    bench-prev) (FLASHGS=$BIN/flashgs_prev TAG=prev_ bench_regions) ;;  # a carried earlier build, to compare
     bench-cpu) bench_cpu ;;
     profile) profile ;;
+    profile-blend) profile_blend ;;
     *) echo "unknown step $step" ;;
   esac
 done
