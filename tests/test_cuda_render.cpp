@@ -214,6 +214,32 @@ TEST(CudaDeterminism, SameFrameTwiceGivesTheSameBytes) {
   }
 }
 
+// The 32-bit keys (tile + a depth bin, ties put in order by the ranges pass) must give the
+// blend exactly the order of the 64-bit keys (tile + the depth's float bits): same kernels on
+// the same order, so the images are equal to the byte. Both resolutions: 4K leaves fewer bits
+// for the depth bin, hence more ties.
+TEST(CudaSortKeys, CompactKeysBlendInTheSameOrderAsFullKeys) {
+  FLASHGS_REQUIRE_CUDA();
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  RenderOptions full_keys;
+  full_keys.minimal_sort_bits = false;
+  for (const std::string& name : test::shared_scene_names()) {
+    const auto scene = test::load_shared_scene(name);
+    const std::vector<Camera> cameras = test::load_shared_cameras(name);
+    auto gpu = make_cuda_renderer();
+    gpu->set_scene(scene);
+    for (int index : {0, 10, 20})
+      for (const Camera& camera : {cameras[index].resized(1920, 1080), cameras[index].resized(3840, 2160)}) {
+        const Result compact = render(*gpu, camera, RenderOptions{});
+        const Result full = render(*gpu, camera, full_keys);
+        EXPECT_EQ(compact.stats.kv_pairs, full.stats.kv_pairs) << name << " " << camera.name;
+        EXPECT_TRUE(compact.image.rgb == full.image.rgb)
+            << name << " camera " << index << " " << camera.width << "x" << camera.height
+            << ": the compact keys changed the blend order";
+      }
+  }
+}
+
 // Same tile counts as the CPU, tile by tile.
 TEST(CudaStats, TileCountsMatchTheCpu) {
   FLASHGS_REQUIRE_CUDA();

@@ -146,7 +146,8 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "stream creation");
     // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
     if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
-    for (cudaEvent_t& e : events_) check_cuda(cudaEventCreate(&e), "event creation");
+    for (auto& set : events_)
+      for (cudaEvent_t& e : set) check_cuda(cudaEventCreate(&e), "event creation");
     check_cuda(cudaMallocHost(&host_counters_, sizeof(cuda::FrameCounters)), "pinned counter allocation");
     for (DeviceBuffer* b : working_buffers()) b->bind(&working_bytes_, &peak_bytes_);
     counters_.reserve(sizeof(cuda::FrameCounters), "frame counters");
@@ -156,8 +157,9 @@ class CudaRendererImpl final : public CudaRenderer {
     if (stream_) cudaStreamSynchronize(stream_);
     for (DeviceBuffer* b : working_buffers()) b->release();
     for (DeviceBuffer* b : scene_buffers()) b->release();
-    for (cudaEvent_t e : events_)
-      if (e) cudaEventDestroy(e);
+    for (auto& set : events_)
+      for (cudaEvent_t e : set)
+        if (e) cudaEventDestroy(e);
     if (host_counters_) cudaFreeHost(host_counters_);
     if (stream_) cudaStreamDestroy(stream_);
   }
@@ -348,10 +350,21 @@ class CudaRendererImpl final : public CudaRenderer {
                       "sort scratch");
   }
 
-  float elapsed(Event a, Event b) const {
-    float ms = 0;
-    check_cuda(cudaEventElapsedTime(&ms, events_[a], events_[b]), "event timing");
-    return ms;
+  // Stage times of the frame whose events are in `set` (its work must have finished).
+  StageTimes stage_times(int set) const {
+    auto elapsed = [this, set](Event a, Event b) {
+      float ms = 0;
+      check_cuda(cudaEventElapsedTime(&ms, events_[set][a], events_[set][b]), "event timing");
+      return static_cast<double>(ms);
+    };
+    StageTimes t;
+    t.project_ms = elapsed(kBegin, kProjected);
+    t.emit_ms = elapsed(kProjected, kScanned) + elapsed(kEmitBegin, kEmitted);
+    t.sort_ms = elapsed(kSortBegin, kSorted);
+    t.ranges_ms = elapsed(kSorted, kRanged);
+    t.blend_ms = elapsed(kRanged, kBlended);
+    t.total_ms = t.project_ms + t.emit_ms + t.sort_ms + t.ranges_ms + t.blend_ms;
+    return t;
   }
 
   void run_frame(const Camera& camera, const RenderOptions& options, Image* out, std::uint64_t surface,
@@ -411,20 +424,27 @@ class CudaRendererImpl final : public CudaRenderer {
 
     // project (+ fused emit), then the frame's one read back: the pair count. Fused emission
     // that overflowed wrote nothing past the capacity; grow and run it again.
+    // Event sets alternate between frames, so that a surface frame's statistics can report
+    // the previous frame's stage times without waiting for its own.
+    const int previous_set = event_set_;
+    const bool previous_complete = last_frame_complete_;  // all its events recorded
+    last_frame_complete_ = false;
+    event_set_ ^= 1;
+    cudaEvent_t* events = events_[event_set_];
     std::uint64_t pairs = 0;
     for (int attempt = 0;; ++attempt) {
       const cuda::FrameBuffers b = frame_buffers();
       check_cuda(cudaMemsetAsync(b.counters, 0, sizeof(cuda::FrameCounters), stream_), "counter reset");
-      check_cuda(cudaEventRecord(events_[kBegin], stream_), "event record");
+      check_cuda(cudaEventRecord(events[kBegin], stream_), "event record");
       cuda::launch_preprocess(device_scene_, b, args, fused, stream_);
-      check_cuda(cudaEventRecord(events_[kProjected], stream_), "event record");
+      check_cuda(cudaEventRecord(events[kProjected], stream_), "event record");
       if (!fused) cuda::launch_scan(n, b, stream_);
-      check_cuda(cudaEventRecord(events_[kScanned], stream_), "event record");
+      check_cuda(cudaEventRecord(events[kScanned], stream_), "event record");
       check_cuda(cudaMemcpyAsync(host_counters_, b.counters, sizeof(cuda::FrameCounters), cudaMemcpyDeviceToHost,
                                  stream_),
                  "pair count read back");
-      check_cuda(cudaEventRecord(events_[kCounted], stream_), "event record");
-      check_cuda(cudaEventSynchronize(events_[kCounted]), "preprocess");
+      check_cuda(cudaEventRecord(events[kCounted], stream_), "event record");
+      check_cuda(cudaEventSynchronize(events[kCounted]), "preprocess");
       pairs = host_counters_->pairs;
       if (pairs > static_cast<std::uint64_t>(INT32_MAX))
         throw Error("cuda renderer: the frame needs " + std::to_string(pairs) +
@@ -436,19 +456,19 @@ class CudaRendererImpl final : public CudaRenderer {
     }
 
     const cuda::FrameBuffers b = frame_buffers();
-    check_cuda(cudaEventRecord(events_[kEmitBegin], stream_), "event record");
+    check_cuda(cudaEventRecord(events[kEmitBegin], stream_), "event record");
     if (!fused) cuda::launch_duplicate(n, b, cam, args.exact_tile_test, stream_);
-    check_cuda(cudaEventRecord(events_[kEmitted], stream_), "event record");
+    check_cuda(cudaEventRecord(events[kEmitted], stream_), "event record");
 
     const int tile_bits = std::max(bits_for(tiles), 1);
     int end_bit = 64;
     if (key_format_.depth_bits > 0) end_bit = tile_bits + key_format_.depth_bits;
     else if (baseline || options.minimal_sort_bits) end_bit = std::min(64, 32 + tile_bits);
-    check_cuda(cudaEventRecord(events_[kSortBegin], stream_), "event record");
+    check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
     const int which = cuda::launch_sort(pairs, end_bit, b, stream_);
-    check_cuda(cudaEventRecord(events_[kSorted], stream_), "event record");
+    check_cuda(cudaEventRecord(events[kSorted], stream_), "event record");
     cuda::launch_ranges(pairs, tiles, b, which, stream_);
-    check_cuda(cudaEventRecord(events_[kRanged], stream_), "event record");
+    check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
 
     cuda::BlendArgs blend{};
     blend.width = cam.width;
@@ -467,7 +487,7 @@ class CudaRendererImpl final : public CudaRenderer {
     blend.image_rgb = out ? b.image_rgb : nullptr;
     blend.surface = surface;
     cuda::launch_blend(blend, stream_);
-    check_cuda(cudaEventRecord(events_[kBlended], stream_), "event record");
+    check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     last_tiles_ = tiles;
 
     if (out) {
@@ -476,9 +496,8 @@ class CudaRendererImpl final : public CudaRenderer {
                                  stream_),
                  "image download");
       check_cuda(cudaStreamSynchronize(stream_), "frame");
-    } else if (stats_out) {
-      check_cuda(cudaEventSynchronize(events_[kBlended]), "frame");
     }
+    last_frame_complete_ = true;
     if (!stats_out) return;
 
     FrameStats stats;
@@ -493,13 +512,14 @@ class CudaRendererImpl final : public CudaRenderer {
     stats.culled_low_opacity = c.culled_low_opacity;
     stats.culled_degenerate = c.culled_degenerate;
     // GPU time of each stage between events; host gaps (the pair-count wait) are not counted.
-    stats.times.project_ms = elapsed(kBegin, kProjected);
-    stats.times.emit_ms = elapsed(kProjected, kScanned) + elapsed(kEmitBegin, kEmitted);
-    stats.times.sort_ms = elapsed(kSortBegin, kSorted);
-    stats.times.ranges_ms = elapsed(kSorted, kRanged);
-    stats.times.blend_ms = elapsed(kRanged, kBlended);
-    stats.times.total_ms = stats.times.project_ms + stats.times.emit_ms + stats.times.sort_ms +
-                           stats.times.ranges_ms + stats.times.blend_ms;
+    // A surface frame is not waited for (the caller presents it while the GPU finishes): it
+    // reports the previous frame's times, complete since this frame's pair-count wait.
+    if (out || !previous_complete) {
+      check_cuda(cudaEventSynchronize(events[kBlended]), "frame");
+      stats.times = stage_times(event_set_);
+    } else {
+      stats.times = stage_times(previous_set);
+    }
     stats.device_memory_bytes = working_bytes_;
     stats.device_peak_bytes = peak_bytes_;
     if (options.collect_tile_counts) {
@@ -512,7 +532,9 @@ class CudaRendererImpl final : public CudaRenderer {
   int device_ = 0;
   std::string device_name_;
   cudaStream_t stream_ = nullptr;
-  cudaEvent_t events_[kEventCount] = {};
+  cudaEvent_t events_[2][kEventCount] = {};
+  int event_set_ = 0;
+  bool last_frame_complete_ = false;  // the last frame recorded all its events
   cuda::FrameCounters* host_counters_ = nullptr;
   std::shared_ptr<const Scene> scene_;
   cuda::DeviceScene device_scene_;

@@ -17,7 +17,10 @@ class CudaRenderer : public Renderer {
  public:
   // Renders and writes the frame as RGBA8 (alpha 255, values clamped to [0, 1]) into a CUDA
   // surface object (a cudaSurfaceObject_t, e.g. of a GL texture mapped through interop);
-  // image row 0 (the top) goes to surface row 0. No copy to the host.
+  // image row 0 (the top) goes to surface row 0. No copy to the host, and no wait for the
+  // frame's end: the caller presents it while the GPU finishes (work queued later on stream()
+  // runs after it). So `stats` has this frame's counts but the previous frame's stage times
+  // (this frame's on the first call, or after a failed one).
   virtual void render_to_surface(const Camera& camera, const RenderOptions& options,
                                  std::uint64_t surface_object, FrameStats* stats) = 0;
   // Per-tile pair counts of the last frame (row-major tiles_y x tiles_x), copied from the
