@@ -399,8 +399,8 @@ void ViewerApp::finish_script() {
                 static_cast<unsigned long long>(m_stats.gaussians), m_stats.times.total_ms, m_stats.times.project_ms,
                 m_stats.times.emit_ms, m_stats.times.sort_ms, m_stats.times.ranges_ms, m_stats.times.blend_ms);
     const double n = static_cast<double>(m_frame_ms.size());
-    std::printf("viewer split (mean wall ms): render call %.3f, draw + panels %.3f, swap %.3f\n", m_split_ms[0] / n,
-                m_split_ms[1] / n, m_split_ms[2] / n);
+    std::printf("viewer split (mean wall ms): events + panels %.3f, render call %.3f, draw %.3f, swap %.3f\n",
+                m_split_ms[3] / n, m_split_ms[0] / n, m_split_ms[1] / n, m_split_ms[2] / n);
     const glm::vec3 p = m_controller.pose().position;
     std::printf("viewer camera: position %.6f %.6f %.6f\n", p.x, p.y, p.z);
   }
@@ -493,6 +493,7 @@ int ViewerApp::run() {
   auto fps_window_start = Clock::now();
   int fps_frames = 0;
   while (!m_window->should_close()) {
+    const auto t_loop = Clock::now();
     const bool idle = !m_scripted && !m_settings.continuous && !m_playing && m_have_frame;
     m_window->poll(idle);
     int fb_w = 0, fb_h = 0;
@@ -587,6 +588,7 @@ int ViewerApp::run() {
     const bool changed = !m_have_frame || !same_camera(camera, m_last_camera) || !same_options(wanted, m_last_options);
     bool rendered = false;
     double render_call_ms = 0;
+    const double before_render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_loop).count();
     if (changed || m_settings.continuous || m_scripted) {
       const auto t0 = Clock::now();
       render_frame(camera);
@@ -626,8 +628,10 @@ int ViewerApp::run() {
       // Frame 0 includes setup; warm-up frames are not timed either.
       if (m_frame >= (m_args.path ? std::max(1, m_args.warmup) : 1)) {
         m_frame_ms.push_back(frame_ms);
-        // Where the frame's wall time goes (CPU side): the render call (queues the GPU work,
-        // or renders on the CPU), drawing + panels, and the swap (on Xvfb: the copy to the server).
+        // Where the frame's wall time goes (CPU side): events and panel building, the render
+        // call (queues the GPU work, or renders on the CPU), drawing, and the swap (on Xvfb:
+        // waiting for the GPU, then the copy to the server).
+        m_split_ms[3] += before_render_ms;
         m_split_ms[0] += render_call_ms;
         m_split_ms[1] += std::chrono::duration<double, std::milli>(t_swap - t_draw).count();
         m_split_ms[2] += std::chrono::duration<double, std::milli>(swapped - t_swap).count();

@@ -146,6 +146,9 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "stream creation");
     // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
     if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
+    // And the box size (in tiles) above which a warp emits a Gaussian's pairs.
+    if (const char* tiles = std::getenv("FLASHGS_LARGE_BOX_TILES"))
+      large_box_tiles_ = std::max(1, std::min(cuda::kHugeBoxTiles, std::atoi(tiles)));
     for (auto& set : events_)
       for (cudaEvent_t& e : set) check_cuda(cudaEventCreate(&e), "event creation");
     check_cuda(cudaMallocHost(&host_counters_, sizeof(cuda::FrameCounters)), "pinned counter allocation");
@@ -421,6 +424,7 @@ class CudaRendererImpl final : public CudaRenderer {
     args.warp_cooperative = !baseline && options.warp_cooperative_emit;
     args.exp2_alpha = !baseline && options.exp2_alpha;
     args.sh_degree = std::max(0, std::min(device_scene_.sh_degree, options.sh_degree_cap));
+    args.large_box_tiles = large_box_tiles_;
 
     // project (+ fused emit), then the frame's one read back: the pair count. Fused emission
     // that overflowed wrote nothing past the capacity; grow and run it again.
@@ -542,6 +546,7 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t pair_capacity_ = 0;
   std::size_t last_tiles_ = 0;
   int region_width_ = 8;
+  int large_box_tiles_ = cuda::kLargeBoxTiles;
   cuda::KeyFormat key_format_;           // this frame's
   double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
   double bounds_radius_ = 0;

@@ -14,9 +14,10 @@ namespace flashgs {
 namespace cuda {
 
 constexpr int kWarp = 32;
-// A Gaussian whose tile box holds more than this many tiles is emitted by a whole warp
-// (FlashGS section 4.3): below it one thread's loop is shorter than the warp's bookkeeping.
-constexpr int kLargeBoxTiles = 16;
+// By default, a Gaussian whose tile box holds more than this many tiles is emitted by a whole
+// warp (FlashGS section 4.3): below it one thread's loop is shorter than the warp's
+// bookkeeping (PreprocessArgs::large_box_tiles; FLASHGS_LARGE_BOX_TILES overrides it).
+constexpr int kLargeBoxTiles = 32;
 // Boxes of more than this many tiles go to a list that a second kernel emits with a whole
 // block per Gaussian: one warp looping over 10^4 tiles would set the preprocess kernel's length.
 constexpr int kHugeBoxTiles = 1024;
@@ -85,7 +86,7 @@ struct FrameBuffers {
   gm::Footprint* footprints = nullptr;    // [gaussians] separate-emission path only
   std::uint32_t* pair_counts = nullptr;   // [gaussians] pairs per Gaussian (separate path)
   std::uint32_t* pair_offsets = nullptr;  // [gaussians] inclusive prefix sum of pair_counts
-  // Deferred by the fused kernel: boxes of more than kLargeBoxTiles (a warp per Gaussian) and
+  // Deferred by the fused kernel: boxes of more than large_box_tiles (a warp per Gaussian) and
   // of more than kHugeBoxTiles tiles (a block per Gaussian).
   DeferredList large;
   DeferredList huge;
@@ -113,7 +114,8 @@ struct PreprocessArgs {
   bool exact_tile_test;
   bool warp_cooperative;
   bool exp2_alpha;
-  int sh_degree;  // bands evaluated (the scene's, capped)
+  int sh_degree;        // bands evaluated (the scene's, capped)
+  int large_box_tiles;  // boxes of more tiles go to the warp-cooperative path
 };
 
 // project (+ fused key emission when `fused`).

@@ -163,7 +163,7 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
         } else {
           large = true;
         }
-      } else if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kLargeBoxTiles)) {
+      } else if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(args.large_box_tiles)) {
         large = true;
       } else if (!args.exact_tile_test) {
         count = box;

@@ -2,7 +2,8 @@
 # GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench
-#                                       bench-regions bench-prev bench-cpu profile profile-blend
+#                                       bench-regions bench-large bench-prev bench-cpu profile
+#                                       profile-blend
 #                                       build-bg wait-build
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
 # cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
@@ -92,6 +93,16 @@ bench_regions() {  # warp-blend region widths: WIDTHS (default 8 16)
   done
 }
 
+bench_large() {  # the warp-emission threshold in tiles: LARGE (default 8 16 32 64)
+  for tiles in ${LARGE:-8 16 32 64}; do
+    log "bench large box tiles=$tiles"
+    for scene in pc_biker pc_playbot; do
+      FLASHGS_LARGE_BOX_TILES=$tiles bench_scene "$SCENES/$scene" bench_large${tiles}_$scene --backend cuda \
+        -r 1920x1080,3840x2160 --configs flash --warmup 2 --repeat 5 | grep -E "^[0-9]+x"
+    done
+  done
+}
+
 bench() {
   log "bench pc_biker"
   bench_scene "$SCENES/pc_biker" bench_biker --backend cuda -r 1920x1080,3840x2160 --warmup 2 --repeat 5
@@ -139,6 +150,7 @@ for step in "$@"; do
     bench-quick) bench_quick ;;
     bench) bench ;;
     bench-regions) bench_regions ;;
+    bench-large) bench_large ;;
     bench-prev) (FLASHGS=$BIN/flashgs_prev TAG=prev_ bench_regions) ;;  # a carried earlier build, to compare
     bench-cpu) bench_cpu ;;
     profile) profile ;;
