@@ -40,6 +40,16 @@ Window::Window(int width, int height, const std::string& title) {
   glfwSetScrollCallback(m_window, on_scroll);
   glfwSetDropCallback(m_window, on_drop);
   glfwSetKeyCallback(m_window, on_key);
+  glfwSetFramebufferSizeCallback(m_window, on_framebuffer_size);
+  glfwSetWindowSizeCallback(m_window, on_window_size);
+  glfwSetCursorPosCallback(m_window, on_cursor_pos);
+  query_sizes_and_cursor();
+}
+
+void Window::query_sizes_and_cursor() {
+  glfwGetFramebufferSize(m_window, &m_framebuffer_w, &m_framebuffer_h);
+  glfwGetWindowSize(m_window, &m_window_w, &m_window_h);
+  glfwGetCursorPos(m_window, &m_cursor_x, &m_cursor_y);
 }
 
 Window::~Window() {
@@ -68,6 +78,7 @@ void Window::resize(int width, int height) {
     if (w == width && h == height) break;
     glfwWaitEventsTimeout(0.01);
   }
+  query_sizes_and_cursor();
 }
 
 void Window::poll(bool wait_for_events) {
@@ -75,13 +86,13 @@ void Window::poll(bool wait_for_events) {
   else glfwPollEvents();
 }
 
-void Window::framebuffer_size(int* width, int* height) const { glfwGetFramebufferSize(m_window, width, height); }
+void Window::framebuffer_size(int* width, int* height) const {
+  *width = m_framebuffer_w;
+  *height = m_framebuffer_h;
+}
 
 float Window::framebuffer_scale() const {
-  int fw = 0, fh = 0, ww = 0, wh = 0;
-  glfwGetFramebufferSize(m_window, &fw, &fh);
-  glfwGetWindowSize(m_window, &ww, &wh);
-  return ww > 0 ? float(fw) / float(ww) : 1.0f;
+  return m_window_w > 0 ? float(m_framebuffer_w) / float(m_window_w) : 1.0f;
 }
 
 float Window::take_scroll() {
@@ -101,7 +112,28 @@ void Window::on_key(GLFWwindow* w, int key, int, int action, int mods) {
 
 bool Window::key_down(int key) const { return glfwGetKey(m_window, key) == GLFW_PRESS; }
 bool Window::mouse_down(int button) const { return glfwGetMouseButton(m_window, button) == GLFW_PRESS; }
-void Window::cursor(double* x, double* y) const { glfwGetCursorPos(m_window, x, y); }
+void Window::cursor(double* x, double* y) const {
+  *x = m_cursor_x;
+  *y = m_cursor_y;
+}
+
+void Window::on_framebuffer_size(GLFWwindow* w, int width, int height) {
+  auto* self = static_cast<Window*>(glfwGetWindowUserPointer(w));
+  self->m_framebuffer_w = width;
+  self->m_framebuffer_h = height;
+}
+
+void Window::on_window_size(GLFWwindow* w, int width, int height) {
+  auto* self = static_cast<Window*>(glfwGetWindowUserPointer(w));
+  self->m_window_w = width;
+  self->m_window_h = height;
+}
+
+void Window::on_cursor_pos(GLFWwindow* w, double x, double y) {
+  auto* self = static_cast<Window*>(glfwGetWindowUserPointer(w));
+  self->m_cursor_x = x;
+  self->m_cursor_y = y;
+}
 
 void Window::on_scroll(GLFWwindow* w, double, double dy) {
   static_cast<Window*>(glfwGetWindowUserPointer(w))->m_scroll += static_cast<float>(dy);

@@ -31,6 +31,8 @@ class Window {
   void resize(int width, int height);
   void poll(bool wait_for_events);
   // Framebuffer size in pixels (zero while minimised) and its ratio to window points (high DPI).
+  // Sizes and the cursor are kept from GLFW's callbacks: querying them is an X server round
+  // trip each (about 0.25 ms a frame on Xvfb for the four the frame loop needs).
   void framebuffer_size(int* width, int* height) const;
   float framebuffer_scale() const;
 
@@ -49,12 +51,18 @@ class Window {
   static void on_scroll(GLFWwindow* w, double dx, double dy);
   static void on_drop(GLFWwindow* w, int count, const char** paths);
   static void on_key(GLFWwindow* w, int key, int scancode, int action, int mods);
+  static void on_framebuffer_size(GLFWwindow* w, int width, int height);
+  static void on_window_size(GLFWwindow* w, int width, int height);
+  static void on_cursor_pos(GLFWwindow* w, double x, double y);
+  void query_sizes_and_cursor();  // the round trips, once: at creation and after resize()
 
   GLFWwindow* m_window = nullptr;
   float m_scroll = 0;
   std::vector<std::string> m_drops;
   std::vector<KeyPress> m_key_presses;
   int m_swap_interval = -1;
+  int m_framebuffer_w = 0, m_framebuffer_h = 0, m_window_w = 0, m_window_h = 0;
+  double m_cursor_x = 0, m_cursor_y = 0;
 };
 
 }  // namespace flashgs::viewer
