@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 namespace flashgs::cli {
 
@@ -15,41 +17,37 @@ std::vector<SweepConfig> sweep_configs() {
     const char* name;
     bool RenderOptions::*member;
   };
-  const Switch geometry[] = {{"opacity_radius", &RenderOptions::opacity_aware_radius},
-                             {"tight_bbox", &RenderOptions::tight_bbox},
-                             {"exact_tile_test", &RenderOptions::exact_tile_test}};
-  for (const Switch& s : geometry) {
-    RenderOptions o;
-    for (const Switch& other : geometry) o.*(other.member) = false;
-    o.*(s.member) = true;
-    out.push_back({std::string("only-") + s.name, "alone", o, false});
-  }
-  for (const Switch& s : geometry) {
-    RenderOptions o;
-    o.*(s.member) = false;
-    out.push_back({std::string("no-") + s.name, "left out", o, false});
-  }
+  // For a group of switches: each one alone (the others of the group off), then each one left
+  // out (the rest of the flash defaults kept).
+  auto add_group = [&out](const std::vector<Switch>& group, const std::string& alone_prefix,
+                          const std::string& alone_kind, const std::string& left_out_kind, bool gpu_only) {
+    for (const Switch& s : group) {
+      RenderOptions o;
+      for (const Switch& other : group) o.*(other.member) = false;
+      o.*(s.member) = true;
+      out.push_back({alone_prefix + s.name, alone_kind, o, gpu_only});
+    }
+    for (const Switch& s : group) {
+      RenderOptions o;
+      o.*(s.member) = false;
+      out.push_back({std::string("no-") + s.name, left_out_kind, o, gpu_only});
+    }
+  };
+  add_group({{"opacity_radius", &RenderOptions::opacity_aware_radius},
+             {"tight_bbox", &RenderOptions::tight_bbox},
+             {"exact_tile_test", &RenderOptions::exact_tile_test}},
+            "only-", "alone", "left out", false);
   for (int denominator : {128, 64, 32, 16}) {
     RenderOptions o;
     o.tau = 1.0f / static_cast<float>(denominator);
     out.push_back({"tau=1/" + std::to_string(denominator), "tau", o, false});
   }
-  const Switch gpu[] = {{"warp_emit", &RenderOptions::warp_cooperative_emit},
-                        {"fused_emit", &RenderOptions::fused_emit},
-                        {"sort_bits", &RenderOptions::minimal_sort_bits},
-                        {"pipelined_blend", &RenderOptions::pipelined_blend},
-                        {"exp2_alpha", &RenderOptions::exp2_alpha}};
-  for (const Switch& s : gpu) {
-    RenderOptions o;
-    for (const Switch& other : gpu) o.*(other.member) = false;
-    o.*(s.member) = true;
-    out.push_back({std::string("gpu-only-") + s.name, "gpu alone", o, true});
-  }
-  for (const Switch& s : gpu) {
-    RenderOptions o;
-    o.*(s.member) = false;
-    out.push_back({std::string("no-") + s.name, "gpu left out", o, true});
-  }
+  add_group({{"warp_emit", &RenderOptions::warp_cooperative_emit},
+             {"fused_emit", &RenderOptions::fused_emit},
+             {"sort_bits", &RenderOptions::minimal_sort_bits},
+             {"pipelined_blend", &RenderOptions::pipelined_blend},
+             {"exp2_alpha", &RenderOptions::exp2_alpha}},
+            "gpu-only-", "gpu alone", "gpu left out", true);
   return out;
 }
 
