@@ -348,9 +348,13 @@ class CudaRendererImpl final : public CudaRenderer {
     grow_cub_temp();
   }
 
+  // CUB's size queries (three of them) run only when the scene or the pair capacity changed.
   void grow_cub_temp() {
+    if (device_scene_.count == cub_sized_for_gaussians_ && pair_capacity_ == cub_sized_for_pairs_) return;
     cub_temp_.reserve(std::max<std::size_t>(cuda::cub_temp_bytes_needed(device_scene_.count, pair_capacity_), 16),
                       "sort scratch");
+    cub_sized_for_gaussians_ = device_scene_.count;  // only once the reserve succeeded
+    cub_sized_for_pairs_ = pair_capacity_;
   }
 
   // Stage times of the frame whose events are in `set` (its work must have finished).
@@ -415,7 +419,7 @@ class CudaRendererImpl final : public CudaRenderer {
       pair_offsets_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair offsets");
     }
     blend_.reserve(std::max<std::size_t>(n, 1) * sizeof(cuda::BlendGaussian), "per-Gaussian blend data");
-    grow_cub_temp();  // host-side size query; allocates only when the scene or pairs grew
+    grow_cub_temp();  // allocates only when the scene or pairs grew
 
     cuda::PreprocessArgs args{};
     args.camera = cam;
@@ -546,6 +550,8 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t pair_capacity_ = 0;
   std::size_t last_tiles_ = 0;
   int region_width_ = 8;
+  std::size_t cub_sized_for_gaussians_ = ~std::size_t{0};  // sizes cub_temp_ was last checked for
+  std::uint64_t cub_sized_for_pairs_ = 0;
   int large_box_tiles_ = cuda::kLargeBoxTiles;
   cuda::KeyFormat key_format_;           // this frame's
   double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
