@@ -111,7 +111,13 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
                          2 * (qx * qy + qw * qz),     1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qw * qx),
                          2 * (qx * qz - qw * qy),     2 * (qy * qz + qw * qx),     1 - 2 * (qx * qx + qy * qy)};
     const double fx = camera.fx, fy = camera.fy, z = v[2];
-    const double j00 = fx / z, j02 = -fx * v[0] / (z * z), j11 = fy / z, j12 = -fy * v[1] / (z * z);
+    // The Jacobian at the direction clamped to the widened frustum (gm::frustum_clamped_direction).
+    const double width = camera.width, height = camera.height;
+    const double tx = std::clamp(v[0] / z, -(camera.cx + 0.5 + 0.15 * width) / fx,
+                                 (width - 0.5 - camera.cx + 0.15 * width) / fx);
+    const double ty = std::clamp(v[1] / z, -(camera.cy + 0.5 + 0.15 * height) / fy,
+                                 (height - 0.5 - camera.cy + 0.15 * height) / fy);
+    const double j00 = fx / z, j02 = -fx * tx / z, j11 = fy / z, j12 = -fy * ty / z;
     double t0[3], t1[3];
     for (int k = 0; k < 3; ++k) {
       t0[k] = j00 * rot[k] + j02 * rot[6 + k];

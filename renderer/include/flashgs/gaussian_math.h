@@ -137,6 +137,21 @@ FLASHGS_HD void to_view(const CameraParams& cam, const float p[3], float v[3]) {
   v[2] = cam.rotation[6] * d0 + cam.rotation[7] * d1 + cam.rotation[8] * d2;
 }
 
+// x/z and y/z clamped to the view frustum widened by 30% of its half-size on each side:
+// 3DGS's limit 1.3 tan(fov / 2), written for any principal point (identical to it when the
+// principal point is the image centre; the image spans pixel edges -0.5 .. width - 0.5).
+FLASHGS_HD void frustum_clamped_direction(const CameraParams& cam, float x_over_z, float y_over_z,
+                                          float& tx, float& ty) {
+  const float margin_x = 0.15f * static_cast<float>(cam.width);
+  const float margin_y = 0.15f * static_cast<float>(cam.height);
+  const float x_lo = -(cam.cx + 0.5f + margin_x) / cam.fx;
+  const float x_hi = (static_cast<float>(cam.width) - 0.5f - cam.cx + margin_x) / cam.fx;
+  const float y_lo = -(cam.cy + 0.5f + margin_y) / cam.fy;
+  const float y_hi = (static_cast<float>(cam.height) - 0.5f - cam.cy + margin_y) / cam.fy;
+  tx = clampf(x_over_z, x_lo, x_hi);
+  ty = clampf(y_over_z, y_lo, y_hi);
+}
+
 // Projects one Gaussian. The 2D covariance is M M^T with M = J W R S (2x3). Its determinant
 // comes from Cauchy-Binet as a sum of squared 2x2 minors of M, never as a*c - b*b: for a
 // needle or pancake (scale ratios of 1e6 and more) a*c and b*b agree in every float digit
@@ -162,9 +177,14 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
   const float inv_z = 1.0f / v[2];
   const float mean_x = cam.fx * v[0] * inv_z + cam.cx;
   const float mean_y = cam.fy * v[1] * inv_z + cam.cy;
-  // J W: rows of the projection Jacobian times the world-to-camera rotation.
-  const float j00 = cam.fx * inv_z, j02 = -cam.fx * v[0] * inv_z * inv_z;
-  const float j11 = cam.fy * inv_z, j12 = -cam.fy * v[1] * inv_z * inv_z;
+  // J W: rows of the projection Jacobian times the world-to-camera rotation. The Jacobian is
+  // taken at the centre's direction clamped to the frustum widened by 30% (3DGS, which the
+  // scenes were trained with): far outside the view the linearisation stretches a Gaussian
+  // into a long smear across the image that the trained model never showed.
+  float tx, ty;
+  frustum_clamped_direction(cam, v[0] * inv_z, v[1] * inv_z, tx, ty);
+  const float j00 = cam.fx * inv_z, j02 = -cam.fx * tx * inv_z;
+  const float j11 = cam.fy * inv_z, j12 = -cam.fy * ty * inv_z;
   float t0[3], t1[3];
   for (int k = 0; k < 3; ++k) {
     t0[k] = j00 * cam.rotation[k] + j02 * cam.rotation[6 + k];
