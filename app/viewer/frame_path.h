@@ -22,13 +22,23 @@ class FramePath {
   virtual std::string name() const = 0;
   // Throws flashgs::Error when the scene cannot be held (the previous one then stays).
   virtual void set_scene(std::shared_ptr<const Scene> scene) = 0;
-  // Binds the frame texture (a GL texture name, RGBA8, width x height). Called again after
-  // every resize; release_texture() comes first. Throws flashgs::Error when the path cannot
-  // write into it (e.g. interop refused): the caller then falls back to another path.
-  virtual void attach_texture(unsigned texture, int width, int height) = 0;
-  virtual void release_texture() = 0;
-  // Renders the camera's view into the attached texture.
+  // How many frame textures the path writes in turn: 2 when it renders the next frame into
+  // one while the window shows the other.
+  virtual int texture_count() const { return 1; }
+  // Binds the frame textures (texture_count() GL texture names, RGBA8, width x height). Called
+  // again after every resize; release_textures() comes first. Throws flashgs::Error when the
+  // path cannot write into them (e.g. interop refused): the caller then falls back to another path.
+  virtual void attach_textures(const unsigned* textures, int width, int height) = 0;
+  virtual void release_textures() = 0;
+  // Renders the camera's view into an attached texture. A path with two textures may leave
+  // this frame in flight and have the window show the previous one (shown_texture()), so
+  // that the GPU renders while the window system presents; present_latest() ends that.
   virtual void render_to_texture(const Camera& camera, const RenderOptions& options, FrameStats* stats) = 0;
+  // The attached texture the window shows now.
+  virtual int shown_texture() const { return 0; }
+  // Makes the last render the shown texture (waits for nothing on the host: GL orders its
+  // use after the render). For frames that render nothing, screenshots and checks.
+  virtual void present_latest() {}
   // Renders into host memory (compare mode, float screenshots).
   virtual void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) = 0;
   // Per-tile pair counts of the last render_to_texture (needs options.collect_tile_counts).

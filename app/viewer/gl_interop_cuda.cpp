@@ -22,40 +22,57 @@ void check(cudaError_t e, const char* what) {
   if (e != cudaSuccess) throw Error(cuda_error(what, e));
 }
 
+// Two textures in turn: frame N is rendered into one while the window draws and presents
+// frame N-1 from the other, so the swap (on Xvfb, a read-back and a copy) does not wait for
+// the GPU frame. The texture being rendered stays mapped until the next frame starts; its
+// unmap then orders GL's use of it after the render, with no host sync.
 class InteropPath final : public FramePath {
  public:
   InteropPath(std::unique_ptr<CudaRenderer> renderer, std::string device)
       : m_renderer(std::move(renderer)), m_device(std::move(device)) {}
-  ~InteropPath() override { release_texture(); }
+  ~InteropPath() override { release_textures(); }
 
   std::string name() const override { return "CUDA-GL interop (" + m_device + ")"; }
   void set_scene(std::shared_ptr<const Scene> scene) override { m_renderer->set_scene(std::move(scene)); }
 
-  void attach_texture(unsigned texture, int width, int height) override {
-    release_texture();
+  int texture_count() const override { return kTextures; }
+
+  void attach_textures(const unsigned* textures, int width, int height) override {
+    release_textures();
     // Registered once per texture (registration is the expensive part); only map/unmap run
     // every frame. WriteDiscard: the renderer overwrites every pixel, nothing is read back.
-    check(cudaGraphicsGLRegisterImage(&m_resource, texture, GL_TEXTURE_2D, cudaGraphicsRegisterFlagsSurfaceLoadStore),
-          "cudaGraphicsGLRegisterImage");
-    check(cudaGraphicsResourceSetMapFlags(m_resource, cudaGraphicsMapFlagsWriteDiscard),
-          "cudaGraphicsResourceSetMapFlags");
+    for (int i = 0; i < kTextures; ++i) {
+      check(cudaGraphicsGLRegisterImage(&m_resources[i], textures[i], GL_TEXTURE_2D,
+                                        cudaGraphicsRegisterFlagsSurfaceLoadStore),
+            "cudaGraphicsGLRegisterImage");
+      check(cudaGraphicsResourceSetMapFlags(m_resources[i], cudaGraphicsMapFlagsWriteDiscard),
+            "cudaGraphicsResourceSetMapFlags");
+    }
     m_width = width;
     m_height = height;
+    m_shown = 0;
   }
 
-  void release_texture() override {
-    if (m_resource) cudaGraphicsUnregisterResource(m_resource);
-    m_resource = nullptr;
+  void release_textures() override {
+    unmap_in_flight();  // errors ignored: the resources go anyway (also runs in the destructor)
+    for (cudaGraphicsResource_t& r : m_resources) {
+      if (r) cudaGraphicsUnregisterResource(r);
+      r = nullptr;
+    }
   }
 
   void render_to_texture(const Camera& camera, const RenderOptions& options, FrameStats* stats) override {
-    if (!m_resource) throw Error("CUDA-GL interop: no texture attached");
+    if (!m_resources[0]) throw Error("CUDA-GL interop: no texture attached");
+    present_latest();  // the previous frame: shown from now on
+    const int target = 1 - m_shown;
     auto stream = static_cast<cudaStream_t>(m_renderer->stream());
-    check(cudaGraphicsMapResources(1, &m_resource, stream), "cudaGraphicsMapResources");
+    // Orders this frame's kernels after GL's last use of the texture (it was shown a frame ago).
+    check(cudaGraphicsMapResources(1, &m_resources[target], stream), "cudaGraphicsMapResources");
     cudaSurfaceObject_t surface = 0;
     try {
       cudaArray_t array = nullptr;
-      check(cudaGraphicsSubResourceGetMappedArray(&array, m_resource, 0, 0), "cudaGraphicsSubResourceGetMappedArray");
+      check(cudaGraphicsSubResourceGetMappedArray(&array, m_resources[target], 0, 0),
+            "cudaGraphicsSubResourceGetMappedArray");
       cudaResourceDesc desc{};
       desc.resType = cudaResourceTypeArray;
       desc.res.array.array = array;
@@ -63,12 +80,20 @@ class InteropPath final : public FramePath {
       m_renderer->render_to_surface(camera, options, static_cast<std::uint64_t>(surface), stats);
     } catch (...) {
       if (surface) cudaDestroySurfaceObject(surface);
-      cudaGraphicsUnmapResources(1, &m_resource, stream);
+      cudaGraphicsUnmapResources(1, &m_resources[target], stream);
       throw;
     }
     cudaDestroySurfaceObject(surface);
-    // Unmap orders GL's later use of the texture after the stream's work: no host sync here.
-    check(cudaGraphicsUnmapResources(1, &m_resource, stream), "cudaGraphicsUnmapResources");
+    m_in_flight = target;
+  }
+
+  int shown_texture() const override { return m_shown; }
+
+  void present_latest() override {
+    const int texture = m_in_flight;
+    if (texture < 0) return;
+    check(unmap_in_flight(), "cudaGraphicsUnmapResources");
+    m_shown = texture;
   }
 
   void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
@@ -81,9 +106,20 @@ class InteropPath final : public FramePath {
   }
 
  private:
+  // Unmap orders GL's later use of the texture after the stream's work: no host sync here.
+  cudaError_t unmap_in_flight() {
+    if (m_in_flight < 0) return cudaSuccess;
+    const int texture = m_in_flight;
+    m_in_flight = -1;
+    return cudaGraphicsUnmapResources(1, &m_resources[texture], static_cast<cudaStream_t>(m_renderer->stream()));
+  }
+
   std::unique_ptr<CudaRenderer> m_renderer;
   std::string m_device;
-  cudaGraphicsResource_t m_resource = nullptr;
+  static constexpr int kTextures = 2;
+  cudaGraphicsResource_t m_resources[kTextures] = {};
+  int m_shown = 0;       // the texture the window draws
+  int m_in_flight = -1;  // the texture still mapped with a render queued into it, or -1
   int m_width = 0, m_height = 0;
 };
 

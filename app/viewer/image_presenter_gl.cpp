@@ -10,7 +10,7 @@
 namespace flashgs::viewer {
 
 ImagePresenter::~ImagePresenter() {
-  if (m_texture) glDeleteTextures(1, &m_texture);
+  glDeleteTextures(m_texture_count, m_textures);
   if (m_counts) glDeleteTextures(1, &m_counts);
   if (m_vao) glDeleteVertexArrays(1, &m_vao);
 }
@@ -29,22 +29,26 @@ void ImagePresenter::init() {
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 }
 
-void ImagePresenter::resize(int width, int height) {
-  if (m_texture) glDeleteTextures(1, &m_texture);
+void ImagePresenter::resize(int width, int height, int count) {
+  glDeleteTextures(m_texture_count, m_textures);
   m_width = width;
   m_height = height;
-  glGenTextures(1, &m_texture);
-  glBindTexture(GL_TEXTURE_2D, m_texture);
-  // Linear filtering: the frame may be rendered below the window size (render scale < 1).
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+  m_texture_count = std::clamp(count, 1, kMaxTextures);
+  m_shown = 0;
+  glGenTextures(m_texture_count, m_textures);
+  for (int i = 0; i < m_texture_count; ++i) {
+    glBindTexture(GL_TEXTURE_2D, m_textures[i]);
+    // Linear filtering: the frame may be rendered below the window size (render scale < 1).
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+  }
 }
 
 void ImagePresenter::upload(const Image& image) {
-  if (needs_resize(image.width, image.height)) resize(image.width, image.height);
+  if (image.width != m_width || image.height != m_height || m_texture_count == 0) resize(image.width, image.height);
   const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
   m_rgba.resize(pixels * 4);
   // 8 Mpixel at 4K: spread over the cores when OpenMP is there (the CPU renderer uses it too).
@@ -57,7 +61,8 @@ void ImagePresenter::upload(const Image& image) {
     }
     m_rgba[i * 4 + 3] = 255;
   }
-  glBindTexture(GL_TEXTURE_2D, m_texture);
+  m_shown = 0;
+  glBindTexture(GL_TEXTURE_2D, m_textures[0]);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE, m_rgba.data());
 }
@@ -84,10 +89,10 @@ void ImagePresenter::draw(int fb_width, int fb_height, const HeatmapView* heatma
   glDisable(GL_SCISSOR_TEST);
   glDisable(GL_BLEND);
   glBindVertexArray(m_vao);
-  if (m_texture) {
+  if (m_texture_count > 0) {
     glUseProgram(m_blit.id());
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, m_texture);
+    glBindTexture(GL_TEXTURE_2D, m_textures[m_shown]);
     glUniform1i(m_blit.uniform("u_image"), 0);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
@@ -115,9 +120,9 @@ void ImagePresenter::draw(int fb_width, int fb_height, const HeatmapView* heatma
 
 Image ImagePresenter::read_back() const {
   Image image;
-  if (!m_texture) return image;
+  if (m_texture_count == 0) return image;
   std::vector<std::uint8_t> rgba(static_cast<std::size_t>(m_width) * m_height * 4);
-  glBindTexture(GL_TEXTURE_2D, m_texture);
+  glBindTexture(GL_TEXTURE_2D, m_textures[m_shown]);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
   image.resize(m_width, m_height);

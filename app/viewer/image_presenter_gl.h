@@ -25,15 +25,21 @@ class ImagePresenter {
 
   // Compiles the shaders (throws flashgs::Error with the driver's log).
   void init();
-  // Whether the frame texture must be recreated for width x height.
-  bool needs_resize(int width, int height) const { return width != m_width || height != m_height; }
-  // Recreates the RGBA8 frame texture (the old one is deleted: detach interop first).
-  void resize(int width, int height);
-  GLuint texture() const { return m_texture; }
+  static constexpr int kMaxTextures = 2;
+  // Whether the frame textures must be recreated for width x height (or another count).
+  bool needs_resize(int width, int height, int count = 1) const {
+    return width != m_width || height != m_height || count != m_texture_count;
+  }
+  // Recreates `count` RGBA8 frame textures (the old ones are deleted: detach interop first);
+  // texture 0 is shown.
+  void resize(int width, int height, int count = 1);
+  GLuint texture(int index) const { return m_textures[index]; }
+  // Which frame texture draw() and read_back() use.
+  void show(int index) { m_shown = index; }
   int width() const { return m_width; }
   int height() const { return m_height; }
 
-  // Uploads a float RGB image (top row first) as RGBA8; the host-memory path.
+  // Uploads a float RGB image (top row first) as RGBA8 into texture 0; the host-memory path.
   void upload(const Image& image);
   // Per-tile pair counts (row-major tiles_y x tiles_x) for the overlay; `max_count` tops the scale.
   void set_tile_counts(const std::vector<std::uint32_t>& counts, int tiles_x, int tiles_y, std::uint32_t max_count);
@@ -41,13 +47,15 @@ class ImagePresenter {
 
   // Draws the frame over the whole framebuffer, then the overlay when `heatmap` is non-null.
   void draw(int framebuffer_width, int framebuffer_height, const HeatmapView* heatmap);
-  // The frame texture read back as float RGB (top row first): screenshots of the CUDA path.
+  // The shown frame texture read back as float RGB (top row first): screenshots of the CUDA path.
   Image read_back() const;
 
  private:
   ShaderProgram m_blit, m_heat;
   GLuint m_vao = 0;
-  GLuint m_texture = 0, m_counts = 0;
+  GLuint m_textures[kMaxTextures] = {};
+  int m_texture_count = 0, m_shown = 0;
+  GLuint m_counts = 0;
   int m_width = 0, m_height = 0;
   int m_tiles_x = 0, m_tiles_y = 0;
   std::uint32_t m_max_count = 1;

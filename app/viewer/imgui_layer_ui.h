@@ -1,14 +1,17 @@
 // ImGuiLayer: Dear ImGui's context with its GLFW and OpenGL 3 backends (init, per-frame begin/end, shutdown).
 #pragma once
 
-struct GLFWwindow;
+struct GLFWcursor;
 
 namespace flashgs::viewer {
+
+class Window;
 
 class ImGuiLayer {
  public:
   // `ui_scale` multiplies font and widget sizes (the monitor's content scale on high-DPI screens).
-  ImGuiLayer(GLFWwindow* window, float ui_scale);
+  // The window must outlive the layer.
+  ImGuiLayer(Window& window, float ui_scale);
   ~ImGuiLayer();
   ImGuiLayer(const ImGuiLayer&) = delete;
   ImGuiLayer& operator=(const ImGuiLayer&) = delete;
@@ -17,6 +20,14 @@ class ImGuiLayer {
   void end_frame();  // draws into the current framebuffer
   bool wants_mouse() const;
   bool wants_keyboard() const;
+
+ private:
+  void update_platform_inputs();
+
+  Window& m_window;
+  double m_last_time = 0;
+  int m_cursor_shape = -1;           // the ImGuiMouseCursor last applied
+  GLFWcursor* m_cursors[9] = {};     // per ImGuiMouseCursor; null: GLFW's default arrow
 };
 
 }  // namespace flashgs::viewer

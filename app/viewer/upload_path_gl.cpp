@@ -12,8 +12,8 @@ class UploadPath final : public FramePath {
 
   std::string name() const override { return m_label; }
   void set_scene(std::shared_ptr<const Scene> scene) override { m_renderer->set_scene(std::move(scene)); }
-  void attach_texture(unsigned, int, int) override {}
-  void release_texture() override {}
+  void attach_textures(const unsigned*, int, int) override {}
+  void release_textures() override {}
 
   void render_to_texture(const Camera& camera, const RenderOptions& options, FrameStats* stats) override {
     m_renderer->render(camera, options, m_image, stats);

@@ -280,14 +280,17 @@ void ViewerApp::apply_actions(const UiActions& a) {
 }
 
 void ViewerApp::ensure_texture(int width, int height) {
-  if (!m_presenter->needs_resize(width, height)) return;
-  m_path->release_texture();
-  m_presenter->resize(width, height);
+  if (!m_presenter->needs_resize(width, height, m_path->texture_count())) return;
+  m_path->release_textures();
+  m_presenter->resize(width, height, m_path->texture_count());
   try {
-    m_path->attach_texture(m_presenter->texture(), width, height);
+    GLuint textures[ImagePresenter::kMaxTextures] = {};
+    for (int i = 0; i < m_path->texture_count(); ++i) textures[i] = m_presenter->texture(i);
+    m_path->attach_textures(textures, width, height);
   } catch (const std::exception& e) {
     use_cpu_path(std::string("interop failed: ") + e.what());
     m_path->set_scene(m_scene.scene);
+    m_presenter->resize(width, height, m_path->texture_count());
   }
 }
 
@@ -303,6 +306,8 @@ void ViewerApp::render_frame(const Camera& camera) {
     m_path->render_to_texture(camera, options, &m_stats);
   }
   if (m_settings.heatmap) {
+    // The overlay's counts are this frame's: show this frame too, not the one before it.
+    m_path->present_latest();
     m_path->tile_counts(m_stats, m_tile_counts);
     std::uint32_t max_count = m_stats.max_tile_pairs;
     if (max_count == 0)
@@ -317,6 +322,8 @@ void ViewerApp::render_frame(const Camera& camera) {
 
 void ViewerApp::save_screenshot(const std::string& path) {
   try {
+    m_path->present_latest();
+    m_presenter->show(m_path->shown_texture());
     Image image;
     const Image* host = m_path->last_image();
     const std::string ext = std::filesystem::path(path).extension().string();
@@ -363,6 +370,8 @@ void ViewerApp::check_displayed_frame() {
   // What the window shows (the texture, written by interop or uploaded) against the same
   // backend's host-memory image of the same view, rounded to 8 bits as the texture is: catches
   // a flipped, shifted, channel-swapped or stale frame on any path.
+  m_path->present_latest();
+  m_presenter->show(m_path->shown_texture());
   const Image shown = m_presenter->read_back();
   Image expected;
   m_path->render_image(m_last_camera, m_last_options, expected, nullptr);
@@ -447,7 +456,7 @@ int ViewerApp::run() {
   m_ui_scale = std::max(1.0f, xscale / m_window->framebuffer_scale());
   std::fprintf(stderr, "flashgs-viewer: framebuffer %dx%d pixels, content scale %.2f, UI scale %.2f\n", fb_w0, fb_h0,
                xscale, m_ui_scale);
-  m_ui = std::make_unique<ImGuiLayer>(m_window->handle(), m_ui_scale);
+  m_ui = std::make_unique<ImGuiLayer>(*m_window, m_ui_scale);
   select_frame_path();
   // On the CPU a frame takes long: re-render only when something changes, so the panels stay
   // responsive (GPU paths render every frame and show their FPS).
@@ -595,7 +604,13 @@ int ViewerApp::run() {
       render_call_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
       if (scale == m_settings.render_scale) m_full_render_ms = render_call_ms;
       rendered = true;
+      // Showing the previous frame while this one renders pays only when another frame
+      // follows at once; a render on demand (the view changed) is shown now.
+      if (!m_settings.continuous && !m_scripted) m_path->present_latest();
+    } else {
+      m_path->present_latest();  // the view rests: show its last frame, not the one before
     }
+    m_presenter->show(m_path->shown_texture());
 
     HeatmapView heat;
     heat.log_scale = m_settings.heatmap_log;

@@ -43,7 +43,12 @@ Window::Window(int width, int height, const std::string& title) {
   glfwSetFramebufferSizeCallback(m_window, on_framebuffer_size);
   glfwSetWindowSizeCallback(m_window, on_window_size);
   glfwSetCursorPosCallback(m_window, on_cursor_pos);
+  glfwSetWindowFocusCallback(m_window, on_focus);
+  glfwSetCursorEnterCallback(m_window, on_cursor_enter);
+  glfwSetMouseButtonCallback(m_window, on_mouse_button);
   query_sizes_and_cursor();
+  m_focused = glfwGetWindowAttrib(m_window, GLFW_FOCUSED) != 0;
+  m_hovered = glfwGetWindowAttrib(m_window, GLFW_HOVERED) != 0;
 }
 
 void Window::query_sizes_and_cursor() {
@@ -115,6 +120,31 @@ bool Window::mouse_down(int button) const { return glfwGetMouseButton(m_window, 
 void Window::cursor(double* x, double* y) const {
   *x = m_cursor_x;
   *y = m_cursor_y;
+}
+
+void Window::window_size(int* width, int* height) const {
+  *width = m_window_w;
+  *height = m_window_h;
+}
+
+bool Window::take_mouse_pressed(int button) {
+  if (button < 0 || button >= kMouseButtons) return false;
+  const bool pressed = m_mouse_pressed[button];
+  m_mouse_pressed[button] = false;
+  return pressed;
+}
+
+void Window::on_focus(GLFWwindow* w, int focused) {
+  static_cast<Window*>(glfwGetWindowUserPointer(w))->m_focused = focused != 0;
+}
+
+void Window::on_cursor_enter(GLFWwindow* w, int entered) {
+  static_cast<Window*>(glfwGetWindowUserPointer(w))->m_hovered = entered != 0;
+}
+
+void Window::on_mouse_button(GLFWwindow* w, int button, int action, int) {
+  auto* self = static_cast<Window*>(glfwGetWindowUserPointer(w));
+  if (action == GLFW_PRESS && button >= 0 && button < kMouseButtons) self->m_mouse_pressed[button] = true;
 }
 
 void Window::on_framebuffer_size(GLFWwindow* w, int width, int height) {

@@ -46,6 +46,14 @@ class Window {
   bool key_down(int glfw_key) const;
   bool mouse_down(int glfw_button) const;
   void cursor(double* x, double* y) const;
+  // Window size in screen points (zero while minimised).
+  void window_size(int* width, int* height) const;
+  // Whether the window has the keyboard focus / the pointer is over it (kept from callbacks).
+  bool focused() const { return m_focused; }
+  bool hovered() const { return m_hovered; }
+  // Whether the button went down since the last call: a click shorter than a frame still
+  // shows up as held for one frame.
+  bool take_mouse_pressed(int glfw_button);
 
  private:
   static void on_scroll(GLFWwindow* w, double dx, double dy);
@@ -54,6 +62,9 @@ class Window {
   static void on_framebuffer_size(GLFWwindow* w, int width, int height);
   static void on_window_size(GLFWwindow* w, int width, int height);
   static void on_cursor_pos(GLFWwindow* w, double x, double y);
+  static void on_focus(GLFWwindow* w, int focused);
+  static void on_cursor_enter(GLFWwindow* w, int entered);
+  static void on_mouse_button(GLFWwindow* w, int button, int action, int mods);
   void query_sizes_and_cursor();  // the round trips, once: at creation and after resize()
 
   GLFWwindow* m_window = nullptr;
@@ -63,6 +74,9 @@ class Window {
   int m_swap_interval = -1;
   int m_framebuffer_w = 0, m_framebuffer_h = 0, m_window_w = 0, m_window_h = 0;
   double m_cursor_x = 0, m_cursor_y = 0;
+  bool m_focused = false, m_hovered = false;
+  static constexpr int kMouseButtons = 8;  // GLFW_MOUSE_BUTTON_LAST + 1
+  bool m_mouse_pressed[kMouseButtons] = {};
 };
 
 }  // namespace flashgs::viewer
