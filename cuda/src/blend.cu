@@ -103,11 +103,17 @@ __device__ __forceinline__ float exp2_approx(float x) {
 
 // A Gaussian as the EXP2 loop reads it from shared memory: u and v at the region's first
 // pixel (computed once by the lane that loaded it), so a lane's pixel costs one FMA for each.
+// Three 16-byte reads per Gaussian: the colour is read once for both pixels of a lane.
 struct alignas(16) RegionGaussian {
-  float u0, v0, w0, w1;
-  float w2, w3, log2_opacity, red;
-  float green, blue, pad0, pad1;
+  float u0, v0, w1, w3;
+  float w0, w2, log2_opacity, pad0;
+  float red, green, blue, pad1;
 };
+
+// The column a finished pixel moves to: every later Gaussian's alpha there is exactly 0 (q
+// overflows to infinity; a finite factor, so 0 * x stays 0 and no NaN appears), so it adds
+// nothing and keeps its transmittance, the background's weight, without a liveness test.
+constexpr float kFinishedX = 1e30f;
 
 // FlashGS render kernel, a warp per 64-pixel region of a tile: REGION_W x (64 / REGION_W)
 // pixels (16 x 4 strips or 8 x 8 quadrants, four warps per tile), each lane a pair of pixels
@@ -121,9 +127,10 @@ struct alignas(16) RegionGaussian {
 // Gaussian it loaded against the region (exact ellipse-rectangle test of the alpha >= 1/255
 // ellipse, with a margin over the blend's rounding), so the loop visits only Gaussians that
 // can change one of the region's pixels; alpha = exp2(log2 o - q') from the pre-scaled
-// whitened rows, the 1/255 cut made on the exponent, FMAs throughout; a finished pixel folds
-// the background in and sets T = 0, so later Gaussians add exactly nothing to it and no
-// per-pixel liveness test is needed. Otherwise the arithmetic is the CPU's, term for term.
+// whitened rows, the 1/255 cut made on the exponent, FMAs throughout, no branch per pixel
+// (at least one lane of the warp passes the cut on almost every visit, so a branch skipped
+// nothing and cost its own instructions); a finished pixel moves to kFinishedX, so later
+// Gaussians add exactly nothing to it. Otherwise the arithmetic is the CPU's, term for term.
 template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
   constexpr int kRegionH = 64 / REGION_W;
@@ -146,16 +153,15 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const int x0 = static_cast<int>(region_x0) + static_cast<int>(lane % kLanesX) * kLanePixelsX;
   const int y = static_cast<int>(region_y0) + static_cast<int>(lane / kLanesX);
   float lane_x[kLanePixelsX];  // relative to the region's first pixel
-#pragma unroll
-  for (int c = 0; c < kLanePixelsX; ++c) lane_x[c] = static_cast<float>(x0 + c) - region_x0;
   const float lane_y = static_cast<float>(y) - region_y0;
   float t[kLanePixelsX], cr[kLanePixelsX], cg[kLanePixelsX], cb[kLanePixelsX];
   unsigned live = 0;  // bit p: pixel p still blending
 #pragma unroll
   for (int p = 0; p < kLanePixelsX; ++p) {
     cr[p] = cg[p] = cb[p] = 0.0f;
+    t[p] = 1.0f;
     if (x0 + p < a.width && y < a.height) live |= 1u << p;
-    t[p] = (!EXP2 || (live & (1u << p))) ? 1.0f : 0.0f;
+    lane_x[p] = !EXP2 || (live & (1u << p)) ? static_cast<float>(x0 + p) - region_x0 : kFinishedX;
   }
   const unsigned inside = live;
   const uint2 range = a.tile_ranges[tile];
@@ -165,7 +171,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     if constexpr (EXP2) {
       live = 0;
 #pragma unroll
-      for (int p = 0; p < kLanePixelsX; ++p) live |= t[p] > 0.0f ? 1u : 0u;
+      for (int p = 0; p < kLanePixelsX; ++p) live |= lane_x[p] != kFinishedX ? 1u << p : 0u;
     }
     if (!__any_sync(kFullMask, live)) break;
     if (!PIPELINED && base + lane < range.y) next = load_gaussian(a.gaussians + a.values[base + lane]);
@@ -174,8 +180,8 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     if constexpr (EXP2) {
       const float ox = next.mean_x - region_x0, oy = next.mean_y - region_y0;
       batch[warp][lane] = RegionGaussian{-__fmaf_rn(next.w0, ox, next.w1 * oy), -__fmaf_rn(next.w2, ox, next.w3 * oy),
-                                         next.w0, next.w1, next.w2, next.w3, next.opacity, next.red, next.green,
-                                         next.blue, 0.0f, 0.0f};
+                                         next.w1, next.w3, next.w0, next.w2, next.opacity, 0.0f, next.red, next.green,
+                                         next.blue, 0.0f};
       bool meets = false;
       const float cut = (next.opacity - kLog2AlphaMin) * 1.00001f + 1e-4f;  // q' of alpha = 1/255
       if (base + lane < range.y && cut > 0.0f) {
@@ -196,29 +202,25 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       const Staged& g = batch[warp][__ffs(m) - 1];
       if constexpr (EXP2) {
         const float uy = __fmaf_rn(g.w1, lane_y, g.u0), vy = __fmaf_rn(g.w3, lane_y, g.v0);
+        const float red = g.red, green = g.green, blue = g.blue;
 #pragma unroll
         for (int p = 0; p < kLanePixelsX; ++p) {
           const float u = __fmaf_rn(g.w0, lane_x[p], uy), v = __fmaf_rn(g.w2, lane_x[p], vy);
           const float e = __fmaf_rn(-u, u, __fmaf_rn(-v, v, g.log2_opacity));  // log2 alpha
-          if (e >= kLog2AlphaMin) {
-            // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the
-            // FMA gives T (1 - alpha) with one rounding: with 1 - alpha exact (alpha >= 1/2),
-            // the CPU's T, so the stop rule's decisions on stacked opaque layers are its own.
-            const float alpha = fminf(gm::kAlphaMax, exp2_approx(e));
-            const float w = alpha * t[p];
-            const float next_t = __fmaf_rn(-alpha, t[p], t[p]);
-            if (next_t < gm::kTransmittanceMin) {  // finished (or already finished: t = 0, adds 0)
-              cr[p] = __fmaf_rn(t[p], a.background[0], cr[p]);
-              cg[p] = __fmaf_rn(t[p], a.background[1], cg[p]);
-              cb[p] = __fmaf_rn(t[p], a.background[2], cb[p]);
-              t[p] = 0.0f;
-            } else {
-              cr[p] = __fmaf_rn(g.red, w, cr[p]);
-              cg[p] = __fmaf_rn(g.green, w, cg[p]);
-              cb[p] = __fmaf_rn(g.blue, w, cb[p]);
-              t[p] = next_t;
-            }
-          }
+          // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the
+          // FMA gives T (1 - alpha) with one rounding: with 1 - alpha exact (alpha >= 1/2),
+          // the CPU's T, so the stop rule's decisions on stacked opaque layers are its own.
+          const float alpha = e >= kLog2AlphaMin ? fminf(gm::kAlphaMax, exp2_approx(e)) : 0.0f;
+          const float next_t = __fmaf_rn(-alpha, t[p], t[p]);
+          // The CPU stops before a Gaussian that would take T below the minimum: it adds
+          // nothing, and T stays the background's weight (next_t = t >= the minimum after).
+          const bool stop = next_t < gm::kTransmittanceMin;
+          const float w = stop ? 0.0f : alpha * t[p];
+          cr[p] = __fmaf_rn(red, w, cr[p]);
+          cg[p] = __fmaf_rn(green, w, cg[p]);
+          cb[p] = __fmaf_rn(blue, w, cb[p]);
+          t[p] = stop ? t[p] : next_t;
+          lane_x[p] = stop ? kFinishedX : lane_x[p];
         }
       } else {
         // The whole region lies beyond the rows this Gaussian can reach: a warp-uniform skip.

@@ -3,7 +3,7 @@
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench
 #                                       bench-regions bench-large bench-prev bench-cpu profile
-#                                       profile-blend
+#                                       profile-blend profile-sass
 #                                       build-bg wait-build
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
 # cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
@@ -61,9 +61,9 @@ tests() {
   fi
 }
 
-sanitize() {
+sanitize() {  # SANITIZERS: the compute-sanitizer tools (default memcheck racecheck)
   export FLASHGS_SANITIZER_SCENE=pc_biker
-  for tool in memcheck racecheck; do
+  for tool in ${SANITIZERS:-memcheck racecheck}; do
     log "compute-sanitizer $tool"
     if [ $tool = racecheck ]; then export FLASHGS_SANITIZER_QUICK=1; fi
     timeout 300 compute-sanitizer --tool $tool --error-exitcode 9 --print-limit 20 \
@@ -137,6 +137,17 @@ profile_blend() {  # one blend kernel in detail: stall reasons, instruction mix,
   grep -vE "^==|^\s*$|----" "$OUT/ncu_blend.txt" | tail -75
 }
 
+profile_sass() {  # executed instructions per SASS line of the blend kernel (binaries built with -lineinfo)
+  log "ncu sass blend ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-3840x2160}"
+  timeout 240 ncu --section SourceCounters --section InstructionStats -k regex:${PROFILE_KERNEL:-blend_warp} \
+    --launch-skip 3 --launch-count 1 -f -o /tmp/sass_profile "$FLASHGS" render \
+    "$SCENES/${PROFILE_SCENE:-pc_playbot}/point_cloud.ply" --backend cuda -c 10 -r "${PROFILE_RES:-3840x2160}" \
+    --repeat 5 -o /tmp/p.ppm > "$OUT/ncu_sass_run.txt" 2>&1
+  log "ncu rc=$?"
+  ncu --import /tmp/sass_profile.ncu-rep --page source --csv --print-source sass > "$OUT/blend_sass.csv" 2>&1
+  log "sass lines: $(wc -l < "$OUT/blend_sass.csv")"
+}
+
 FLASHGS=$BIN/flashgs
 TESTS=$BIN/test_cuda_render
 for step in "$@"; do
@@ -155,6 +166,7 @@ for step in "$@"; do
     bench-cpu) bench_cpu ;;
     profile) profile ;;
     profile-blend) profile_blend ;;
+    profile-sass) profile_sass ;;
     *) echo "unknown step $step" ;;
   esac
 done
