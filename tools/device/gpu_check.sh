@@ -137,15 +137,17 @@ profile_blend() {  # one blend kernel in detail: stall reasons, instruction mix,
   grep -vE "^==|^\s*$|----" "$OUT/ncu_blend.txt" | tail -75
 }
 
-profile_sass() {  # executed instructions per SASS line of the blend kernel (binaries built with -lineinfo)
-  log "ncu sass blend ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-3840x2160}"
-  timeout 240 ncu --section SourceCounters --section InstructionStats -k regex:${PROFILE_KERNEL:-blend_warp} \
-    --launch-skip 3 --launch-count 1 -f -o /tmp/sass_profile "$FLASHGS" render \
-    "$SCENES/${PROFILE_SCENE:-pc_playbot}/point_cloud.ply" --backend cuda -c 10 -r "${PROFILE_RES:-3840x2160}" \
-    --repeat 5 -o /tmp/p.ppm > "$OUT/ncu_sass_run.txt" 2>&1
-  log "ncu rc=$?"
-  ncu --import /tmp/sass_profile.ncu-rep --page source --csv --print-source sass > "$OUT/blend_sass.csv" 2>&1
-  log "sass lines: $(wc -l < "$OUT/blend_sass.csv")"
+profile_sass() {  # executed instructions per SASS line of PROFILE_KERNELS (binaries built with -lineinfo)
+  for kernel in ${PROFILE_KERNELS:-blend_warp}; do
+    log "ncu sass $kernel ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-3840x2160}"
+    timeout 240 ncu --section SourceCounters --section InstructionStats -k regex:"$kernel" \
+      --launch-skip 3 --launch-count 1 -f -o /tmp/sass_profile "$FLASHGS" render \
+      "$SCENES/${PROFILE_SCENE:-pc_playbot}/point_cloud.ply" --backend cuda -c 10 -r "${PROFILE_RES:-3840x2160}" \
+      --repeat 5 -o /tmp/p.ppm > "$OUT/ncu_sass_run_$kernel.txt" 2>&1
+    log "ncu rc=$?"
+    ncu --import /tmp/sass_profile.ncu-rep --page source --csv --print-source sass > "$OUT/sass_$kernel.csv" 2>&1
+    log "sass lines: $(wc -l < "$OUT/sass_$kernel.csv")"
+  done
 }
 
 FLASHGS=$BIN/flashgs

@@ -71,6 +71,10 @@ struct Footprint {
   // q >= 0 by construction (the conic form goes slightly negative on a needle's axis, where
   // 3DGS's "skip power > 0" then drops the Gaussian at its most opaque pixels).
   float whiten[4];
+  // Where q is smallest along a vertical edge at offset dx: dy = edge_slope_x * dx
+  // (= -conic_b / conic_c); along a horizontal edge: dx = edge_slope_y * dy. Divided once here,
+  // not in each tile test.
+  float edge_slope_x, edge_slope_y;
 };
 
 FLASHGS_HD float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
@@ -281,6 +285,8 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
   out.whiten[1] = w1;
   out.whiten[2] = w2;
   out.whiten[3] = w3;
+  out.edge_slope_x = -out.conic_b / out.conic_c;
+  out.edge_slope_y = -out.conic_b / out.conic_a;
   out.threshold = threshold;
   return kVisible;
 }
@@ -315,25 +321,23 @@ FLASHGS_HD float whitened_q(const float w[4], float dx, float dy) {
 }
 
 // ellipse_meets_rect for the whitened form: the same edge minimisation (the minimiser along
-// an edge comes from the conic W^T W, where a small error only moves it along a flat
-// valley), but q itself evaluated without cancellation, so that tiles thousands of pixels
-// along a needle are decided correctly.
-FLASHGS_HD bool whitened_ellipse_meets_rect(const float w[4], float t, float dx0, float dx1, float dy0,
-                                            float dy1) {
+// an edge, edge_slope_* times the edge's offset, comes from the conic W^T W, where a small
+// error only moves it along a flat valley: q changes to second order), but q itself
+// evaluated without cancellation, so that tiles thousands of pixels along a needle are
+// decided correctly.
+FLASHGS_HD bool whitened_ellipse_meets_rect(const float w[4], float edge_slope_x, float edge_slope_y, float t,
+                                            float dx0, float dx1, float dy0, float dy1) {
   const bool inside_x = dx0 <= 0.0f && dx1 >= 0.0f;
   const bool inside_y = dy0 <= 0.0f && dy1 >= 0.0f;
   if (inside_x && inside_y) return true;
-  const float a = w[0] * w[0] + w[2] * w[2];
-  const float b = w[0] * w[1] + w[2] * w[3];
-  const float c = w[1] * w[1] + w[3] * w[3];
   if (!inside_x) {
     const float dx = dx0 > 0.0f ? dx0 : dx1;
-    const float dy = clampf(-b * dx / c, dy0, dy1);
+    const float dy = clampf(edge_slope_x * dx, dy0, dy1);
     if (whitened_q(w, dx, dy) <= t) return true;
   }
   if (!inside_y) {
     const float dy = dy0 > 0.0f ? dy0 : dy1;
-    const float dx = clampf(-b * dy / a, dx0, dx1);
+    const float dx = clampf(edge_slope_y * dy, dx0, dx1);
     if (whitened_q(w, dx, dy) <= t) return true;
   }
   return false;
@@ -346,7 +350,7 @@ FLASHGS_HD bool footprint_touches_tile(const Footprint& f, int tx, int ty, int w
   const float y0 = static_cast<float>(ty * kTileSize);
   const float x1 = minf(x0 + (kTileSize - 1), static_cast<float>(width - 1));
   const float y1 = minf(y0 + (kTileSize - 1), static_cast<float>(height - 1));
-  return whitened_ellipse_meets_rect(f.whiten, f.threshold, x0 - f.mean_x, x1 - f.mean_x, y0 - f.mean_y,
+  return whitened_ellipse_meets_rect(f.whiten, f.edge_slope_x, f.edge_slope_y, f.threshold, x0 - f.mean_x, x1 - f.mean_x, y0 - f.mean_y,
                                      y1 - f.mean_y);
 }
 
