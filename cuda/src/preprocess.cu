@@ -60,24 +60,81 @@ __device__ __forceinline__ bool touches(const gm::Footprint& f, int tx, int ty, 
   return !exact || gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height);
 }
 
+// A segment of up to 32 chunks of 32 tiles of a box (tiles counted row-major from the box's
+// first), walked by a warp: lane j handles tile s0 + 32 c + j of chunk c. The tile's column
+// and row advance by a fixed step per chunk, so only the first costs integer divisions.
+struct BoxWalk {
+  unsigned box, box_w;   // tiles in the box, tiles per box row
+  unsigned step_x, step_y;  // 32 tiles further: columns and rows to add
+  __device__ BoxWalk(const gm::Footprint& g)
+      : box(static_cast<unsigned>(g.tile_x1 - g.tile_x0) * static_cast<unsigned>(g.tile_y1 - g.tile_y0)),
+        box_w(static_cast<unsigned>(g.tile_x1 - g.tile_x0)),
+        step_x(kWarp % box_w),
+        step_y(kWarp / box_w) {}
+  __device__ unsigned chunks(unsigned s0) const { return min(static_cast<unsigned>(kWarp), (box - s0 + kWarp - 1) / kWarp); }
+  // Column and row (in the box) of tile s0 + lane.
+  __device__ void start(unsigned s0, unsigned lane, unsigned& x, unsigned& y) const {
+    const unsigned t = s0 + lane;
+    x = t % box_w;
+    y = t / box_w;
+  }
+  __device__ void advance(unsigned& x, unsigned& y) const {
+    x += step_x;
+    y += step_y;
+    if (x >= box_w) {
+      x -= box_w;
+      ++y;
+    }
+  }
+};
+
+// Tests the segment at s0 (all lanes call with the same footprint); lane c returns chunk c's
+// ballot of passing tiles.
+__device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
+                                      const gm::CameraParams& cam, bool exact) {
+  const unsigned lane = lane_id();
+  const unsigned chunks = walk.chunks(s0);
+  unsigned x, y;
+  walk.start(s0, lane, x, y);
+  unsigned my_ballot = 0;
+  for (unsigned c = 0; c < chunks; ++c) {
+    const bool pass = s0 + c * kWarp + lane < walk.box &&
+                      touches(g, g.tile_x0 + static_cast<int>(x), g.tile_y0 + static_cast<int>(y), cam, exact);
+    const unsigned ballot = __ballot_sync(kFullMask, pass);
+    if (lane == c) my_ballot = ballot;
+    walk.advance(x, y);
+  }
+  return my_ballot;
+}
+
+// Writes the segment's passing tiles; lane c holds chunk c's ballot and its first offset.
+__device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
+                                   unsigned my_ballot, unsigned long long my_base, std::uint32_t depth_bits,
+                                   unsigned id, const gm::CameraParams& cam) {
+  const unsigned lane = lane_id();
+  const unsigned lanes_below = (1u << lane) - 1u;
+  const unsigned chunks = walk.chunks(s0);
+  unsigned x, y;
+  walk.start(s0, lane, x, y);
+  for (unsigned c = 0; c < chunks; ++c) {
+    const unsigned ballot = __shfl_sync(kFullMask, my_ballot, c);
+    const unsigned long long chunk_base = __shfl_sync(kFullMask, my_base, c);
+    if (ballot & (1u << lane))
+      store_pair(buf, chunk_base + __popc(ballot & lanes_below),
+                 static_cast<unsigned>(g.tile_y0 + static_cast<int>(y)) * cam.tiles_x + g.tile_x0 + x, depth_bits, id);
+    walk.advance(x, y);
+  }
+}
+
 // The pairs of one Gaussian's box, emitted by the whole warp (all lanes call with the same
-// footprint); returns how many were wanted.
+// footprint), one atomic per segment; returns how many were wanted.
 __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g, std::uint32_t depth_bits,
                                   unsigned id, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
-  const unsigned lanes_below = (1u << lane) - 1u;
-  const unsigned box_w = static_cast<unsigned>(g.tile_x1 - g.tile_x0);
-  const unsigned box = box_w * static_cast<unsigned>(g.tile_y1 - g.tile_y0);
+  const BoxWalk walk(g);
   unsigned total = 0;
-  for (unsigned s0 = 0; s0 < box; s0 += kWarp * kWarp) {
-    const unsigned chunks = min(static_cast<unsigned>(kWarp), (box - s0 + kWarp - 1) / kWarp);
-    unsigned my_ballot = 0;  // lane c: chunk c of this segment
-    for (unsigned c = 0; c < chunks; ++c) {
-      const unsigned t = s0 + c * kWarp + lane;
-      const bool pass = t < box && touches(g, g.tile_x0 + t % box_w, g.tile_y0 + t / box_w, cam, exact);
-      const unsigned ballot = __ballot_sync(kFullMask, pass);
-      if (lane == c) my_ballot = ballot;
-    }
+  for (unsigned s0 = 0; s0 < walk.box; s0 += kWarp * kWarp) {
+    const unsigned my_ballot = warp_test_segment(g, walk, s0, cam, exact);
     const unsigned my_count = __popc(my_ballot);
     const unsigned inclusive = warp_inclusive_sum(my_count);
     const unsigned segment_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -85,15 +142,7 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
     unsigned long long base = 0;
     if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
     base = __shfl_sync(kFullMask, base, 0) + (inclusive - my_count);  // lane c: chunk c's offset
-    for (unsigned c = 0; c < chunks; ++c) {
-      const unsigned ballot = __shfl_sync(kFullMask, my_ballot, c);
-      const unsigned long long chunk_base = __shfl_sync(kFullMask, base, c);
-      if (ballot & (1u << lane)) {
-        const unsigned t = s0 + c * kWarp + lane;
-        store_pair(buf, chunk_base + __popc(ballot & lanes_below),
-                   (g.tile_y0 + t / box_w) * cam.tiles_x + g.tile_x0 + t % box_w, depth_bits, id);
-      }
-    }
+    warp_write_segment(buf, g, walk, s0, my_ballot, base, depth_bits, id, cam);
     total += segment_total;
   }
   return total;
@@ -256,19 +305,57 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   }
 }
 
-// The deferred large Gaussians: a warp per Gaussian, spread over every warp of the grid.
+// The deferred large Gaussians: a warp per Gaussian, spread over every warp of the grid. A
+// warp tests up to kLargeBatch of its Gaussians before it reserves all their pairs with one
+// atomic: a wait on the contended pair counter for each Gaussian held the kernel back. Boxes
+// of more than one segment (huge ones the huge list had no room for) go through
+// warp_emit_box on their own.
+constexpr int kLargeBatch = 4;
 __global__ void __launch_bounds__(kBlock) large_emit_kernel(FrameBuffers buf, gm::CameraParams cam, bool exact) {
   const unsigned count = min(buf.counters->large, buf.large.capacity);
   constexpr unsigned kWarps = kBlock / kWarp;
-  const unsigned first = blockIdx.x * kWarps + threadIdx.x / kWarp;
+  const unsigned lane = lane_id();
+  const unsigned stride = gridDim.x * kWarps;
   unsigned visible = 0, offscreen = 0;
-  for (unsigned k = first; k < count; k += gridDim.x * kWarps) {
-    const gm::Footprint f = buf.large.footprints[k];
-    const unsigned total = warp_emit_box(buf, f, sort_depth(buf.key_format, f.depth), buf.large.ids[k], cam, exact);
-    if (total > 0) ++visible;
-    else ++offscreen;
+  for (unsigned k0 = blockIdx.x * kWarps + threadIdx.x / kWarp; k0 < count; k0 += kLargeBatch * stride) {
+    unsigned my_ballot[kLargeBatch], my_offset[kLargeBatch];  // lane c: chunk c's ballot, offset in the batch
+    unsigned batch_total = 0;
+#pragma unroll
+    for (int j = 0; j < kLargeBatch; ++j) {
+      const unsigned k = k0 + j * stride;
+      my_ballot[j] = 0;
+      unsigned emitted = 0;  // by warp_emit_box, for a box of several segments
+      if (k < count) {
+        const gm::Footprint f = buf.large.footprints[k];
+        const BoxWalk walk(f);
+        if (walk.box <= kWarp * kWarp) my_ballot[j] = warp_test_segment(f, walk, 0, cam, exact);
+        else emitted = warp_emit_box(buf, f, sort_depth(buf.key_format, f.depth), buf.large.ids[k], cam, exact);
+      }
+      const unsigned my_count = __popc(my_ballot[j]);
+      const unsigned inclusive = warp_inclusive_sum(my_count);
+      my_offset[j] = batch_total + inclusive - my_count;
+      const unsigned total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
+      batch_total += total;
+      if (k < count) {
+        if (total + emitted > 0) ++visible;
+        else ++offscreen;
+      }
+    }
+    if (batch_total == 0) continue;
+    unsigned long long base = 0;
+    if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(batch_total));
+    base = __shfl_sync(kFullMask, base, 0);
+#pragma unroll
+    for (int j = 0; j < kLargeBatch; ++j) {
+      const unsigned k = k0 + j * stride;
+      if (k >= count) break;
+      if (!__any_sync(kFullMask, my_ballot[j] != 0)) continue;  // nothing passed (or emitted already)
+      const gm::Footprint f = buf.large.footprints[k];
+      warp_write_segment(buf, f, BoxWalk(f), 0, my_ballot[j], base + my_offset[j],
+                         sort_depth(buf.key_format, f.depth), buf.large.ids[k], cam);
+    }
   }
-  if (lane_id() == 0) {
+  if (lane == 0) {
     if (visible) atomicAdd(&buf.counters->visible, visible);
     if (offscreen) atomicAdd(&buf.counters->culled_offscreen, offscreen);
   }
