@@ -16,47 +16,9 @@ __device__ __forceinline__ std::uint64_t blend_order(const BlendGaussian* gaussi
   return (static_cast<std::uint64_t>(__float_as_uint(gaussians[id].depth)) << 32) | id;
 }
 
-// Compare-exchange of two register slots (constant indices keep the arrays in registers).
-__device__ __forceinline__ void order_pair(std::uint64_t* key, std::uint32_t* id, int a, int b) {
-  if (key[b] < key[a]) {
-    const std::uint64_t k = key[a];
-    key[a] = key[b];
-    key[b] = k;
-    const std::uint32_t i = id[a];
-    id[a] = id[b];
-    id[b] = i;
-  }
-}
-
-// A run of at most 8 (nearly all of them): the depths are loaded at once and sorted in
-// registers by Batcher's 19-comparator network; insertion sort made one dependent global
-// load per comparison, and the few threads holding runs set the kernel's length.
-__device__ void sort_short_run(std::uint32_t* v, unsigned n, const BlendGaussian* gaussians) {
-  constexpr int kMax = 8;
-  std::uint64_t key[kMax];
-  std::uint32_t id[kMax];
-#pragma unroll
-  for (int k = 0; k < kMax; ++k) {
-    id[k] = k < static_cast<int>(n) ? v[k] : 0u;
-    key[k] = k < static_cast<int>(n) ? blend_order(gaussians, id[k]) : ~std::uint64_t{0};
-  }
-  constexpr int kNetwork[19][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3}, {4, 6}, {5, 7}, {1, 2}, {5, 6},
-                                   {0, 4}, {3, 7}, {1, 5}, {2, 6}, {1, 4}, {3, 6}, {2, 4}, {3, 5}, {3, 4}};
-#pragma unroll
-  for (int c = 0; c < 19; ++c) order_pair(key, id, kNetwork[c][0], kNetwork[c][1]);
-#pragma unroll
-  for (int k = 0; k < kMax; ++k)
-    if (k < static_cast<int>(n)) v[k] = id[k];
-}
-
-// Sorts a run of ids in place by blend_order: the register network for the usual short run,
-// insertion sort up to 16, heap sort for the long runs of a planar scene seen head-on, where
-// insertion would be quadratic.
+// Sorts a run of ids in place by blend_order: insertion sort for the usual run of 2-3, heap
+// sort for the long runs of a planar scene seen head-on, where insertion would be quadratic.
 __device__ void sort_run(std::uint32_t* v, unsigned n, const BlendGaussian* gaussians) {
-  if (n <= 8) {
-    sort_short_run(v, n, gaussians);
-    return;
-  }
   if (n <= 16) {
     for (unsigned a = 1; a < n; ++a) {
       const std::uint32_t x = v[a];
