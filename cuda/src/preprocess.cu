@@ -148,6 +148,108 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
   return total;
 }
 
+// The small boxes of a warp's Gaussians (at most kWarp tiles each), tested and emitted by the
+// whole warp over their concatenation, 32 tiles per step: a thread looping over its own box
+// left most lanes idle while the warp's largest box finished (2-7 of 32 lanes active).
+// What a lane's tile test needs of its owner is staged in shared memory.
+struct alignas(16) SmallBox {
+  float4 whiten;
+  float edge_slope_x, edge_slope_y, threshold, mean_x;
+  float mean_y;
+  int tile_x0, tile_y0, box_w;
+  unsigned start, row_magic, id, depth_bits;  // row_magic: ceil(2^16 / box_w), t / box_w = (t row_magic) >> 16
+};
+constexpr int kSmallTilesPerWarp = kWarp * kWarp;
+
+struct SmallBoxScratch {
+  SmallBox boxes[kWarp];
+  unsigned char owner[kSmallTilesPerWarp];  // concatenated tile -> the lane whose box holds it
+};
+
+// Tile t of the box (row-major from its first tile): t < kSmallTilesPerWarp and box_w <= kWarp
+// keep (t row_magic) >> 16 exact (the magic's excess times t stays below 1/box_w).
+__device__ __forceinline__ void small_box_tile(const SmallBox& b, unsigned t, int& tx, int& ty) {
+  const unsigned row = (t * b.row_magic) >> 16;
+  tx = b.tile_x0 + static_cast<int>(t - row * static_cast<unsigned>(b.box_w));
+  ty = b.tile_y0 + static_cast<int>(row);
+}
+
+// All lanes call; my_box: this lane's box size (0: nothing to emit here). Returns this lane's
+// pair count.
+__device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers& buf, const gm::Footprint& f,
+                                          unsigned my_box, std::uint32_t depth_bits, unsigned id,
+                                          const gm::CameraParams& cam) {
+  const unsigned lane = lane_id();
+  const unsigned inclusive = warp_inclusive_sum(my_box);
+  const unsigned start = inclusive - my_box, total_tiles = __shfl_sync(kFullMask, inclusive, kWarp - 1);
+  if (total_tiles == 0) return 0;
+  if (my_box > 0) {
+    const int box_w = f.tile_x1 - f.tile_x0;
+    s.boxes[lane] = SmallBox{make_float4(f.whiten[0], f.whiten[1], f.whiten[2], f.whiten[3]),
+                             f.edge_slope_x, f.edge_slope_y, f.threshold, f.mean_x, f.mean_y, f.tile_x0, f.tile_y0,
+                             box_w, start, (65536u + static_cast<unsigned>(box_w) - 1u) / static_cast<unsigned>(box_w),
+                             id, depth_bits};
+    for (unsigned t = 0; t < my_box; ++t) s.owner[start + t] = static_cast<unsigned char>(lane);
+  }
+  __syncwarp();
+  // Test: lane c keeps step c's ballot.
+  const unsigned steps = (total_tiles + kWarp - 1) / kWarp;
+  unsigned my_ballot = 0;
+  for (unsigned c = 0; c < steps; ++c) {
+    const unsigned g = c * kWarp + lane;
+    bool pass = false;
+    if (g < total_tiles) {
+      const SmallBox& b = s.boxes[s.owner[g]];
+      int tx, ty;
+      small_box_tile(b, g - b.start, tx, ty);
+      const float w[4] = {b.whiten.x, b.whiten.y, b.whiten.z, b.whiten.w};
+      pass = gm::ellipse_touches_tile(w, b.edge_slope_x, b.edge_slope_y, b.threshold, b.mean_x, b.mean_y, tx, ty,
+                                      cam.width, cam.height);
+    }
+    const unsigned ballot = __ballot_sync(kFullMask, pass);
+    if (lane == c) my_ballot = ballot;
+  }
+  // This lane's count: the bits of its range [start, start + my_box), in at most two steps.
+  unsigned my_count = 0;
+  {
+    const unsigned first_step = start / kWarp, last_step = (start + (my_box > 0 ? my_box : 1) - 1) / kWarp;
+    const unsigned b0 = __shfl_sync(kFullMask, my_ballot, first_step & (kWarp - 1));
+    const unsigned b1 = __shfl_sync(kFullMask, my_ballot, last_step & (kWarp - 1));
+    if (my_box > 0) {
+      const unsigned lo = start % kWarp;
+      if (first_step == last_step) {
+        const unsigned mask = (my_box == kWarp ? 0xffffffffu : ((1u << my_box) - 1u)) << lo;
+        my_count = __popc(b0 & mask);
+      } else {
+        my_count = __popc(b0 & (0xffffffffu << lo)) + __popc(b1 & ((1u << ((start + my_box) % kWarp)) - 1u));
+      }
+    }
+  }
+  // One atomic for the warp, then each step's pairs at its offset.
+  const unsigned step_count = __popc(my_ballot);
+  const unsigned step_inclusive = warp_inclusive_sum(step_count);
+  const unsigned total = __shfl_sync(kFullMask, step_inclusive, kWarp - 1);
+  if (total == 0) return my_count;
+  unsigned long long base = 0;
+  if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(total));
+  base = __shfl_sync(kFullMask, base, 0) + (step_inclusive - step_count);  // lane c: step c's offset
+  const unsigned lanes_below = (1u << lane) - 1u;
+  for (unsigned c = 0; c < steps; ++c) {
+    const unsigned ballot = __shfl_sync(kFullMask, my_ballot, c);
+    const unsigned long long step_base = __shfl_sync(kFullMask, base, c);
+    if (ballot & (1u << lane)) {
+      const SmallBox& b = s.boxes[s.owner[c * kWarp + lane]];
+      int tx, ty;
+      small_box_tile(b, c * kWarp + lane - b.start, tx, ty);
+      store_pair(buf, step_base + __popc(ballot & lanes_below),
+                 static_cast<unsigned>(ty) * static_cast<unsigned>(cam.tiles_x) + static_cast<unsigned>(tx),
+                 b.depth_bits, b.id);
+    }
+  }
+  __syncwarp();  // the scratch is free again
+  return my_count;
+}
+
 // One thread per Gaussian. FUSED: keys are written here (FlashGS); otherwise the footprint
 // and the pair count are stored for the separate prefix sum + duplicate pass (3DGS).
 template <int DEGREE, bool FUSED>
@@ -168,6 +270,9 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   unsigned passed_mask = 0;    // tiles of a box of <= 32 tiles that passed the exact test
   bool large = false;          // emitted by a whole warp (large_emit_kernel, or below)
   bool deferred = false;       // emitted and counted by large_emit_kernel or huge_emit_kernel
+  // The flash path: boxes of at most large_box_tiles <= 32 tiles tested by the whole warp.
+  const bool balanced = FUSED && args.warp_cooperative && args.exact_tile_test && args.large_box_tiles <= kWarp;
+  unsigned small_box = 0;
   if (valid) {
     const float4 po = __ldg(scene.position_opacity + i);
     const float4 q = __ldg(scene.rotation + i);
@@ -216,6 +321,8 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
         large = true;
       } else if (!args.exact_tile_test) {
         count = box;
+      } else if (balanced) {
+        small_box = box;
       } else {
         unsigned k = 0;
         for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
@@ -230,13 +337,15 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
 
   if constexpr (FUSED) {
     const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
+    __shared__ SmallBoxScratch small_scratch[kBlock / kWarp];
+    if (balanced) count = warp_emit_small_boxes(small_scratch[threadIdx.x / kWarp], buf, f, small_box, depth_bits, i, cam);
     // Thread-emitted Gaussians: one atomic per warp reserves all their pairs.
-    const unsigned inclusive = warp_inclusive_sum(count);
+    const unsigned inclusive = warp_inclusive_sum(balanced ? 0u : count);
     const unsigned warp_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
     unsigned long long base = 0;
     if (lane == kWarp - 1 && warp_total > 0) base = atomicAdd(&buf.counters->pairs, warp_total);
     base = __shfl_sync(kFullMask, base, kWarp - 1);
-    if (count > 0) {
+    if (!balanced && count > 0) {
       unsigned long long offset = base + inclusive - count;
       const int box_w = f.tile_x1 - f.tile_x0;
       const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);

@@ -344,14 +344,21 @@ FLASHGS_HD bool whitened_ellipse_meets_rect(const float w[4], float edge_slope_x
 }
 
 // The exact test for tile (tx, ty): the rectangle spanned by its pixel centres, clipped to
-// the image.
-FLASHGS_HD bool footprint_touches_tile(const Footprint& f, int tx, int ty, int width, int height) {
+// the image. The parts of a Footprint it reads are passed one by one for callers that keep
+// only those.
+FLASHGS_HD bool ellipse_touches_tile(const float whiten[4], float edge_slope_x, float edge_slope_y, float threshold,
+                                     float mean_x, float mean_y, int tx, int ty, int width, int height) {
   const float x0 = static_cast<float>(tx * kTileSize);
   const float y0 = static_cast<float>(ty * kTileSize);
   const float x1 = minf(x0 + (kTileSize - 1), static_cast<float>(width - 1));
   const float y1 = minf(y0 + (kTileSize - 1), static_cast<float>(height - 1));
-  return whitened_ellipse_meets_rect(f.whiten, f.edge_slope_x, f.edge_slope_y, f.threshold, x0 - f.mean_x, x1 - f.mean_x, y0 - f.mean_y,
-                                     y1 - f.mean_y);
+  return whitened_ellipse_meets_rect(whiten, edge_slope_x, edge_slope_y, threshold, x0 - mean_x, x1 - mean_x,
+                                     y0 - mean_y, y1 - mean_y);
+}
+
+FLASHGS_HD bool footprint_touches_tile(const Footprint& f, int tx, int ty, int width, int height) {
+  return ellipse_touches_tile(f.whiten, f.edge_slope_x, f.edge_slope_y, f.threshold, f.mean_x, f.mean_y, tx, ty,
+                              width, height);
 }
 
 // Real spherical harmonics constants (degree 0..3) of the 3DGS colour model.
