@@ -210,6 +210,50 @@ exit $status
 #endif
 }
 
+// A real mouse click (XTEST) on the panel's "Compare this view" button runs the comparison:
+// ImGui's mouse position and buttons reach it through the viewer's own platform inputs.
+TEST(Viewer, MouseClickOnAPanelButtonWorks) {
+#ifndef FLASHGS_X11_CLICK
+  GTEST_SKIP() << "built without libXtst: the click helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string dir = out_dir();
+  const std::string log = dir + "/click_viewer.log", script = dir + "/click_test.sh";
+  {
+    FILE* f = std::fopen(script.c_str(), "w");
+    ASSERT_TRUE(f);
+    // The button's place in a 1280x720 window at UI scale 1 (the panel layout is fixed).
+    std::fputs(R"sh(viewer=$1 click=$2 log=$3
+"$viewer" --backend cpu --size 1280x720 > "$log" 2>&1 &
+pid=$!
+wait_for() {  # a line in the viewer's log, while the viewer runs (up to 60 s)
+  for _ in $(seq 1 600); do grep -qF -- "$1" "$log" && return 0; kill -0 $pid 2>/dev/null || return 1; sleep 0.1; done
+  return 1
+}
+status=0
+wait_for "Gaussians, SH degree" || status=10
+[ $status -eq 0 ] && { sleep 1; "$click" 95 650 || status=11; }
+[ $status -eq 0 ] && { wait_for "compare flash vs baseline" || status=12; }
+kill -0 $pid 2>/dev/null || status=13
+kill $pid 2>/dev/null
+wait $pid 2>/dev/null
+exit $status
+)sh", f);
+    std::fclose(f);
+  }
+  const RunResult r = run(prefix + "bash " + script + " " + viewer() + " " + FLASHGS_X11_CLICK + " " + log);
+  std::string viewer_log;
+  if (FILE* f = std::fopen(log.c_str(), "r")) {
+    char line[1024];
+    while (std::fgets(line, sizeof line, f)) viewer_log += line;
+    std::fclose(f);
+  }
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 no comparison, 13 crash)\n"
+                            << r.output << viewer_log;
+#endif
+}
+
 // The heat-map shader draws over the frame, and its legend runs from blue (0) to red (max).
 TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
   REQUIRE_DISPLAY(prefix);
