@@ -67,6 +67,23 @@ std::string display_prefix() {
   const std::string prefix = display_prefix();                                                  \
   if (prefix.empty()) GTEST_SKIP() << "no X display and no xvfb-run (install xvfb): viewer test skipped"
 
+// Runs a shell script (written to `script`) that drives a running viewer whose output goes to
+// `log`; returns the script's result with the viewer's log appended to its output.
+RunResult run_viewer_script(const std::string& prefix, const std::string& script, const char* text,
+                            const std::string& args, const std::string& log) {
+  if (FILE* f = std::fopen(script.c_str(), "w")) {
+    std::fputs(text, f);
+    std::fclose(f);
+  }
+  RunResult r = run(prefix + "bash " + script + " " + args);
+  if (FILE* f = std::fopen(log.c_str(), "r")) {
+    char line[1024];
+    while (std::fgets(line, sizeof line, f)) r.output += line;
+    std::fclose(f);
+  }
+  return r;
+}
+
 std::string viewer() { return FLASHGS_VIEWER; }
 std::string cli() { return FLASHGS_CLI; }
 
@@ -173,10 +190,7 @@ TEST(Viewer, DroppedFilesOpenAndABadOneKeepsTheViewerRunning) {
                              std::filesystem::copy_options::overwrite_existing);
   std::filesystem::remove(bad);
   const std::string script = dir + "/drop_test.sh";
-  {
-    FILE* f = std::fopen(script.c_str(), "w");
-    ASSERT_TRUE(f);
-    std::fputs(R"sh(viewer=$1 drop=$2 good=$3 bad=$4 log=$5
+  const char* text = R"sh(viewer=$1 drop=$2 good=$3 bad=$4 log=$5
 "$viewer" --backend cpu --size 800x450 > "$log" 2>&1 &
 pid=$!
 wait_for() {  # a line in the viewer's log, while the viewer runs (up to 60 s)
@@ -194,19 +208,11 @@ kill -0 $pid 2>/dev/null || status=15
 kill $pid 2>/dev/null
 wait $pid 2>/dev/null
 exit $status
-)sh", f);
-    std::fclose(f);
-  }
-  const RunResult r = run(prefix + "bash " + script + " " + viewer() + " " + FLASHGS_X11_DROP + " " + good + " " + bad +
-                          " " + log);
-  std::string viewer_log;
-  if (FILE* f = std::fopen(log.c_str(), "r")) {
-    char line[1024];
-    while (std::fgets(line, sizeof line, f)) viewer_log += line;
-    std::fclose(f);
-  }
+)sh";
+  const RunResult r = run_viewer_script(prefix, script, text,
+                                        viewer() + " " + FLASHGS_X11_DROP + " " + good + " " + bad + " " + log, log);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11/13 drop, 12 load, 14 error, 15 crash)\n"
-                            << r.output << viewer_log;
+                            << r.output;
 #endif
 }
 
@@ -220,11 +226,8 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   const std::string dir = out_dir();
   const std::string log = dir + "/click_viewer.log", script = dir + "/click_test.sh";
-  {
-    FILE* f = std::fopen(script.c_str(), "w");
-    ASSERT_TRUE(f);
-    // The button's place in a 1280x720 window at UI scale 1 (the panel layout is fixed).
-    std::fputs(R"sh(viewer=$1 click=$2 log=$3
+  // The button's place in a 1280x720 window at UI scale 1 (the panel layout is fixed).
+  const char* text = R"sh(viewer=$1 click=$2 log=$3
 "$viewer" --backend cpu --size 1280x720 > "$log" 2>&1 &
 pid=$!
 wait_for() {  # a line in the viewer's log, while the viewer runs (up to 60 s)
@@ -239,18 +242,10 @@ kill -0 $pid 2>/dev/null || status=13
 kill $pid 2>/dev/null
 wait $pid 2>/dev/null
 exit $status
-)sh", f);
-    std::fclose(f);
-  }
-  const RunResult r = run(prefix + "bash " + script + " " + viewer() + " " + FLASHGS_X11_CLICK + " " + log);
-  std::string viewer_log;
-  if (FILE* f = std::fopen(log.c_str(), "r")) {
-    char line[1024];
-    while (std::fgets(line, sizeof line, f)) viewer_log += line;
-    std::fclose(f);
-  }
+)sh";
+  const RunResult r = run_viewer_script(prefix, script, text, viewer() + " " + FLASHGS_X11_CLICK + " " + log, log);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 no comparison, 13 crash)\n"
-                            << r.output << viewer_log;
+                            << r.output;
 #endif
 }
 
