@@ -14,6 +14,7 @@
 namespace flashgs::viewer {
 
 ImGuiLayer::ImGuiLayer(Window& window, float ui_scale) : m_window(window) {
+  static_assert(kCursorShapes == ImGuiMouseCursor_COUNT, "one GLFW cursor slot per ImGui cursor shape");
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGuiIO& io = ImGui::GetIO();

@@ -27,7 +27,8 @@ class ImGuiLayer {
   Window& m_window;
   double m_last_time = 0;
   int m_cursor_shape = -1;           // the ImGuiMouseCursor last applied
-  GLFWcursor* m_cursors[9] = {};     // per ImGuiMouseCursor; null: GLFW's default arrow
+  static constexpr int kCursorShapes = 9;  // ImGuiMouseCursor_COUNT (checked where imgui.h is seen)
+  GLFWcursor* m_cursors[kCursorShapes] = {};  // per ImGuiMouseCursor; null: GLFW's default arrow
 };
 
 }  // namespace flashgs::viewer
