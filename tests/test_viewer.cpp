@@ -67,15 +67,31 @@ std::string display_prefix() {
   const std::string prefix = display_prefix();                                                  \
   if (prefix.empty()) GTEST_SKIP() << "no X display and no xvfb-run (install xvfb): viewer test skipped"
 
-// Runs a shell script (written to `script`) that drives a running viewer whose output goes to
-// `log`; returns the script's result with the viewer's log appended to its output.
-RunResult run_viewer_script(const std::string& prefix, const std::string& script, const char* text,
-                            const std::string& args, const std::string& log) {
+// Starts the viewer (`viewer_args`, output to `log`) in the background and runs `steps`, shell
+// lines that drive it (`$helper` is `helper`, `wait_for TEXT` waits up to 60 s for a line of
+// its log, and a failing step sets `status`); the script then exits with `crash_status` if the
+// viewer is gone, else with `status`. Returns its result with the viewer's log appended.
+RunResult run_live_viewer(const std::string& prefix, const std::string& script, const std::string& viewer_args,
+                          const std::string& helper, const std::string& steps, int crash_status,
+                          const std::string& log) {
   if (FILE* f = std::fopen(script.c_str(), "w")) {
-    std::fputs(text, f);
+    std::fputs(("viewer=$1 helper=$2 log=$3\n"
+                "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
+                "pid=$!\n"
+                "wait_for() {\n"
+                "  for _ in $(seq 1 600); do grep -qF -- \"$1\" \"$log\" && return 0; kill -0 $pid 2>/dev/null || return 1; "
+                "sleep 0.1; done\n"
+                "  return 1\n"
+                "}\n"
+                "status=0\n" + steps +
+                "kill -0 $pid 2>/dev/null || status=" + std::to_string(crash_status) + "\n"
+                "kill $pid 2>/dev/null\n"
+                "wait $pid 2>/dev/null\n"
+                "exit $status\n").c_str(),
+               f);
     std::fclose(f);
   }
-  RunResult r = run(prefix + "bash " + script + " " + args);
+  RunResult r = run(prefix + "bash " + script + " " + FLASHGS_VIEWER + " " + helper + " " + log);
   if (FILE* f = std::fopen(log.c_str(), "r")) {
     char line[1024];
     while (std::fgets(line, sizeof line, f)) r.output += line;
@@ -189,28 +205,14 @@ TEST(Viewer, DroppedFilesOpenAndABadOneKeepsTheViewerRunning) {
   std::filesystem::copy_file(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply", good,
                              std::filesystem::copy_options::overwrite_existing);
   std::filesystem::remove(bad);
-  const std::string script = dir + "/drop_test.sh";
-  const char* text = R"sh(viewer=$1 drop=$2 good=$3 bad=$4 log=$5
-"$viewer" --backend cpu --size 800x450 > "$log" 2>&1 &
-pid=$!
-wait_for() {  # a line in the viewer's log, while the viewer runs (up to 60 s)
-  for _ in $(seq 1 600); do grep -qF -- "$1" "$log" && return 0; kill -0 $pid 2>/dev/null || return 1; sleep 0.1; done
-  return 1
-}
-status=0
-wait_for "frame path" || status=10
-[ $status -eq 0 ] && { sleep 1; "$drop" 600 300 "$good" || status=11; }
-[ $status -eq 0 ] && { wait_for "$good: 30000 Gaussians" || status=12; }
-[ $status -eq 0 ] && { "$drop" 600 300 "$bad" || status=13; }
-[ $status -eq 0 ] && { wait_for "load failed, scene kept: $bad" || status=14; }
-sleep 0.5
-kill -0 $pid 2>/dev/null || status=15
-kill $pid 2>/dev/null
-wait $pid 2>/dev/null
-exit $status
-)sh";
-  const RunResult r = run_viewer_script(prefix, script, text,
-                                        viewer() + " " + FLASHGS_X11_DROP + " " + good + " " + bad + " " + log, log);
+  const std::string steps = "wait_for \"frame path\" || status=10\n"
+                            "[ $status -eq 0 ] && { sleep 1; \"$helper\" 600 300 \"" + good + "\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"" + good + ": 30000 Gaussians\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { \"$helper\" 600 300 \"" + bad + "\" || status=13; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"load failed, scene kept: " + bad + "\" || status=14; }\n"
+                            "sleep 0.5\n";
+  const RunResult r = run_live_viewer(prefix, dir + "/drop_test.sh", "--backend cpu --size 800x450", FLASHGS_X11_DROP,
+                                      steps, 15, log);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11/13 drop, 12 load, 14 error, 15 crash)\n"
                             << r.output;
 #endif
@@ -225,25 +227,13 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   const std::string dir = out_dir();
-  const std::string log = dir + "/click_viewer.log", script = dir + "/click_test.sh";
+  const std::string log = dir + "/click_viewer.log";
   // The button's place in a 1280x720 window at UI scale 1 (the panel layout is fixed).
-  const char* text = R"sh(viewer=$1 click=$2 log=$3
-"$viewer" --backend cpu --size 1280x720 > "$log" 2>&1 &
-pid=$!
-wait_for() {  # a line in the viewer's log, while the viewer runs (up to 60 s)
-  for _ in $(seq 1 600); do grep -qF -- "$1" "$log" && return 0; kill -0 $pid 2>/dev/null || return 1; sleep 0.1; done
-  return 1
-}
-status=0
-wait_for "Gaussians, SH degree" || status=10
-[ $status -eq 0 ] && { sleep 1; "$click" 95 650 || status=11; }
-[ $status -eq 0 ] && { wait_for "compare flash vs baseline" || status=12; }
-kill -0 $pid 2>/dev/null || status=13
-kill $pid 2>/dev/null
-wait $pid 2>/dev/null
-exit $status
-)sh";
-  const RunResult r = run_viewer_script(prefix, script, text, viewer() + " " + FLASHGS_X11_CLICK + " " + log, log);
+  const std::string steps = "wait_for \"Gaussians, SH degree\" || status=10\n"
+                            "[ $status -eq 0 ] && { sleep 1; \"$helper\" 95 650 || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=12; }\n";
+  const RunResult r = run_live_viewer(prefix, dir + "/click_test.sh", "--backend cpu --size 1280x720",
+                                      FLASHGS_X11_CLICK, steps, 13, log);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 no comparison, 13 crash)\n"
                             << r.output;
 #endif
