@@ -30,7 +30,25 @@ struct RefGaussian {
   double opacity;
   double rgb[3];
   std::size_t index;
+  int px0, px1, py0, py1;  // the pixels it may reach: [px0, px1) x [py0, py1)
 };
+
+// 3DGS's pixel rectangle (getRect over its radius), in double: the pixels of tiles
+// [trunc((m - r) / 16), trunc((m + r + 15) / 16)) clamped to the grid. a, c: the diagonal of
+// the dilated covariance; det its determinant.
+void box_3dgs(const Camera& camera, double mean_x, double mean_y, double a, double c, double det, RefGaussian& g) {
+  const double mid = 0.5 * (a + c);
+  const double lambda = mid + std::sqrt(std::max(double(gm::kBaselineSpreadFloor), mid * mid - det));
+  const double radius = std::ceil(gm::kBaselineSigmas * std::sqrt(lambda));
+  const double ts = gm::kTileSize;
+  const double grid_x = (camera.width + gm::kTileSize - 1) / gm::kTileSize;
+  const double grid_y = (camera.height + gm::kTileSize - 1) / gm::kTileSize;
+  auto tile = [&](double v, double grid) { return static_cast<int>(std::clamp(std::trunc(v / ts), 0.0, grid)); };
+  g.px0 = gm::kTileSize * tile(mean_x - radius, grid_x);
+  g.px1 = gm::kTileSize * tile(mean_x + radius + ts - 1, grid_x);
+  g.py0 = gm::kTileSize * tile(mean_y - radius, grid_y);
+  g.py1 = gm::kTileSize * tile(mean_y + radius + ts - 1, grid_y);
+}
 
 // Real SH in double, same basis as gaussian_math.h.
 void sh_rgb_double(const Scene& scene, std::size_t i, int degree, const double dir[3], double rgb[3]) {
@@ -88,7 +106,7 @@ double min_q_over_rect(const RefGaussian& g, double dx0, double dx1, double dy0,
 }  // namespace
 
 Image render_reference(const Scene& scene, const Camera& camera, const RenderOptions& options,
-                       PixelWindow window) {
+                       PixelWindow window, ReferenceFootprint footprint) {
   if (window.width < 0) window.width = camera.width;
   if (window.height < 0) window.height = camera.height;
   const int degree = std::max(0, std::min(scene.sh_degree, options.sh_degree_cap));
@@ -163,6 +181,14 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
     g.opacity = opacity;
     g.index = i;
     if (!std::isfinite(g.mean_x) || !std::isfinite(g.mean_y)) continue;
+    g.px0 = g.py0 = std::numeric_limits<int>::min();
+    g.px1 = g.py1 = std::numeric_limits<int>::max();
+    if (footprint == ReferenceFootprint::box_3dgs) {
+      box_3dgs(camera, g.mean_x, g.mean_y, a, c, det, g);
+      if (g.px1 <= window.x0 || g.px0 >= window.x0 + window.width || g.py1 <= window.y0 ||
+          g.py0 >= window.y0 + window.height)
+        continue;
+    }
     // Skip exactly the Gaussians whose alpha stays below 1/255 over the whole window.
     const double q_min = min_q_over_rect(g, window.x0 - g.mean_x, window.x0 + window.width - 1 - g.mean_x,
                                          window.y0 - g.mean_y, window.y0 + window.height - 1 - g.mean_y);
@@ -187,6 +213,7 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
       const double px = window.x0 + x, py = window.y0 + y;
       double t = 1.0, rgb[3] = {0, 0, 0};
       for (const RefGaussian& g : gaussians) {
+        if (px < g.px0 || px >= g.px1 || py < g.py0 || py >= g.py1) continue;
         const double dx = px - g.mean_x, dy = py - g.mean_y;
         const double power = -0.5 * (g.a * dx * dx + g.c * dy * dy) - g.b * dx * dy;
         if (power > 0) continue;

@@ -130,18 +130,22 @@ Camera axis_camera(int width, int height, double fov_degrees) {
 //      well-conditioned footprints (measured: ~1e-6).
 //  (2) a threshold decided on the other side (alpha vs 1/255, T vs 1e-4): one flip changes a
 //      pixel by at most alpha * T * |rgb - what is behind| <= 1/255 for the alpha test.
-//  (3) the baseline's box (3DGS, reproduced on purpose): radius ceil(3 sigma), where alpha can
-//      still be 0.99 e^-4.5 = 0.011 > 1/255, and getRect's trunc((x + r + 15) / 16), which
-//      leaves out the tile in whose first pixel x + r falls: a pixel up to 1 px inside the
-//      radius loses the Gaussian. For the smallest footprint (sigma^2 = 0.3 px^2, r = 2) alpha
-//      there is up to 0.99 e^(-1 / 0.6) = 0.187 (measured 0.086 on stiff_extreme, a 1e-9 dot).
-//      The flash extent sqrt(2 ln(o / tau)) and its pixel-exact box have no such cut.
+//  (3) the baseline's box (3DGS, reproduced on purpose): radius r = ceil(3 sqrt(lambda)),
+//      lambda = mid + sqrt(max(0.1, mid^2 - det)) >= the largest variance, and getRect's
+//      trunc((x + r + 15) / 16), which leaves out the tile in whose first pixel x + r falls,
+//      so a pixel more than r - 1 from the centre (along x or y) can lose the Gaussian. There
+//      q >= (r - 1)^2 / lambda: the floor makes lambda >= 0.3 + sqrt(0.1), so r >= 3; for
+//      lambda <= 1, r = 3 and q >= 4; above, q >= (3 - 1 / sqrt(lambda))^2 > 4. One cut is
+//      therefore at most 0.99 e^-2 = 0.134 (a footprint elongated along x with variance 1
+//      there; an isotropic one, whose variance is lambda - sqrt(0.1), at most 0.053). Beyond
+//      the box, q >= 9: alpha <= 0.011. The flash extent sqrt(2 ln(o / tau)) and its
+//      pixel-exact box have no such cut.
 constexpr double kRounding = 1e-4;
 constexpr double kOneFlip = 1.0 / 255.0;
-constexpr double kBoxCut = 0.99 * 0.18887560283756186;          // 0.99 e^(-1 / 0.6)
+constexpr double kBoxCut = 0.99 * 0.1353352832366127;  // 0.99 e^-2
 
 // The baseline's bound adds one box cut to the flash bound.
-constexpr const char* kBaselineWhy = "; baseline: + one cut by 3DGS's box (0.187, see kBoxCut)";
+constexpr const char* kBaselineWhy = "; baseline: + one cut by 3DGS's box (0.99 e^-2 = 0.134, see kBoxCut)";
 
 void set_bounds(StressCase& c, double flash, const std::string& reason) {
   c.bound_flash = flash;

@@ -28,6 +28,7 @@ constexpr float kAlphaMax = 0.99f;       // alpha clamp (3DGS)
 constexpr float kAlphaMin = 1.0f / 255.0f;    // blend skips alpha below this
 constexpr float kTransmittanceMin = 1e-4f;    // stop once T would fall below this
 constexpr float kBaselineSigmas = 3.0f;
+constexpr float kBaselineSpreadFloor = 0.1f;  // 3DGS: lambda = mid + sqrt(max(0.1, mid^2 - det))
 
 // Camera in the form the kernels need (plain data, copied to the GPU by value).
 struct CameraParams {
@@ -222,7 +223,8 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
   // difference of two numbers equal to every float digit; the major axis from whichever of
   // (lambda_max - cd, b) and (b, lambda_max - ad) adds, not subtracts.
   const float half_diff = 0.5f * (ad - cd);
-  const float root = sqrtf(half_diff * half_diff + b * b);
+  const float spread = half_diff * half_diff + b * b;  // mid^2 - det, without the cancellation
+  const float root = sqrtf(spread);
   const float lambda_max = 0.5f * (ad + cd) + root;
   const float lambda_min = det_d / lambda_max;
   float ux = half_diff >= 0.0f ? half_diff + root : b;
@@ -244,9 +246,14 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
     // max |dx| on q = t is sqrt(t * Sigma_xx) (same for y)
     half_x = sqrtf(threshold * ad);
     half_y = sqrtf(threshold * cd);
+  } else if (geo.baseline) {
+    // 3DGS's radius: ceil(3 sqrt(mid + sqrt(max(0.1, mid^2 - det)))). The 0.1 floor is part
+    // of the rule the scenes were trained with: it widens near-isotropic footprints (the
+    // smallest gets radius 3, not 2), and getRect below cuts pixels up to 1 px inside it.
+    const float lambda_box = 0.5f * (ad + cd) + sqrtf(maxf(kBaselineSpreadFloor, spread));
+    half_x = half_y = ceilf(sqrtf(threshold * lambda_box));
   } else {
-    const float radius = sqrtf(threshold * lambda_max);
-    half_x = half_y = geo.baseline ? ceilf(radius) : radius;
+    half_x = half_y = sqrtf(threshold * lambda_max);
   }
   if (!is_finite(half_x) || !is_finite(half_y)) return kCulledDegenerate;
 

@@ -13,14 +13,22 @@ struct PixelWindow {
   int x0 = 0, y0 = 0, width = -1, height = -1;  // width/height -1: the whole image
 };
 
-// Renders in double precision with no tiles, no boxes and no extent: each pixel composites
-// all Gaussians sorted by (depth, index) under the 3DGS rules (near cull z <= 0.2, +0.3
-// dilation, alpha = min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4).
-// Only options.background and options.sh_degree_cap are used. Cost is pixels x Gaussians, so
-// meant for small scenes and crops (Gaussians that cannot reach alpha 1/255 anywhere in the
-// window are skipped exactly, with the same minimum-over-a-rectangle test as the tile test).
+// Which pixels a Gaussian may reach in the reference.
+enum class ReferenceFootprint {
+  unbounded,  // every pixel where alpha >= 1/255: the image the rules define
+  box_3dgs,   // only the tiles of 3DGS's box (radius ceil(3 sqrt(mid + sqrt(max(0.1, mid^2 -
+              // det)))), getRect's 16x16 tiles): the original rasterizer's image, in double
+};
+
+// Renders in double precision with no tiles and no extent (unless `footprint` asks for 3DGS's
+// box): each pixel composites all Gaussians sorted by (depth, index) under the 3DGS rules
+// (near cull z <= 0.2, +0.3 dilation, alpha = min(0.99, o e^power), skip alpha < 1/255, stop
+// before T < 1e-4). Only options.background and options.sh_degree_cap are used. Cost is
+// pixels x Gaussians, so meant for small scenes and crops (Gaussians that cannot reach alpha
+// 1/255 anywhere in the window are skipped exactly, with the same minimum-over-a-rectangle
+// test as the tile test).
 Image render_reference(const Scene& scene, const Camera& camera, const RenderOptions& options,
-                       PixelWindow window = {});
+                       PixelWindow window = {}, ReferenceFootprint footprint = ReferenceFootprint::unbounded);
 
 // Copies a window out of a full image (to compare with a reference crop).
 Image crop_image(const Image& image, const PixelWindow& window);
