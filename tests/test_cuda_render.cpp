@@ -80,6 +80,7 @@ void expect_match(const std::string& what, const Result& cpu, const Result& gpu)
   EXPECT_EQ(gpu.stats.culled_offscreen, cpu.stats.culled_offscreen) << what;
   EXPECT_EQ(gpu.stats.culled_low_opacity, cpu.stats.culled_low_opacity) << what;
   EXPECT_EQ(gpu.stats.culled_degenerate, cpu.stats.culled_degenerate) << what;
+  EXPECT_EQ(gpu.stats.max_tile_pairs, cpu.stats.max_tile_pairs) << what << " (without tile counts requested)";
   const ImageDifference d = compare_images(cpu.image, gpu.image);
   const double typical = fraction_over(cpu.image, gpu.image, kTypicalAbs);
   std::printf("%-58s kv %10llu  max abs %.2e  PSNR %6.1f dB  >1e-3: %.2e\n", what.c_str(),
@@ -325,6 +326,37 @@ TEST(CudaSurface, MatchesTheFloatImage) {
   EXPECT_LE(worst, 0);
   cudaDestroySurfaceObject(surface);
   cudaFreeArray(array);
+}
+
+// A surface smaller than the frame (or not RGBA8) is refused before anything is written.
+TEST(CudaSurface, TooSmallOrWrongFormatIsAnError) {
+  FLASHGS_REQUIRE_CUDA();
+  auto gpu = make_cuda_renderer();
+  gpu->set_scene(test::load_demo_scene());
+  const Camera camera = test::load_demo_cameras()[1].resized(333, 187);
+  auto expect_refused = [&](cudaChannelFormatDesc desc, int width, int height, const char* why) {
+    cudaArray_t array = nullptr;
+    ASSERT_EQ(cudaMallocArray(&array, &desc, width, height, cudaArraySurfaceLoadStore), cudaSuccess);
+    cudaResourceDesc res{};
+    res.resType = cudaResourceTypeArray;
+    res.res.array.array = array;
+    cudaSurfaceObject_t surface = 0;
+    ASSERT_EQ(cudaCreateSurfaceObject(&surface, &res), cudaSuccess);
+    try {
+      gpu->render_to_surface(camera, RenderOptions{}, surface, nullptr);
+      ADD_FAILURE() << "a " << width << "x" << height << " surface was accepted for a 333x187 frame";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+    cudaDestroySurfaceObject(surface);
+    cudaFreeArray(array);
+  };
+  const cudaChannelFormatDesc rgba8 = cudaCreateChannelDesc(8, 8, 8, 8, cudaChannelFormatKindUnsigned);
+  expect_refused(rgba8, 332, 187, "smaller than");
+  expect_refused(rgba8, 333, 100, "smaller than");
+  expect_refused(cudaCreateChannelDesc(32, 0, 0, 0, cudaChannelFormatKindFloat), 333, 187, "not RGBA8");
+  // The renderer still works afterwards.
+  EXPECT_GT(render(*gpu, camera, RenderOptions{}).stats.kv_pairs, 0u);
 }
 
 // A scene that cannot fit in GPU memory is a flashgs::Error, not a crash, and the old scene

@@ -188,10 +188,11 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
         const float w[4] = {next.w0, next.w1, next.w2, next.w3};
         // Fast divisions: the cut's margin covers their error (it moves the edge minimiser
         // along a flat valley, changing q to second order only).
-        const float a = __fmaf_rn(next.w0, next.w0, next.w2 * next.w2);
-        const float b = __fmaf_rn(next.w0, next.w1, next.w2 * next.w3);
-        const float c = __fmaf_rn(next.w1, next.w1, next.w3 * next.w3);
-        meets = gm::whitened_ellipse_meets_rect(w, __fdividef(-b, c), __fdividef(-b, a), cut, region_x0 - next.mean_x,
+        const float conic_a = __fmaf_rn(next.w0, next.w0, next.w2 * next.w2);
+        const float conic_b = __fmaf_rn(next.w0, next.w1, next.w2 * next.w3);
+        const float conic_c = __fmaf_rn(next.w1, next.w1, next.w3 * next.w3);
+        meets = gm::whitened_ellipse_meets_rect(w, __fdividef(-conic_b, conic_c), __fdividef(-conic_b, conic_a), cut,
+                                                region_x0 - next.mean_x,
                                                 region_x1 - next.mean_x,
                                                 region_y0 - next.mean_y, region_y1 - next.mean_y);
       }

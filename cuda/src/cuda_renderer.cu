@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -50,21 +51,52 @@ namespace {
 
 using cuda::check_cuda;
 
+// Owns one CUDA runtime handle (a stream, an event, pinned memory) and destroys it, so that a
+// constructor that throws half way leaks nothing.
+template <typename Handle, cudaError_t (*Destroy)(Handle)>
+class CudaHandle {
+ public:
+  CudaHandle() = default;
+  CudaHandle(const CudaHandle&) = delete;
+  CudaHandle& operator=(const CudaHandle&) = delete;
+  ~CudaHandle() {
+    if (handle_) Destroy(handle_);
+  }
+  Handle* out() { return &handle_; }  // for the call that creates it
+  Handle get() const { return handle_; }
+
+ private:
+  Handle handle_ = nullptr;
+};
+using StreamHandle = CudaHandle<cudaStream_t, cudaStreamDestroy>;
+using EventHandle = CudaHandle<cudaEvent_t, cudaEventDestroy>;
+using PinnedHandle = CudaHandle<void*, cudaFreeHost>;
+
+// What each frame reads back into pinned host memory.
+struct HostReadback {
+  cuda::FrameCounters counters;    // after the preprocess: pairs and culls of this frame
+  std::uint32_t tile_max[2] = {};  // FrameCounters::max_tile_pairs, per event set
+};
+
 // One device allocation; grows (discarding its content) but never shrinks. The owner's byte
-// counters follow every change so FrameStats can report current and peak memory.
+// counters follow every change so FrameStats can report current and peak memory. Growing a
+// bound buffer first waits for its stream: a frame still in flight may be reading the old
+// allocation (cudaFree's implicit synchronisation is not something to rely on).
 class DeviceBuffer {
  public:
   DeviceBuffer() = default;
   DeviceBuffer(const DeviceBuffer&) = delete;
   DeviceBuffer& operator=(const DeviceBuffer&) = delete;
   ~DeviceBuffer() { release(); }
-  void bind(std::uint64_t* current, std::uint64_t* peak) {
+  void bind(std::uint64_t* current, std::uint64_t* peak, cudaStream_t stream) {
     current_ = current;
     peak_ = peak;
+    stream_ = stream;
   }
   // Ensures at least `bytes`; throws flashgs::Error when the device has no room.
   void reserve(std::size_t bytes, const char* what) {
     if (bytes <= bytes_) return;
+    if (ptr_ && stream_) check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation before a buffer grows");
     release();
     void* p = nullptr;
     const cudaError_t status = cudaMalloc(&p, bytes);
@@ -103,6 +135,7 @@ class DeviceBuffer {
   std::size_t bytes_ = 0;
   std::uint64_t* current_ = nullptr;
   std::uint64_t* peak_ = nullptr;
+  cudaStream_t stream_ = nullptr;
 };
 
 int bits_for(std::uint64_t values) {  // bits to hold 0 .. values - 1
@@ -143,28 +176,27 @@ class CudaRendererImpl final : public CudaRenderer {
     cudaDeviceProp prop{};
     check_cuda(cudaGetDeviceProperties(&prop, device_), "cudaGetDeviceProperties");
     device_name_ = prop.name;
-    check_cuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "stream creation");
+    check_cuda(cudaStreamCreateWithFlags(stream_handle_.out(), cudaStreamNonBlocking), "stream creation");
+    stream_ = stream_handle_.get();
     // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
     if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
     // And the box size (in tiles) above which a warp emits a Gaussian's pairs.
     if (const char* tiles = std::getenv("FLASHGS_LARGE_BOX_TILES"))
       large_box_tiles_ = std::max(1, std::min(cuda::kHugeBoxTiles, std::atoi(tiles)));
-    for (auto& set : events_)
-      for (cudaEvent_t& e : set) check_cuda(cudaEventCreate(&e), "event creation");
-    check_cuda(cudaMallocHost(&host_counters_, sizeof(cuda::FrameCounters)), "pinned counter allocation");
-    for (DeviceBuffer* b : working_buffers()) b->bind(&working_bytes_, &peak_bytes_);
+    for (int set = 0; set < 2; ++set)
+      for (int e = 0; e < kEventCount; ++e) {
+        check_cuda(cudaEventCreate(event_handles_[set][e].out()), "event creation");
+        events_[set][e] = event_handles_[set][e].get();
+      }
+    check_cuda(cudaMallocHost(pinned_.out(), sizeof(HostReadback)), "pinned read-back allocation");
+    readback_ = new (pinned_.get()) HostReadback{};
+    for (DeviceBuffer* b : working_buffers()) b->bind(&working_bytes_, &peak_bytes_, stream_);
     counters_.reserve(sizeof(cuda::FrameCounters), "frame counters");
   }
 
+  // The handles and buffers free themselves (members); only the work in flight is waited for.
   ~CudaRendererImpl() override {
     if (stream_) cudaStreamSynchronize(stream_);
-    for (DeviceBuffer* b : working_buffers()) b->release();
-    for (DeviceBuffer* b : scene_buffers()) b->release();
-    for (auto& set : events_)
-      for (cudaEvent_t e : set)
-        if (e) cudaEventDestroy(e);
-    if (host_counters_) cudaFreeHost(host_counters_);
-    if (stream_) cudaStreamDestroy(stream_);
   }
 
   std::string name() const override { return "cuda (" + device_name_ + ")"; }
@@ -265,7 +297,6 @@ class CudaRendererImpl final : public CudaRenderer {
     return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
             &values_[1], &ranges_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
   }
-  std::vector<DeviceBuffer*> scene_buffers() { return {&scene_pos_, &scene_rot_, &scene_scale_, &scene_dc_, &scene_rest_}; }
 
   // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
   // distance to its centre plus its radius.
@@ -330,7 +361,6 @@ class CudaRendererImpl final : public CudaRenderer {
     b.cub_temp = cub_temp_.as<void>();
     b.cub_temp_bytes = cub_temp_.bytes();
     b.counters = counters_.as<cuda::FrameCounters>();
-    b.host_counters = host_counters_;
     return b;
   }
 
@@ -374,10 +404,30 @@ class CudaRendererImpl final : public CudaRenderer {
     return t;
   }
 
+  // The blend writes RGBA8 pixels up to the camera's size: the surface must be an array of at
+  // least that size with 4 x 8-bit channels, or the writes would land outside it.
+  static void check_surface(std::uint64_t surface, const Camera& camera) {
+    cudaResourceDesc desc{};
+    check_cuda(cudaGetSurfaceObjectResourceDesc(&desc, static_cast<cudaSurfaceObject_t>(surface)),
+               "surface query");
+    if (desc.resType != cudaResourceTypeArray) throw Error("cuda renderer: the surface is not backed by a CUDA array");
+    cudaChannelFormatDesc format{};
+    cudaExtent extent{};
+    unsigned flags = 0;
+    check_cuda(cudaArrayGetInfo(&format, &extent, &flags, desc.res.array.array), "surface array query");
+    if (format.x != 8 || format.y != 8 || format.z != 8 || format.w != 8)
+      throw Error("cuda renderer: the surface is not RGBA8");
+    if (extent.width < static_cast<std::size_t>(camera.width) || extent.height < static_cast<std::size_t>(camera.height))
+      throw Error("cuda renderer: the surface is " + std::to_string(extent.width) + "x" +
+                  std::to_string(extent.height) + ", smaller than the " + std::to_string(camera.width) + "x" +
+                  std::to_string(camera.height) + " frame");
+  }
+
   void run_frame(const Camera& camera, const RenderOptions& options, Image* out, std::uint64_t surface,
                  FrameStats* stats_out) {
     if (!scene_) throw Error("cuda renderer: no scene set");
     if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
+    if (surface) check_surface(surface, camera);
     const gm::CameraParams cam = make_camera_params(camera);
     const std::uint64_t tiles = static_cast<std::uint64_t>(cam.tiles_x) * cam.tiles_y;
     const std::uint64_t pixels = static_cast<std::uint64_t>(cam.width) * cam.height;
@@ -448,12 +498,12 @@ class CudaRendererImpl final : public CudaRenderer {
       check_cuda(cudaEventRecord(events[kProjected], stream_), "event record");
       if (!fused) cuda::launch_scan(n, b, stream_);
       check_cuda(cudaEventRecord(events[kScanned], stream_), "event record");
-      check_cuda(cudaMemcpyAsync(host_counters_, b.counters, sizeof(cuda::FrameCounters), cudaMemcpyDeviceToHost,
-                                 stream_),
+      check_cuda(cudaMemcpyAsync(&readback_->counters, b.counters, sizeof(cuda::FrameCounters),
+                                 cudaMemcpyDeviceToHost, stream_),
                  "pair count read back");
       check_cuda(cudaEventRecord(events[kCounted], stream_), "event record");
       check_cuda(cudaEventSynchronize(events[kCounted]), "preprocess");
-      pairs = host_counters_->pairs;
+      pairs = readback_->counters.pairs;
       if (pairs > static_cast<std::uint64_t>(INT32_MAX))
         throw Error("cuda renderer: the frame needs " + std::to_string(pairs) +
                     " Gaussian-tile pairs, more than the 2^31 the sort can take");
@@ -497,6 +547,11 @@ class CudaRendererImpl final : public CudaRenderer {
     cuda::launch_blend(blend, stream_);
     check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     last_tiles_ = tiles;
+    // The fullest tile, for the statistics (after the last timed event: not a stage's cost).
+    cuda::launch_tile_max(tiles, b, stream_);
+    check_cuda(cudaMemcpyAsync(&readback_->tile_max[event_set_], &b.counters->max_tile_pairs, sizeof(std::uint32_t),
+                               cudaMemcpyDeviceToHost, stream_),
+               "tile maximum read back");
 
     if (out) {
       if (out->width != camera.width || out->height != camera.height) out->resize(camera.width, camera.height);
@@ -509,41 +564,44 @@ class CudaRendererImpl final : public CudaRenderer {
     if (!stats_out) return;
 
     FrameStats stats;
-    const cuda::FrameCounters& c = *host_counters_;
+    const cuda::FrameCounters& c = readback_->counters;
     stats.kv_pairs = pairs;
     stats.tiles_x = cam.tiles_x;
     stats.tiles_y = cam.tiles_y;
     stats.gaussians = n;
-    stats.visible = c.visible;
-    stats.culled_near = c.culled_near;
-    stats.culled_offscreen = c.culled_offscreen;
-    stats.culled_low_opacity = c.culled_low_opacity;
-    stats.culled_degenerate = c.culled_degenerate;
+    stats.visible = c.by_reason[gm::kVisible];
+    stats.culled_near = c.by_reason[gm::kCulledNear];
+    stats.culled_offscreen = c.by_reason[gm::kCulledOffscreen];
+    stats.culled_low_opacity = c.by_reason[gm::kCulledLowOpacity];
+    stats.culled_degenerate = c.by_reason[gm::kCulledDegenerate];
     // GPU time of each stage between events; host gaps (the pair-count wait) are not counted.
     // A surface frame is not waited for (the caller presents it while the GPU finishes): it
     // reports the previous frame's times, complete since this frame's pair-count wait.
     if (out || !previous_complete) {
-      check_cuda(cudaEventSynchronize(events[kBlended]), "frame");
+      check_cuda(cudaStreamSynchronize(stream_), "frame");
       stats.times = stage_times(event_set_);
+      stats.max_tile_pairs = readback_->tile_max[event_set_];
     } else {
       stats.times = stage_times(previous_set);
+      stats.max_tile_pairs = readback_->tile_max[previous_set];
     }
     stats.device_memory_bytes = working_bytes_;
     stats.device_peak_bytes = peak_bytes_;
-    if (options.collect_tile_counts) {
-      download_tile_counts(stats.tile_pair_counts);
-      for (std::uint32_t v : stats.tile_pair_counts) stats.max_tile_pairs = std::max(stats.max_tile_pairs, v);
-    }
+    if (options.collect_tile_counts) download_tile_counts(stats.tile_pair_counts);
     *stats_out = std::move(stats);
   }
 
   int device_ = 0;
   std::string device_name_;
-  cudaStream_t stream_ = nullptr;
-  cudaEvent_t events_[2][kEventCount] = {};
+  // Declared before the buffers: destroyed after them.
+  StreamHandle stream_handle_;
+  EventHandle event_handles_[2][kEventCount];
+  PinnedHandle pinned_;
+  cudaStream_t stream_ = nullptr;  // stream_handle_'s
+  cudaEvent_t events_[2][kEventCount] = {};  // event_handles_'
+  HostReadback* readback_ = nullptr;         // in pinned_
   int event_set_ = 0;
   bool last_frame_complete_ = false;  // the last frame recorded all its events
-  cuda::FrameCounters* host_counters_ = nullptr;
   std::shared_ptr<const Scene> scene_;
   cuda::DeviceScene device_scene_;
   std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;

@@ -62,11 +62,10 @@ struct KeyFormat {
 // Counters one frame accumulates on the device; copied to the host once per frame.
 struct FrameCounters {
   unsigned long long pairs;        // Gaussian-tile pairs wanted (may exceed capacity)
-  unsigned int visible;            // Gaussians with at least one pair
-  unsigned int culled_near;
-  unsigned int culled_offscreen;   // box or ellipse missed every tile
-  unsigned int culled_low_opacity;
-  unsigned int culled_degenerate;
+  // Gaussians by gm::CullReason: kVisible counts those with at least one pair, and one whose
+  // box met the image but whose ellipse missed every tile counts as kCulledOffscreen.
+  unsigned int by_reason[gm::kCullReasonCount];
+  unsigned int max_tile_pairs;     // pairs of the fullest tile (set after the ranges pass)
   unsigned int large;             // Gaussians deferred to the large-emission kernel
   unsigned int huge;              // Gaussians deferred to the huge-emission kernel
 };
@@ -104,8 +103,7 @@ struct FrameBuffers {
   std::uint64_t pixel_capacity = 0;
   void* cub_temp = nullptr;  // sort and scan scratch
   std::size_t cub_temp_bytes = 0;
-  FrameCounters* counters = nullptr;       // [1] device
-  FrameCounters* host_counters = nullptr;  // [1] pinned host
+  FrameCounters* counters = nullptr;  // [1] device
 };
 
 struct PreprocessArgs {
@@ -135,6 +133,8 @@ int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, c
 // Gaussian id) order.
 void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers& buffers, int which,
                    cudaStream_t stream);
+// FrameCounters::max_tile_pairs from the tile ranges (a statistic: run outside the timed stages).
+void launch_tile_max(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
 
 enum class BlendKernel { per_pixel, warp_tile, warp_tile_pipelined };
 struct BlendArgs {

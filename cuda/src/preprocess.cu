@@ -255,8 +255,8 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
 template <int DEGREE, bool FUSED>
 __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, FrameBuffers buf,
                                                             PreprocessArgs args) {
-  __shared__ unsigned block_counts[5];  // visible, near, offscreen, low opacity, degenerate
-  if (threadIdx.x < 5) block_counts[threadIdx.x] = 0;
+  __shared__ unsigned block_counts[gm::kCullReasonCount];  // by gm::CullReason
+  if (threadIdx.x < gm::kCullReasonCount) block_counts[threadIdx.x] = 0;
   __syncthreads();
 
   const unsigned i = blockIdx.x * kBlock + threadIdx.x;
@@ -399,19 +399,13 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   }
 
   if (valid && !deferred) {
-    int slot;
-    if (reason == gm::kVisible) slot = count > 0 ? 0 : 2;  // box met the image, the ellipse did not
-    else if (reason == gm::kCulledNear) slot = 1;
-    else if (reason == gm::kCulledOffscreen) slot = 2;
-    else if (reason == gm::kCulledLowOpacity) slot = 3;
-    else slot = 4;
+    // A box that met the image around an ellipse that met no tile counts as off screen.
+    const int slot = reason == gm::kVisible && count == 0 ? gm::kCulledOffscreen : reason;
     atomicAdd(&block_counts[slot], 1u);
   }
   __syncthreads();
-  if (threadIdx.x < 5 && block_counts[threadIdx.x] > 0) {
-    unsigned* dst = threadIdx.x == 0 ? &buf.counters->visible : &buf.counters->culled_near + (threadIdx.x - 1);
-    atomicAdd(dst, block_counts[threadIdx.x]);
-  }
+  if (threadIdx.x < gm::kCullReasonCount && block_counts[threadIdx.x] > 0)
+    atomicAdd(&buf.counters->by_reason[threadIdx.x], block_counts[threadIdx.x]);
 }
 
 // The deferred large Gaussians: a warp per Gaussian, spread over every warp of the grid. A
@@ -465,8 +459,8 @@ __global__ void __launch_bounds__(kBlock) large_emit_kernel(FrameBuffers buf, gm
     }
   }
   if (lane == 0) {
-    if (visible) atomicAdd(&buf.counters->visible, visible);
-    if (offscreen) atomicAdd(&buf.counters->culled_offscreen, offscreen);
+    if (visible) atomicAdd(&buf.counters->by_reason[gm::kVisible], visible);
+    if (offscreen) atomicAdd(&buf.counters->by_reason[gm::kCulledOffscreen], offscreen);
   }
 }
 
@@ -532,7 +526,8 @@ __global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm:
       gaussian_total += segment_total;
       __syncthreads();  // the shared arrays are reused by the next segment or Gaussian
     }
-    if (threadIdx.x == 0) atomicAdd(gaussian_total > 0 ? &buf.counters->visible : &buf.counters->culled_offscreen, 1u);
+    if (threadIdx.x == 0)
+      atomicAdd(&buf.counters->by_reason[gaussian_total > 0 ? gm::kVisible : gm::kCulledOffscreen], 1u);
   }
 }
 

@@ -72,7 +72,23 @@ __global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, con
   }
 }
 
+// The largest end - start over the tiles: a warp reduction, one atomic per warp.
+__global__ void __launch_bounds__(kBlock) tile_max_kernel(std::uint64_t tiles, const uint2* __restrict__ tile_ranges,
+                                                          FrameCounters* counters) {
+  const std::uint64_t t = static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x;
+  const uint2 range = t < tiles ? tile_ranges[t] : make_uint2(0, 0);
+  const unsigned warp_max = __reduce_max_sync(kFullMask, range.y - range.x);
+  if (lane_id() == 0 && warp_max > 0) atomicMax(&counters->max_tile_pairs, warp_max);
+}
+
 }  // namespace
+
+void launch_tile_max(std::uint64_t tiles, const FrameBuffers& b, cudaStream_t stream) {
+  if (tiles == 0) return;
+  const unsigned blocks = static_cast<unsigned>((tiles + kBlock - 1) / kBlock);
+  tile_max_kernel<<<blocks, kBlock, 0, stream>>>(tiles, b.tile_ranges, b.counters);
+  check_cuda(cudaGetLastError(), "tile max kernel launch");
+}
 
 void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers& b, int which,
                    cudaStream_t stream) {

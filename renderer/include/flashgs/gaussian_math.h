@@ -54,6 +54,7 @@ enum CullReason : std::uint8_t {
   kCulledLowOpacity = 3,
   kCulledDegenerate = 4,
 };
+constexpr int kCullReasonCount = 5;  // the values above, 0 .. 4: counters are indexed by them
 
 // The screen-space footprint of one Gaussian.
 struct Footprint {
