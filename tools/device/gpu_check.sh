@@ -46,6 +46,7 @@ build() {
   if [ $rc -eq 0 ]; then
     FLASHGS=$ROOT/build-dev/app/flashgs
     TESTS=$ROOT/build-dev/tests/test_cuda_render
+    STRESS_TESTS=$ROOT/build-dev/tests/test_stress_gpu
   fi
   tail -5 "$OUT/build.log"
 }
@@ -54,9 +55,9 @@ tests() {
   log "gpu tests"
   "$TESTS" --gtest_filter=-CudaSanitizer.* 2>&1 | tee "$OUT/gpu_tests.log" | grep -E "^\[  (FAILED|PASSED|SKIPPED) |Failure|expected error" | head -40
   log "gpu tests rc=${PIPESTATUS[0]}"
-  if [ -x "$BIN/test_stress_gpu" ]; then
+  if [ -x "$STRESS_TESTS" ]; then
     log "stress gpu tests"
-    "$BIN/test_stress_gpu" 2>&1 | tee "$OUT/stress_gpu.log" | grep -E -A6 "^\[  (FAILED|PASSED) |Failure" | head -60
+    "$STRESS_TESTS" 2>&1 | tee "$OUT/stress_gpu.log" | grep -E -A6 "^\[  (FAILED|PASSED) |Failure" | head -60
     log "stress gpu rc=${PIPESTATUS[0]}"
   fi
 }
@@ -152,6 +153,7 @@ profile_sass() {  # executed instructions per SASS line of PROFILE_KERNELS (bina
 
 FLASHGS=$BIN/flashgs
 TESTS=$BIN/test_cuda_render
+STRESS_TESTS=$BIN/test_stress_gpu
 for step in "$@"; do
   case $step in
     setup) setup ;;
