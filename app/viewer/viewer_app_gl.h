@@ -101,7 +101,6 @@ class ViewerApp {
   // Input state between frames.
   double m_last_cursor_x = 0, m_last_cursor_y = 0;
   std::string m_path_buffer, m_shot_buffer;
-  int m_screenshot_count = 0;
 
   // Scripted mode.
   bool m_scripted = false;
