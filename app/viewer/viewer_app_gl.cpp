@@ -523,8 +523,10 @@ bool ViewerApp::load_first_scene() {
   bool loaded = false;
   if (m_args.generate_demo > 0) {
     const std::string option = "--generate-demo " + std::to_string(m_args.generate_demo);
-    const std::string problem = scene_size_problem(
-        scene_bytes(std::uint64_t(m_args.generate_demo), scene_bytes_per_gaussian(1)), available_memory_bytes());
+    const int demo_sh_degree = 1;  // what make_demo_scene builds
+    const std::string problem =
+        scene_size_problem(scene_bytes(std::uint64_t(m_args.generate_demo), scene_bytes_per_gaussian(demo_sh_degree)),
+                           available_memory_bytes());
     try {
       if (!problem.empty()) throw Error(problem);
       install_scene(generate_demo_scene(static_cast<std::size_t>(m_args.generate_demo)));
@@ -559,7 +561,7 @@ bool ViewerApp::apply_start_options() {
       if (!problem.empty()) throw Error(problem + " for " + std::to_string(gaussians) + " Gaussians");
       install_scene(tile_loaded_scene(m_scene, m_args.tile));
     } catch (const std::exception& e) {
-      set_notice(option + " refused: " + reason(e) + "; the scene is shown once");
+      set_notice(option + " refused: " + reason(e) + (m_scripted ? "" : "; the scene is shown once"));
       if (m_scripted) return false;
     }
   }
@@ -568,7 +570,7 @@ bool ViewerApp::apply_start_options() {
                                                    m_path->texture_count(), m_max_texture_size, available_memory_bytes());
     if (!problem.empty()) {
       set_notice("--render-size " + size_text(m_settings.forced_width, m_settings.forced_height) + " refused: " +
-                 problem + "; rendering at the window size");
+                 problem + (m_scripted ? "" : "; rendering at the window size"));
       if (m_scripted) return false;
       m_settings.forced_width = m_settings.forced_height = 0;
     }
