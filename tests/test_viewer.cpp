@@ -8,10 +8,12 @@
 #include <filesystem>
 #include <string>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "flashgs/image.h"
 #include "flashgs/image_io.h"
+#include "memory_budget.h"
 #include "test_support.h"
 
 namespace {
@@ -67,37 +69,84 @@ std::string display_prefix() {
   const std::string prefix = display_prefix();                                                  \
   if (prefix.empty()) GTEST_SKIP() << "no X display and no xvfb-run (install xvfb): viewer test skipped"
 
-// Starts the viewer (`viewer_args`, output to `log`) in the background and runs `steps`, shell
-// lines that drive it (`$helper` is `helper`, `wait_for TEXT` waits up to 60 s for a line of
-// its log, and a failing step sets `status`); the script then exits with `crash_status` if the
-// viewer is gone, else with `status`. Returns its result with the viewer's log appended.
-RunResult run_live_viewer(const std::string& prefix, const std::string& script, const std::string& viewer_args,
-                          const std::string& helper, const std::string& steps, int crash_status,
-                          const std::string& log) {
+#ifdef FLASHGS_X11_DROP
+const char* const kDropHelper = FLASHGS_X11_DROP;
+#else
+const char* const kDropHelper = "";
+#endif
+#ifdef FLASHGS_X11_INPUT
+const char* const kInputHelper = FLASHGS_X11_INPUT;
+#else
+const char* const kInputHelper = "";
+#endif
+
+// Starts the viewer (`viewer_args`, run in the test output folder, output to NAME.log there)
+// in the background and runs `steps`, shell lines that drive it. They have `$drop` (x11_drop),
+// `$input` (x11_input) and `$log`, and these functions, each waiting for the viewer's log (up
+// to 120 s) and failing when the viewer is gone:
+//   wait_for TEXT        a line of the log containing TEXT
+//   wait_count TEXT N    N lines containing TEXT
+//   press WHAT TOKEN     `$input down WHAT`, then two more frames logged with TOKEN held
+//                        (--log-input): down across two frames, however slow they are
+//   hold WHAT TOKEN      press, then `$input up WHAT`
+//   close_window         a window manager's close request; waits for the viewer to exit and
+//                        sets `closed` (its exit status in `exit_status`)
+// A failing step sets `status`. The script then exits with `crash_status` if the viewer is gone
+// without being closed, else with `status`. Returns its result with the viewer's log appended.
+RunResult run_live_viewer(const std::string& prefix, const std::string& name, const std::string& viewer_args,
+                          const std::string& steps, int crash_status) {
+  const std::string dir = out_dir(), script = dir + "/" + name + ".sh", log = dir + "/" + name + ".log";
   if (FILE* f = std::fopen(script.c_str(), "w")) {
-    std::fputs(("viewer=$1 helper=$2 log=$3\n"
+    std::fputs(("viewer=$1 drop=$2 input=$3 log=$4\n"
+                "cd \"$(dirname \"$log\")\"\n"
                 "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
                 "pid=$!\n"
-                "wait_for() {\n"
-                "  for _ in $(seq 1 600); do grep -qF -- \"$1\" \"$log\" && return 0; kill -0 $pid 2>/dev/null || return 1; "
-                "sleep 0.1; done\n"
+                "closed=0 exit_status=\n"
+                "wait_count() {\n"
+                "  for _ in $(seq 1 1200); do [ \"$(grep -cF -- \"$1\" \"$log\")\" -ge \"$2\" ] && return 0; "
+                "kill -0 $pid 2>/dev/null || return 1; sleep 0.1; done\n"
                 "  return 1\n"
                 "}\n"
+                "wait_for() { wait_count \"$1\" 1; }\n"
+                "press() {\n"
+                "  n=$(grep -cF -- \"$2\" \"$log\")\n"
+                "  \"$input\" down \"$1\" || return 1\n"
+                "  wait_count \"$2\" $((n + 2))\n"
+                "}\n"
+                "hold() { press \"$1\" \"$2\"; r=$?; \"$input\" up \"$1\"; return $r; }\n"
+                "close_window() {\n"
+                "  \"$input\" close 20 20 || return 1\n"
+                "  for _ in $(seq 1 1200); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done\n"
+                "  kill -0 $pid 2>/dev/null && return 1\n"
+                "  wait $pid; exit_status=$?; closed=1\n"
+                "}\n"
                 "status=0\n" + steps +
-                "kill -0 $pid 2>/dev/null || status=" + std::to_string(crash_status) + "\n"
+                "[ $closed -eq 1 ] || kill -0 $pid 2>/dev/null || status=" + std::to_string(crash_status) + "\n"
                 "kill $pid 2>/dev/null\n"
                 "wait $pid 2>/dev/null\n"
                 "exit $status\n").c_str(),
                f);
     std::fclose(f);
   }
-  RunResult r = run(prefix + "bash " + script + " " + FLASHGS_VIEWER + " " + helper + " " + log);
+  RunResult r = run(prefix + "bash " + script + " " + FLASHGS_VIEWER + " \"" + kDropHelper + "\" \"" + kInputHelper +
+                    "\" " + log);
   if (FILE* f = std::fopen(log.c_str(), "r")) {
     char line[1024];
     while (std::fgets(line, sizeof line, f)) r.output += line;
     std::fclose(f);
   }
   return r;
+}
+
+// The fraction of pixels brighter than near-black (a NaN pose renders the background only).
+double lit_fraction(const flashgs::Image& image) {
+  std::size_t lit = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const float* p = image.pixel(x, y);
+      lit += p[0] + p[1] + p[2] > 0.1f;
+    }
+  return image.width > 0 ? double(lit) / (double(image.width) * image.height) : 0.0;
 }
 
 std::string viewer() { return FLASHGS_VIEWER; }
@@ -193,49 +242,142 @@ TEST(Viewer, FailedLoadKeepsTheCurrentScene) {
 }
 
 // Drag and drop end to end: an XDND drop (what a file manager sends) on the running, unscripted
-// viewer opens the file; a dropped file that fails to load leaves the viewer running.
+// viewer opens the file; a dropped file that fails to load leaves the viewer running, and it
+// closes normally afterwards.
 TEST(Viewer, DroppedFilesOpenAndABadOneKeepsTheViewerRunning) {
-#ifndef FLASHGS_X11_DROP
-  GTEST_SKIP() << "built without Xlib: the drop helper is absent";
+#if !defined(FLASHGS_X11_DROP) || !defined(FLASHGS_X11_INPUT)
+  GTEST_SKIP() << "built without Xlib or libXtst: the drop and input helpers are absent";
 #else
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   const std::string dir = out_dir();
-  const std::string good = dir + "/dropped_scene.ply", bad = dir + "/dropped_missing.ply", log = dir + "/drop_viewer.log";
+  const std::string good = dir + "/dropped_scene.ply", bad = dir + "/dropped_missing.ply";
   std::filesystem::copy_file(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply", good,
                              std::filesystem::copy_options::overwrite_existing);
   std::filesystem::remove(bad);
-  const std::string steps = "wait_for \"frame path\" || status=10\n"
-                            "[ $status -eq 0 ] && { sleep 1; \"$helper\" 600 300 \"" + good + "\" || status=11; }\n"
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$drop\" 600 300 \"" + good + "\" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"" + good + ": 30000 Gaussians\" || status=12; }\n"
-                            "[ $status -eq 0 ] && { \"$helper\" 600 300 \"" + bad + "\" || status=13; }\n"
+                            "[ $status -eq 0 ] && { \"$drop\" 600 300 \"" + bad + "\" || status=13; }\n"
                             "[ $status -eq 0 ] && { wait_for \"load failed, scene kept: " + bad + "\" || status=14; }\n"
-                            "sleep 0.5\n";
-  const RunResult r = run_live_viewer(prefix, dir + "/drop_test.sh", "--backend cpu --size 800x450", FLASHGS_X11_DROP,
-                                      steps, 15, log);
-  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11/13 drop, 12 load, 14 error, 15 crash)\n"
+                            "[ $status -eq 0 ] && { close_window || status=16; }\n"
+                            "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=17\n";
+  const RunResult r = run_live_viewer(prefix, "drop", "--backend cpu --size 800x450", steps, 15);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11/13 drop, 12 load, 14 error, 15 crash, 16 no exit on close, "
+                               "17 exit status)\n"
                             << r.output;
 #endif
 }
 
-// A real mouse click (XTEST) on the panel's "Compare this view" button runs the comparison:
-// ImGui's mouse position and buttons reach it through the viewer's own platform inputs.
-TEST(Viewer, MouseClickOnAPanelButtonWorks) {
-#ifndef FLASHGS_X11_CLICK
-  GTEST_SKIP() << "built without libXtst: the click helper is absent";
+// A FIFO dropped on the window: one clear message, the scene stays, and closing the window
+// does not wait for anything (opening a FIFO blocks until a writer appears).
+TEST(Viewer, ADroppedFifoIsRefusedAndTheWindowClosesPromptly) {
+#if !defined(FLASHGS_X11_DROP) || !defined(FLASHGS_X11_INPUT)
+  GTEST_SKIP() << "built without Xlib or libXtst: the drop and input helpers are absent";
 #else
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
-  const std::string dir = out_dir();
-  const std::string log = dir + "/click_viewer.log";
+  const std::string fifo = out_dir() + "/dropped_fifo.ply";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$drop\" 600 300 \"" + fifo + "\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"load failed, scene kept: " + fifo +
+                            ": a FIFO\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=14; }\n"
+                            "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=15\n";
+  const RunResult r = run_live_viewer(prefix, "drop_fifo", "--backend cpu --size 800x450", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 drop, 12 no FIFO message, 13 crash, 14 close blocked, "
+                               "15 exit status)\n"
+                            << r.output;
+  std::filesystem::remove(fifo);
+#endif
+}
+
+// A FIFO as the scene or as --then-open in a scripted run: refused at once, not a hang.
+TEST(Viewer, AFifoSceneIsRefusedInScriptedRuns) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string fifo = out_dir() + "/scripted_fifo.ply";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  // `timeout`: before the fix the viewer blocked in open() for ever.
+  const RunResult a = run(prefix + "timeout 120 " + viewer() + " " + fifo + " --backend cpu --size 320x180 --frames 1 --exit");
+  EXPECT_EQ(a.exit_code, 2) << a.output;
+  EXPECT_NE(a.output.find("load failed (no scene loaded yet): " + fifo + ": a FIFO"), std::string::npos) << a.output;
+  EXPECT_NE(a.output.find("no scene to run the script on"), std::string::npos) << a.output;
+  const RunResult b = run(prefix + "timeout 120 " + viewer() + " --backend cpu --size 320x180 --frames 2 --then-open " +
+                          fifo + " --exit");
+  EXPECT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_NE(b.output.find("load failed, scene kept: " + fifo + ": a FIFO"), std::string::npos) << b.output;
+  std::filesystem::remove(fifo);
+}
+
+// A real mouse click (XTEST) on the panel's "Compare this view" button runs the comparison:
+// ImGui's mouse position and buttons reach it through the viewer's own platform inputs. The
+// click starts once the panels are on screen ("UI ready") and the button is held until the
+// viewer has seen it down in two frames, so a slow frame on a loaded machine cannot lose it.
+TEST(Viewer, MouseClickOnAPanelButtonWorks) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   // The button's place in a 1280x720 window at UI scale 1 (the panel layout is fixed).
-  const std::string steps = "wait_for \"Gaussians, SH degree\" || status=10\n"
-                            "[ $status -eq 0 ] && { sleep 1; \"$helper\" 95 650 || status=11; }\n"
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$input\" move 95 650 && hold button \" mouse0 \" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=12; }\n";
-  const RunResult r = run_live_viewer(prefix, dir + "/click_test.sh", "--backend cpu --size 1280x720",
-                                      FLASHGS_X11_CLICK, steps, 13, log);
+  const RunResult r = run_live_viewer(prefix, "click", "--backend cpu --size 1280x720 --log-input", steps, 13);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 no comparison, 13 crash)\n"
                             << r.output;
+#endif
+}
+
+// Ctrl+click on a slider turns it into a text field: what is typed there is clamped to the
+// slider's range. The issue's two cases: 0 seconds per camera, then Space (the path then
+// divided by zero and read a camera key at index INT_MIN), and a render scale of 40.
+TEST(Viewer, TypedSliderValuesAreClampedToTheirRanges) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  if (!flashgs::image_io_has_oiio()) GTEST_SKIP() << "F12 saves PNG, which needs OpenImageIO";
+  const std::string dir = out_dir();
+  std::filesystem::remove(dir + "/flashgs_screenshot.png");
+  // Slider places in a 640x720 window at UI scale 1 (the panel layout is fixed): "s per
+  // camera" at (100, 196), "Render scale" at (110, 281). GLFW key codes: Ctrl 341, Enter 257, Space 32.
+  auto typed = [](int x, int y, const std::string& text) {
+    return "press Control_L \" key341 \" && \"$input\" move " + std::to_string(x) + " " +
+           std::to_string(y) + " && hold button \" mouse0 \" && \"$input\" up Control_L && \"$input\" type " + text +
+           " && hold Return \" key257 \"";
+  };
+  const std::string steps =
+      "wait_for \"UI ready\" || status=10\n"
+      "[ $status -eq 0 ] && { " + typed(100, 196, "0") + " || status=11; }\n"
+      "[ $status -eq 0 ] && { hold space \" key32 \" || status=12; }\n"
+      "[ $status -eq 0 ] && { \"$input\" down F12 && \"$input\" up F12 || status=12; }\n"
+      "[ $status -eq 0 ] && { wait_for \"saved flashgs_screenshot\" || status=13; }\n"
+      "[ $status -eq 0 ] && { cp flashgs_screenshot.png playing_after_typed_zero.png; hold space \" key32 \" || status=14; }\n"
+      "[ $status -eq 0 ] && { " + typed(110, 281, "40") + " || status=14; }\n"
+      "[ $status -eq 0 ] && { \"$input\" down F12 && \"$input\" up F12 || status=14; }\n"
+      "[ $status -eq 0 ] && { wait_count \"saved flashgs_screenshot\" 2 || status=15; }\n"
+      "[ $status -eq 0 ] && { close_window || status=17; }\n";
+  std::filesystem::remove(dir + "/playing_after_typed_zero.png");
+  const RunResult r = run_live_viewer(prefix, "typed_sliders", "--backend cpu --size 640x720 --log-input", steps, 16);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 typing 0, 12 play + screenshot, 13 no screenshot, 14 typing 40, "
+                               "15 no screenshot, 16 crash, 17 close)\n"
+                            << r.output;
+  // The typed 0 became the range's bottom, 0.1 s; playing then shows the scene (a NaN pose
+  // shows only the background).
+  EXPECT_NE(r.output.find("playing the camera path: 36 cameras, 0.10 s each"), std::string::npos) << r.output;
+  const double lit = lit_fraction(flashgs::read_image(dir + "/playing_after_typed_zero.png"));
+  std::printf("playing after a typed 0: %.1f %% of the pixels lit\n", 100.0 * lit);
+  EXPECT_GT(lit, 0.05);
+  // 40 became the range's top, 4: a 2560x2880 frame.
+  EXPECT_NE(r.output.find("saved flashgs_screenshot.png (2560x2880)"), std::string::npos) << r.output;
 #endif
 }
 
@@ -284,6 +426,93 @@ TEST(Viewer, HeatmapAndCompareRun) {
   // The texture on screen holds exactly the backend's image of the view.
   EXPECT_NE(r.output.find("viewer frame check: displayed 480x270"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("-> ok"), std::string::npos) << r.output;
+}
+
+// Bad option values: one line naming the option, a non-zero exit, no window opened. `timeout`:
+// before the fix some were accepted and the viewer ran.
+TEST(Viewer, NonFiniteAndOutOfRangeOptionsAreRefusedNamingTheOption) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"--scale nan", "--scale"},          {"--scale inf", "--scale"},     {"--scale 40", "--scale"},
+      {"--fov nan", "--fov"},              {"--tau nan", "--tau"},         {"--background 0,nan,0", "--background"},
+      {"--camera -1", "--camera"},         {"--render-size 0x10", "--render-size"},
+      {"--render-size 99999999999x1", "--render-size"}, {"--size 12x", "--size"}};
+  for (const auto& [args, option] : cases) {
+    const RunResult r = run("timeout 60 " + viewer() + " " + args + " --backend cpu --frames 1 --exit");
+    EXPECT_NE(r.exit_code, 0) << args << "\n" << r.output;
+    EXPECT_EQ(r.output.rfind(std::string(option) + ": ", 0), 0u) << args << ": the first line must name the option\n"
+                                                                 << r.output;
+  }
+}
+
+TEST(Viewer, ACameraBeyondTheSceneIsAnErrorNamingTheOption) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 320x180 --camera 99 --frames 1 --exit");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--camera 99: the scene has 36 cameras (0..35)"), std::string::npos) << r.output;
+}
+
+// Frames and scenes too large for this machine are refused with their figures, before any
+// allocation (no std::bad_alloc, no abort).
+TEST(Viewer, ARenderSizeBeyondMemoryOrTextureLimitIsRefused) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 320x180 --render-size 32768x28800 --frames 1 --exit");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--render-size 32768x28800 refused: a 32768x28800 frame"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" GB of memory"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("bad_alloc"), std::string::npos) << r.output;
+}
+
+TEST(Viewer, AGeneratedOrTiledSceneBeyondMemoryIsRefused) {
+  REQUIRE_DISPLAY(prefix);
+  namespace fv = flashgs::viewer;
+  // 200 M demo Gaussians (SH degree 1); a machine with room for them would really build them.
+  const std::uint64_t need = fv::scene_bytes(200000000, fv::scene_bytes_per_gaussian(1));
+  if (double(need) <= fv::kMemoryShare * double(fv::available_memory_bytes()))
+    GTEST_SKIP() << "this machine has memory for " << fv::memory_text(need) << ": nothing to refuse";
+  const RunResult a = run(prefix + viewer() + " --backend cpu --size 320x180 --generate-demo 200000000 --frames 1 --exit");
+  EXPECT_EQ(a.exit_code, 2) << a.output;
+  // The reason first, then what follows from it (the run has no scene).
+  const auto reason = a.output.find("load failed (no scene loaded yet): --generate-demo 200000000: the scene would need about");
+  EXPECT_NE(reason, std::string::npos) << a.output;
+  EXPECT_GT(a.output.find("no scene to run the script on"), reason) << a.output;
+  const RunResult b = run(prefix + viewer() + " --backend cpu --size 320x180 --generate-demo 200000 --tile 1000 --frames 1 --exit");
+  EXPECT_EQ(b.exit_code, 2) << b.output;
+  EXPECT_NE(b.output.find("--tile 1000 refused: the scene would need about"), std::string::npos) << b.output;
+}
+
+// A window times the render scale beyond OpenGL's texture limit: the frame falls back to a
+// size that fits, with one line saying so, and the run goes on.
+TEST(Viewer, ARenderSizeBeyondTheTextureLimitFallsBackToOneThatFits) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult probe = run(prefix + viewer() + " --backend cpu --size 64x36 --frames 1 --exit");
+  ASSERT_EQ(probe.exit_code, 0) << probe.output;
+  const auto at = probe.output.find("textures up to ");
+  ASSERT_NE(at, std::string::npos) << probe.output;
+  const int limit = std::atoi(probe.output.c_str() + at + std::string("textures up to ").size());
+  ASSERT_GT(limit, 0);
+  const int window = limit / 4 + 8, wanted = window * 4;  // at scale 4: just over the limit
+  const std::string shot = out_dir() + "/fallback" + kExt;
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size " + std::to_string(window) +
+                          "x8 --scale 4 --frames 2 --screenshot " + shot + " --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string refused = "render size " + std::to_string(wanted) + "x32 refused: a " + std::to_string(wanted) +
+                              "x32 frame is larger than OpenGL's texture limit of " + std::to_string(limit);
+  EXPECT_NE(r.output.find(refused), std::string::npos) << r.output;
+  const flashgs::Image image = flashgs::read_image(shot);
+  EXPECT_LE(image.width, limit);
+  EXPECT_EQ(image.width, wanted / 2);
+}
+
+// An allocation failure inside a frame (here forced by a 3 GB address-space limit) is one line
+// and exit 2 from a scripted run, not "std::bad_alloc" from the top level.
+TEST(Viewer, AFrameThatRunsOutOfMemoryIsReportedNotFatal) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult r = run(prefix + "sh -c 'ulimit -v 3000000; exec " + viewer() +
+                          " --backend cpu --size 320x180 --render-size 12000x12000 --frames 2 --exit'");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("a 12000x12000 frame failed: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("out of memory"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("flashgs-viewer: error:"), std::string::npos) << r.output;
 }
 
 }  // namespace

@@ -1,15 +1,29 @@
-// The viewer's navigation logic without a window: exact snapping, frame-rate independence, paths, key scripts.
+// The viewer's logic without a window: navigation, paths, key scripts, settings ranges, memory estimates, scene loads.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <future>
+#include <limits>
+#include <thread>
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "camera_controller.h"
 #include "camera_path.h"
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
+#include "flashgs/io.h"
 #include "key_script.h"
+#include "memory_budget.h"
+#include "scene_loader.h"
 #include "scene_state.h"
 #include "stats_history.h"
+#include "test_support.h"
+#include "viewer_settings.h"
 
 namespace fv = flashgs::viewer;
 
@@ -26,6 +40,24 @@ float max_abs_diff(const glm::mat3& a, const glm::mat3& b) {
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r) m = std::max(m, std::abs(a[c][r] - b[c][r]));
   return m;
+}
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInff = std::numeric_limits<float>::infinity();
+
+void expect_rotation(const glm::mat3& r, const std::string& what) {
+  EXPECT_LT(max_abs_diff(glm::transpose(r) * r, glm::mat3(1.0f)), 1e-4f) << what;
+  EXPECT_NEAR(glm::determinant(r), 1.0f, 1e-4f) << what;
+}
+
+// A fresh scratch folder under the test output directory.
+std::string scratch_dir(const std::string& name) {
+  const std::string dir = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/viewer_logic/" + name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
 }
 
 }  // namespace
@@ -209,4 +241,238 @@ TEST(ViewerStats, FrameTimeSummary) {
   EXPECT_DOUBLE_EQ(s.min_ms, 1.0);
   EXPECT_DOUBLE_EQ(s.max_ms, 4.0);
   EXPECT_DOUBLE_EQ(s.fps, 400.0);
+}
+
+TEST(ViewerCameraPath, AnyTimeGivesAPoseOnThePath) {
+  // A different field of view per camera: a key index out of range reads something else.
+  auto cameras = orbit(24);
+  for (std::size_t k = 0; k < cameras.size(); ++k) cameras[k].fx *= 1.0f + 0.03f * float(k);
+  float lo = 1e9f, hi = 0;
+  for (const auto& c : cameras) lo = std::min(lo, c.horizontal_fov_degrees()), hi = std::max(hi, c.horizontal_fov_degrees());
+  fv::CameraPath path(cameras);
+  for (double t : {0.0, -0.0, -1e-17, 1.0, 0.999999999999, -5.3, 7.25, 1e300, -1e300, kNaN, kInf, -kInf,
+                   std::numeric_limits<double>::max(), std::numeric_limits<double>::denorm_min()}) {
+    const fv::Pose pose = path.pose_at(t);
+    EXPECT_TRUE(fv::is_finite(pose)) << "t = " << t;
+    expect_rotation(pose.rotation, "t = " + std::to_string(t));
+    const float fov = path.fov_at(t);
+    EXPECT_GE(fov, lo - 1e-3f) << "t = " << t;
+    EXPECT_LE(fov, hi + 1e-3f) << "t = " << t;
+  }
+  // NaN and the infinities mean "no position on the loop": camera 0.
+  EXPECT_LT(glm::length(path.pose_at(kNaN).position - fv::pose_of(cameras[0]).position), 1e-5f);
+  EXPECT_NEAR(path.fov_at(kInf), cameras[0].horizontal_fov_degrees(), 1e-4f);
+}
+
+TEST(ViewerCameraPath, AdvanceIsTotalInTimeAndDuration) {
+  fv::CameraPath path(orbit(24));
+  // One second at 2 s per camera over 24 cameras: 1/48 of the loop.
+  EXPECT_NEAR(path.advance(0.0, 1.0, 2.0), 1.0 / 48.0, 1e-12);
+  EXPECT_NEAR(path.advance(0.99, 1.0, 2.0), 0.99 + 1.0 / 48.0 - 1.0, 1e-12);  // wraps
+  for (double seconds : {0.0, -0.0, -1.0, kNaN, kInf, -kInf, 1e-320, 1e300})
+    for (double dt : {0.0, 1.0 / 60.0, -1.0, kNaN, kInf, 1e308}) {
+      const double t = path.advance(0.25, dt, seconds);
+      EXPECT_TRUE(std::isfinite(t) && t >= 0.0 && t < 1.0) << "dt " << dt << " s/camera " << seconds << " -> " << t;
+      EXPECT_TRUE(fv::is_finite(path.pose_at(t)));
+    }
+  // A duration that is no duration leaves the path where it is.
+  EXPECT_EQ(path.advance(0.25, 1.0 / 60.0, 0.0), 0.25);
+  EXPECT_EQ(path.advance(0.25, 1.0 / 60.0, kNaN), 0.25);
+  EXPECT_EQ(path.advance(0.25, kInf, 2.0), 0.25);
+  // An empty path is total too.
+  fv::CameraPath none({});
+  EXPECT_TRUE(fv::is_finite(none.pose_at(kNaN)));
+  EXPECT_EQ(none.advance(kNaN, 1.0, 0.0), 0.0);
+}
+
+TEST(ViewerNavigation, NonFiniteOrHugeInputNeverGivesANaNPose) {
+  fv::ViewerSettings s;
+  for (auto mode : {fv::NavigationMode::fly, fv::NavigationMode::orbit}) {
+    s.mode = mode;
+    fv::CameraController c;
+    c.reset(glm::vec3(1, 2, 3), 2.0f, glm::vec3(0, 1, 0));
+    const std::string m = mode == fv::NavigationMode::fly ? "fly: " : "orbit: ";
+    for (float bad : {kNaNf, kInff, -kInff, 1e30f, -3e38f, std::numeric_limits<float>::max()}) {
+      for (int field = 0; field < 5; ++field) {
+        fv::NavigationInput in;
+        in.forward = true;
+        float* values[5] = {&in.look_dx, &in.look_dy, &in.pan_dx, &in.pan_dy, &in.scroll};
+        *values[field] = bad;
+        c.update(in, 0.016f, s);
+        const std::string what = m + "field " + std::to_string(field) + " = " + std::to_string(bad);
+        ASSERT_TRUE(fv::is_finite(c.pose())) << what;
+        expect_rotation(c.pose().rotation, what);
+        EXPECT_TRUE(std::isfinite(s.move_speed) && s.move_speed > 0) << what;
+        const flashgs::Camera cam = c.render_camera(64, 36, s.fov_x_degrees);
+        for (float v : cam.rotation) ASSERT_TRUE(std::isfinite(v)) << what;
+        for (float v : cam.position) ASSERT_TRUE(std::isfinite(v)) << what;
+      }
+      fv::NavigationInput in;
+      in.forward = true;
+      in.back = false;
+      for (float dt : {kNaNf, kInff, -1.0f, 1e30f}) {
+        c.update(in, dt, s);
+        ASSERT_TRUE(fv::is_finite(c.pose())) << m << "dt " << dt;
+      }
+    }
+    // A NaN speed or field of view in the settings cannot reach the pose or the camera either.
+    s.move_speed = kNaNf;
+    fv::NavigationInput in;
+    in.forward = true;
+    c.update(in, 0.1f, s);
+    EXPECT_TRUE(fv::is_finite(c.pose())) << m;
+    const flashgs::Camera cam = c.render_camera(64, 36, kNaNf);
+    EXPECT_TRUE(std::isfinite(cam.fx) && cam.fx > 0) << m;
+    s = fv::ViewerSettings{};
+  }
+  // A non-finite pose handed in (a broken path) is ignored.
+  fv::CameraController c;
+  c.reset(glm::vec3(0), 1.0f, glm::vec3(0, 1, 0));
+  const glm::vec3 before = c.pose().position;
+  fv::Pose bad;
+  bad.position = glm::vec3(kNaNf, 0, 0);
+  c.set_pose(bad);
+  EXPECT_EQ(c.pose().position, before);
+}
+
+TEST(ViewerSettings, TypedValuesStayInTheirRanges) {
+  const fv::ViewerSettings before;
+  fv::ViewerSettings s = before;
+  s.path_seconds_per_camera = 0.0f;  // the Ctrl+click "0"
+  s.render_scale = 40.0f;            // the typed render scale
+  s.fov_x_degrees = kNaNf;
+  s.move_speed = -kInff;
+  s.heatmap_opacity = 7.0f;
+  s.options.tau = kNaNf;
+  s.options.background[1] = kInff;
+  s.options.background[2] = -0.5f;
+  s.options.sh_degree_cap = 9;
+  fv::keep_settings_valid(s, before);
+  EXPECT_EQ(s.path_seconds_per_camera, fv::kPathSecondsRange.min);
+  EXPECT_EQ(s.render_scale, fv::kRenderScaleRange.max);
+  EXPECT_EQ(s.fov_x_degrees, before.fov_x_degrees);  // NaN: the value before the edit
+  EXPECT_EQ(s.move_speed, before.move_speed);
+  EXPECT_EQ(s.heatmap_opacity, fv::kHeatmapOpacityRange.max);
+  EXPECT_EQ(s.options.tau, before.options.tau);
+  EXPECT_EQ(s.options.background[1], before.options.background[1]);
+  EXPECT_EQ(s.options.background[2], 0.0f);
+  EXPECT_EQ(s.options.sh_degree_cap, fv::kMaxShDegree);
+  // Values in range are left exactly as they are.
+  fv::ViewerSettings fine = before;
+  fine.render_scale = 0.37f;
+  fine.path_seconds_per_camera = 3.5f;
+  fv::keep_settings_valid(fine, before);
+  EXPECT_EQ(fine.render_scale, 0.37f);
+  EXPECT_EQ(fine.path_seconds_per_camera, 3.5f);
+}
+
+TEST(ViewerMemory, TooLargeFramesAreRefusedWithTheirFigures) {
+  // 32768 x 28800 (the issue's --render-size): 943 Mpixel at 24 bytes with one texture.
+  EXPECT_NEAR(double(fv::frame_bytes(32768, 28800, 1)), 32768.0 * 28800 * 20, 32768.0 * 28800 * 0.3);
+  const std::string over_limit = fv::frame_size_problem(32768, 28800, 1, 16384, 64000000000ull);
+  EXPECT_NE(over_limit.find("32768x28800"), std::string::npos) << over_limit;
+  EXPECT_NE(over_limit.find("texture limit of 16384"), std::string::npos) << over_limit;
+  EXPECT_NE(over_limit.find(" GB"), std::string::npos) << over_limit;
+  // 20000 x 20000 on a machine with 8 GB free: over 8 GB needed, refused by memory alone.
+  const std::string over_memory = fv::frame_size_problem(20000, 20000, 1, 0, 8000000000ull);
+  EXPECT_GT(fv::frame_bytes(20000, 20000, 1), 8000000000ull);
+  EXPECT_NE(over_memory.find("needs about " + fv::memory_text(fv::frame_bytes(20000, 20000, 1))), std::string::npos)
+      << over_memory;
+  EXPECT_NE(over_memory.find("8.0 GB is available"), std::string::npos) << over_memory;
+  // Ordinary frames fit; unknown memory (0) is not held against them.
+  EXPECT_EQ(fv::frame_size_problem(3840, 2160, 2, 16384, 8000000000ull), "");
+  EXPECT_EQ(fv::frame_size_problem(3840, 2160, 2, 16384, 0), "");
+  EXPECT_NE(fv::frame_size_problem(0, 10, 1, 16384, 0), "");
+  // Scenes: 200 M demo Gaussians (SH degree 1) do not fit in 20 GB, 30 000 do.
+  const std::uint64_t per = fv::scene_bytes_per_gaussian(1);
+  EXPECT_EQ(per, 23u * 4u);
+  EXPECT_NE(fv::scene_size_problem(fv::scene_bytes(200000000, per), 20000000000ull).find(" GB of memory"),
+            std::string::npos);
+  EXPECT_EQ(fv::scene_size_problem(fv::scene_bytes(30000, per), 20000000000ull), "");
+  EXPECT_GT(fv::available_memory_bytes(), 0u);
+}
+
+// Loads with a time limit: a load that blocks fails the test instead of hanging it.
+flashgs::Error load_error_within(const std::string& path, std::chrono::seconds limit) {
+  auto result = std::make_shared<std::promise<std::string>>();
+  std::future<std::string> done = result->get_future();
+  std::thread([result, path] {
+    try {
+      fv::load_scene(path);
+      result->set_value("");
+    } catch (const std::exception& e) {
+      result->set_value(e.what());
+    }
+  }).detach();
+  if (done.wait_for(limit) != std::future_status::ready) return flashgs::Error(path + ": the load blocked");
+  return flashgs::Error(done.get());
+}
+
+TEST(ViewerScene, AFifoOrDeviceIsRefusedWithoutOpeningIt) {
+  const std::string dir = scratch_dir("fifo");
+  const std::string fifo = dir + "/scene.ply";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const std::string e = load_error_within(fifo, std::chrono::seconds(20)).what();
+  EXPECT_NE(e.find(fifo + ": a FIFO"), std::string::npos) << e;
+  // A folder whose point_cloud.ply is a FIFO, and a device.
+  std::filesystem::create_directories(dir + "/folder");
+  ASSERT_EQ(mkfifo((dir + "/folder/point_cloud.ply").c_str(), 0600), 0);
+  const std::string f = load_error_within(dir + "/folder", std::chrono::seconds(20)).what();
+  EXPECT_NE(f.find("point_cloud.ply: a FIFO"), std::string::npos) << f;
+  const std::string d = load_error_within("/dev/zero", std::chrono::seconds(20)).what();
+  EXPECT_NE(d.find("/dev/zero: a device"), std::string::npos) << d;
+}
+
+TEST(ViewerScene, AFifoAsCamerasJsonIsNotedAndTheSceneLoads) {
+  const std::string dir = scratch_dir("fifo_cameras");
+  std::filesystem::copy_file(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply", dir + "/point_cloud.ply");
+  ASSERT_EQ(mkfifo((dir + "/cameras.json").c_str(), 0600), 0);
+  auto result = std::async(std::launch::async, [&] { return fv::load_scene(dir + "/point_cloud.ply"); });
+  ASSERT_EQ(result.wait_for(std::chrono::seconds(30)), std::future_status::ready) << "blocked on the FIFO";
+  const fv::LoadedScene scene = result.get();
+  EXPECT_GT(scene.scene->size(), 0u);
+  EXPECT_TRUE(scene.cameras.empty());
+  EXPECT_NE(scene.cameras_note.find("cameras.json: a FIFO"), std::string::npos) << scene.cameras_note;
+}
+
+TEST(ViewerSceneLoader, LoadsInTheBackgroundAndReportsErrors) {
+  fv::SceneLoader loader;
+  ASSERT_TRUE(loader.start(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply"));
+  EXPECT_FALSE(loader.start("/another.ply")) << "a second load while one runs";
+  fv::LoadedScene scene;
+  std::string error;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!loader.take(&scene, &error) && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+  EXPECT_EQ(error, "");
+  ASSERT_TRUE(scene.scene);
+  EXPECT_EQ(scene.scene->size(), 30000u);
+  EXPECT_FALSE(loader.busy());
+  ASSERT_TRUE(loader.start("/nonexistent/x.ply"));
+  while (!loader.take(&scene, &error) && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+  EXPECT_NE(error.find("/nonexistent/x.ply"), std::string::npos) << error;
+}
+
+TEST(ViewerSceneLoader, ABlockedLoadIsAbandonedWithoutWaiting) {
+  // A load that blocks until released, as open() on a FIFO or a hung mount does.
+  auto release = std::make_shared<std::promise<void>>();
+  std::shared_future<void> released = release->get_future().share();
+  const int running_before = fv::SceneLoader::running();
+  {
+    fv::SceneLoader loader([released](const std::string& path) -> fv::LoadedScene {
+      released.wait();
+      throw flashgs::Error(path + ": released");
+    });
+    ASSERT_TRUE(loader.start("blocked.ply"));
+    EXPECT_TRUE(loader.busy());
+    EXPECT_EQ(loader.path(), "blocked.ply");
+    loader.abandon();  // the Cancel button
+    EXPECT_FALSE(loader.busy());
+    ASSERT_TRUE(loader.start("blocked-too.ply")) << "a new load can start after abandoning";
+    EXPECT_EQ(fv::SceneLoader::running(), running_before + 2);
+  }  // destroyed with a load still blocked: must return at once (this line is reached)
+  release->set_value();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (fv::SceneLoader::running() != running_before && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::yield();
+  EXPECT_EQ(fv::SceneLoader::running(), running_before) << "the abandoned threads did not end";
 }

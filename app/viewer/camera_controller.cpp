@@ -21,7 +21,32 @@ glm::mat3 orthonormalised(const glm::mat3& r) {
   return glm::mat3(x, y, f);
 }
 
+// More than any real drag or wheel turn within one frame (a 16K screen crossed four times).
+constexpr float kMaxDragPoints = 65536.0f;
+constexpr float kMaxScrollSteps = 100.0f;
+
+float finite_clamped(float v, float limit) { return std::isfinite(v) ? std::clamp(v, -limit, limit) : 0.0f; }
+
 }  // namespace
+
+NavigationInput sanitized(const NavigationInput& in) {
+  NavigationInput out = in;
+  out.look_dx = finite_clamped(in.look_dx, kMaxDragPoints);
+  out.look_dy = finite_clamped(in.look_dy, kMaxDragPoints);
+  out.pan_dx = finite_clamped(in.pan_dx, kMaxDragPoints);
+  out.pan_dy = finite_clamped(in.pan_dy, kMaxDragPoints);
+  out.scroll = finite_clamped(in.scroll, kMaxScrollSteps);
+  return out;
+}
+
+bool is_finite(const Pose& pose) {
+  for (int c = 0; c < 3; ++c) {
+    if (!std::isfinite(pose.position[c])) return false;
+    for (int r = 0; r < 3; ++r)
+      if (!std::isfinite(pose.rotation[c][r])) return false;
+  }
+  return true;
+}
 
 Pose pose_of(const Camera& camera) {
   Pose pose;
@@ -34,10 +59,12 @@ Pose pose_of(const Camera& camera) {
 }
 
 void CameraController::reset(const glm::vec3& centre, float extent, const glm::vec3& world_up) {
-  m_centre = centre;
+  const bool centre_ok = std::isfinite(glm::dot(centre, centre));
+  m_centre = centre_ok ? centre : glm::vec3(0.0f);
   m_extent = extent > 0.0f && std::isfinite(extent) ? extent : 1.0f;
-  m_up = glm::normalize(world_up);
-  m_pivot = centre;
+  const float up_length = glm::length(world_up);
+  m_up = up_length > 0.0f && std::isfinite(up_length) ? world_up / up_length : glm::vec3(0.0f, -1.0f, 0.0f);
+  m_pivot = m_centre;
   m_snapped_valid = false;
   // Default view: from a distance of two extents, looking at the centre, level with the horizon.
   glm::vec3 any = std::abs(m_up.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, 1);
@@ -45,7 +72,7 @@ void CameraController::reset(const glm::vec3& centre, float extent, const glm::v
   forward = glm::normalize(forward - m_up * 0.3f);
   const glm::vec3 right = glm::normalize(glm::cross(m_up, forward) * -1.0f);
   m_pose.rotation = orthonormalised(glm::mat3(right, glm::cross(forward, right), forward));
-  m_pose.position = centre - forward * (2.0f * m_extent);
+  m_pose.position = m_centre - forward * (2.0f * m_extent);
   m_orbit_distance = 2.0f * m_extent;
 }
 
@@ -57,7 +84,8 @@ void CameraController::snap_to(const Camera& camera) {
   place_pivot_ahead();
 }
 
-void CameraController::set_pose(const Pose& pose, float) {
+void CameraController::set_pose(const Pose& pose) {
+  if (!is_finite(pose)) return;
   m_pose = pose;
   m_snapped_valid = false;
   place_pivot_ahead();
@@ -99,12 +127,31 @@ void CameraController::rotate_view(float yaw, float pitch) {
   m_pose.rotation = orthonormalised(r);
 }
 
-bool CameraController::update(const NavigationInput& in, float dt, ViewerSettings& settings) {
+bool CameraController::update(const NavigationInput& input, float dt, ViewerSettings& settings) {
+  if (!std::isfinite(dt) || dt < 0.0f) dt = 0.0f;
+  settings.move_speed = kMoveSpeedRange.clamp(settings.move_speed, 1.0f);
+  settings.look_sensitivity = kLookSensitivityRange.clamp(settings.look_sensitivity, 0.004f);
+  // The last line of defence: whatever the arithmetic did, a non-finite result is undone.
+  const Pose pose = m_pose;
+  const glm::vec3 pivot = m_pivot;
+  const float distance = m_orbit_distance;
+  const bool changed = apply(sanitized(input), dt, settings);
+  if (!is_finite(m_pose) || !std::isfinite(glm::dot(m_pivot, m_pivot)) || !std::isfinite(m_orbit_distance)) {
+    m_pose = pose;
+    m_pivot = pivot;
+    m_orbit_distance = distance;
+    return false;
+  }
+  return changed;
+}
+
+bool CameraController::apply(const NavigationInput& in, float dt, ViewerSettings& settings) {
   if (m_mode != settings.mode) set_mode(settings.mode);
   bool changed = false;
   const float sens = settings.look_sensitivity;
   if (m_mode == NavigationMode::fly) {
-    if (in.scroll != 0.0f) settings.move_speed = std::clamp(settings.move_speed * std::pow(1.2f, in.scroll), 1e-4f, 1e4f);
+    if (in.scroll != 0.0f)
+      settings.move_speed = std::clamp(settings.move_speed * std::pow(1.2f, in.scroll), kMoveSpeedRange.min, kMoveSpeedRange.max);
     if (in.look_dx != 0.0f || in.look_dy != 0.0f) {
       rotate_view(-in.look_dx * sens, -in.look_dy * sens);
       changed = true;
@@ -151,7 +198,7 @@ Camera CameraController::render_camera(int width, int height, float fov_x_degree
     // Same aspect: the scene camera resized exactly as `flashgs render -r WxH` does.
     if (std::abs(aspect_scene / aspect_view - 1.0) < 1e-3) return m_snapped.resized(width, height);
   }
-  const float fov = std::clamp(fov_x_degrees, 1.0f, 170.0f) * float(M_PI / 180.0);
+  const float fov = kFovRange.clamp(fov_x_degrees, 60.0f) * float(M_PI / 180.0);
   const float f = 0.5f * float(width) / std::tan(0.5f * fov);
   float c2w[9];
   for (int row = 0; row < 3; ++row)

@@ -33,24 +33,27 @@ class CameraController {
   // Places the camera exactly at a scene camera; render_camera() reproduces it bit for bit at
   // the same aspect ratio until the camera moves.
   void snap_to(const Camera& camera);
-  void set_pose(const Pose& pose, float fov_x_degrees);
-  // Applies one frame of input over `dt` seconds; returns whether the view changed.
+  // Moves the camera to `pose` (the field of view is the caller's setting); a pose with a NaN
+  // or infinite component is ignored.
+  void set_pose(const Pose& pose);
+  // Applies one frame of input over `dt` seconds; returns whether the view changed. Non-finite
+  // input is ignored and huge drags are clamped: the pose stays finite whatever arrives.
   bool update(const NavigationInput& input, float dt, ViewerSettings& settings);
   // Inverts the world-up axis and rolls the camera half a turn so the picture turns upright.
   void flip_up();
   void set_mode(NavigationMode mode);
 
-  // The camera to render at width x height.
+  // The camera to render at width x height (fov clamped to kFovRange; NaN gives 60 degrees).
   Camera render_camera(int width, int height, float fov_x_degrees) const;
 
   const Pose& pose() const { return m_pose; }
   const glm::vec3& world_up() const { return m_up; }
-  float extent() const { return m_extent; }
   const glm::vec3& pivot() const { return m_pivot; }
   // Whether the camera still sits exactly on the snapped scene camera.
   bool on_scene_camera() const { return m_snapped_valid; }
 
  private:
+  bool apply(const NavigationInput& input, float dt, ViewerSettings& settings);
   void rotate_view(float yaw, float pitch);
   void place_pivot_ahead();
 
@@ -65,6 +68,11 @@ class CameraController {
   bool m_snapped_valid = false;
   float m_snapped_fov = 0.0f;
 };
+
+// `input` with every NaN or infinite value zeroed and drags and wheel steps clamped to what a
+// hand can do in one frame (a window-system glitch or a script cannot turn into a NaN pose).
+NavigationInput sanitized(const NavigationInput& input);
+bool is_finite(const Pose& pose);
 
 // Pose of a scene camera (inverse of Camera's world-to-camera rotation).
 Pose pose_of(const Camera& camera);

@@ -1,6 +1,7 @@
 // Camera path interpolation: uniform Catmull-Rom through the centres, quaternion slerp between rotations.
 #include "camera_path.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/quaternion.hpp>
@@ -13,19 +14,35 @@ CameraPath::CameraPath(const std::vector<Camera>& cameras) {
 
 namespace {
 
+// Into [0, 1); not finite -> 0, so no index computed from it can be NaN or out of range.
 double wrap01(double t) {
-  t = std::fmod(t, 1.0);
-  return t < 0.0 ? t + 1.0 : t;
+  if (!std::isfinite(t)) return 0.0;
+  t -= std::floor(t);
+  return t < 1.0 ? t : 0.0;  // t just below 0 can round up to exactly 1
 }
 
 }  // namespace
 
+void CameraPath::locate(double t, int* key, float* u) const {
+  const int n = static_cast<int>(m_keys.size());
+  const double s = wrap01(t) * n;
+  const double whole = std::floor(s);
+  *key = std::clamp(static_cast<int>(whole), 0, n - 1);
+  *u = std::clamp(static_cast<float>(s - whole), 0.0f, 1.0f);
+}
+
+double CameraPath::advance(double t, double dt, double seconds_per_camera) const {
+  if (m_keys.empty() || !(seconds_per_camera > 0.0) || !std::isfinite(seconds_per_camera) || !std::isfinite(dt))
+    return wrap01(t);
+  return wrap01(wrap01(t) + dt / (seconds_per_camera * static_cast<double>(m_keys.size())));
+}
+
 Pose CameraPath::pose_at(double t) const {
   if (m_keys.empty()) return {};
   const int n = static_cast<int>(m_keys.size());
-  const double s = wrap01(t) * n;
-  const int i = static_cast<int>(std::floor(s)) % n;
-  const float u = static_cast<float>(s - std::floor(s));
+  int i = 0;
+  float u = 0;
+  locate(t, &i, &u);
   auto at = [&](int k) -> const Key& { return m_keys[((k % n) + n) % n]; };
   const glm::vec3 p0 = at(i - 1).pose.position, p1 = at(i).pose.position, p2 = at(i + 1).pose.position,
                   p3 = at(i + 2).pose.position;
@@ -45,9 +62,9 @@ Pose CameraPath::pose_at(double t) const {
 float CameraPath::fov_at(double t) const {
   if (m_keys.empty()) return 60.0f;
   const int n = static_cast<int>(m_keys.size());
-  const double s = wrap01(t) * n;
-  const int i = static_cast<int>(std::floor(s)) % n;
-  const float u = static_cast<float>(s - std::floor(s));
+  int i = 0;
+  float u = 0;
+  locate(t, &i, &u);
   return m_keys[i].fov + (m_keys[(i + 1) % n].fov - m_keys[i].fov) * u;
 }
 

@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
+
+#include "flashgs/error.h"
 
 #include "viewer_shaders.h"  // generated from shaders/*.glsl by CMake
 
@@ -31,6 +34,7 @@ void ImagePresenter::init() {
 
 void ImagePresenter::resize(int width, int height, int count) {
   glDeleteTextures(m_texture_count, m_textures);
+  while (glGetError() != GL_NO_ERROR) {}  // only this call's errors count below
   m_width = width;
   m_height = height;
   m_texture_count = std::clamp(count, 1, kMaxTextures);
@@ -44,6 +48,15 @@ void ImagePresenter::resize(int width, int height, int count) {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+  }
+  if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
+    // Out of memory or beyond the size limit: no textures rather than unusable ones, so
+    // that the next resize() starts clean.
+    glDeleteTextures(m_texture_count, m_textures);
+    m_texture_count = m_width = m_height = 0;
+    char text[128];
+    std::snprintf(text, sizeof text, "OpenGL refused %dx%d frame textures (error 0x%04x)", width, height, error);
+    throw Error(text);
   }
 }
 

@@ -31,7 +31,7 @@ class ImagePresenter {
     return width != m_width || height != m_height || count != m_texture_count;
   }
   // Recreates `count` RGBA8 frame textures (the old ones are deleted: detach interop first);
-  // texture 0 is shown.
+  // texture 0 is shown. Throws flashgs::Error when GL refuses them (none are left then).
   void resize(int width, int height, int count = 1);
   GLuint texture(int index) const { return m_textures[index]; }
   // Which frame texture draw() and read_back() use.

@@ -1,6 +1,7 @@
 // LoadedScene: a scene with its cameras and the framing the viewer derives from them; loading never leaves a half-made scene.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,7 +15,6 @@ namespace flashgs::viewer {
 
 struct LoadedScene {
   std::string path;                     // the PLY (or a description for generated scenes)
-  std::string cameras_path;             // empty when none was found
   std::shared_ptr<const Scene> scene;
   std::vector<Camera> cameras;          // may be empty
   LoadReport report;
@@ -22,12 +22,15 @@ struct LoadedScene {
   glm::vec3 centre{0.0f};               // orbit pivot / default look-at
   float extent = 1.0f;                  // typical size, sets navigation speeds
   glm::vec3 up{0.0f, -1.0f, 0.0f};      // guessed world up
-  double load_seconds = 0;
 };
 
-// Loads `ply_path` and the cameras.json beside it (or `cameras_path`). Throws flashgs::Error
-// naming the file and the problem; a missing or broken cameras.json is not fatal (noted).
+// Loads `ply_path` (a regular file, or a folder holding point_cloud.ply) and the cameras.json
+// beside it (or `cameras_path`). Throws flashgs::Error naming the file and the problem, before
+// opening anything that is not a regular file (a FIFO would block); a missing, broken or
+// irregular cameras.json is not fatal (noted).
 LoadedScene load_scene(const std::string& ply_path, const std::string& cameras_path = "");
+// Empty for a regular file; else what the path is instead ("a FIFO (named pipe), not a regular file").
+std::string file_type_problem(const std::filesystem::file_status& status);
 // The procedural demo scene (`count` Gaussians) with orbit cameras, for runs where no file can travel.
 LoadedScene generate_demo_scene(std::size_t count);
 // `copies` copies of a loaded scene on a grid (large-scene benchmarks); cameras kept.

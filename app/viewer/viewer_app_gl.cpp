@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <future>
+#include <new>
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -17,6 +17,7 @@
 #include "gl_headers_gl.h"
 #include "image_presenter_gl.h"
 #include "imgui_layer_ui.h"
+#include "memory_budget.h"
 #include "viewer_panels_ui.h"
 #include "window_gl.h"
 
@@ -50,6 +51,13 @@ glm::vec3 axis_from_text(const std::string& t) {
 
 std::string demo_scene_path() { return std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply"; }
 
+// An exception's text for a message: a bare std::bad_alloc says only "std::bad_alloc".
+std::string reason(const std::exception& e) {
+  return dynamic_cast<const std::bad_alloc*>(&e) ? std::string("out of memory") : std::string(e.what());
+}
+
+std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
+
 }  // namespace
 
 ViewerApp::ViewerApp(ViewerArgs args) : m_args(std::move(args)) {
@@ -59,6 +67,7 @@ ViewerApp::ViewerApp(ViewerArgs args) : m_args(std::move(args)) {
   o.sh_degree_cap = m_args.sh_degree;
   for (int c = 0; c < 3; ++c) o.background[c] = m_args.background[c];
   m_settings.render_scale = m_args.scale;
+  m_good_scale = m_args.scale;
   m_settings.forced_width = m_args.render_width;
   m_settings.forced_height = m_args.render_height;
   m_settings.heatmap = m_args.heatmap;
@@ -134,6 +143,12 @@ void ViewerApp::apply_up_choice() {
   if (m_settings.flip_up) m_controller.flip_up();
 }
 
+void ViewerApp::report_failed_load(const std::string& error) {
+  // Says what the window shows now: the scene from before, or (first load) nothing yet.
+  m_load_error = m_scene.scene ? "load failed, scene kept: " + error : "load failed (no scene loaded yet): " + error;
+  std::fprintf(stderr, "flashgs-viewer: %s\n", m_load_error.c_str());
+}
+
 bool ViewerApp::open_scene(const std::string& path) {
   try {
     install_scene(load_scene(path, path == m_args.scene ? m_args.cameras : ""));
@@ -141,8 +156,7 @@ bool ViewerApp::open_scene(const std::string& path) {
     m_path_buffer = path;
     return true;
   } catch (const std::exception& e) {
-    m_load_error = e.what();
-    std::fprintf(stderr, "flashgs-viewer: load failed, scene kept: %s\n", e.what());
+    report_failed_load(reason(e));
     return false;
   }
 }
@@ -152,29 +166,26 @@ void ViewerApp::request_open(const std::string& path) {
     open_scene(path);
     return;
   }
-  if (m_pending_load.valid()) {
-    m_status = "still loading " + m_pending_path + "; " + path + " ignored";
-    return;
-  }
   // Parsing a large PLY takes seconds: it runs beside the frame loop, which keeps drawing the
   // current scene; the new one is installed (uploaded) on this thread once it is ready.
-  m_pending_path = path;
-  m_pending_load = std::async(std::launch::async, [path] { return load_scene(path); });
+  if (!m_loader.start(path)) set_notice("still loading " + m_loader.path() + "; " + path + " ignored");
 }
 
 void ViewerApp::finish_pending_load() {
-  if (!m_pending_load.valid() ||
-      m_pending_load.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+  const std::string path = m_loader.path();
+  LoadedScene scene;
+  std::string error;
+  if (!m_loader.take(&scene, &error)) return;
+  if (!error.empty()) {
+    report_failed_load(error);
     return;
-  const std::string path = m_pending_path;
-  m_pending_path.clear();
+  }
   try {
-    install_scene(m_pending_load.get());
+    install_scene(std::move(scene));
     m_load_error.clear();
     m_path_buffer = path;
   } catch (const std::exception& e) {
-    m_load_error = e.what();
-    std::fprintf(stderr, "flashgs-viewer: load failed, scene kept: %s\n", e.what());
+    report_failed_load(path + ": " + reason(e));
   }
 }
 
@@ -188,7 +199,7 @@ void ViewerApp::snap_to_camera(int index) {
   m_playing = false;
 }
 
-void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions, float) {
+void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   double x = 0, y = 0;
   m_window->cursor(&x, &y);
   const float dx = float(x - m_last_cursor_x), dy = float(y - m_last_cursor_y);
@@ -255,13 +266,21 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions, float) {
 }
 
 void ViewerApp::apply_actions(const UiActions& a) {
+  if (a.cancel_load && m_loader.busy()) {
+    set_notice("stopped waiting for " + m_loader.path());
+    m_loader.abandon();
+  }
   if (!a.open_path.empty()) request_open(a.open_path);
   if (a.snap_camera >= 0) snap_to_camera(a.snap_camera);
   if (a.next_camera) snap_to_camera(m_camera_index + 1);
   if (a.previous_camera) snap_to_camera(m_camera_index < 0 ? 0 : m_camera_index - 1);
   if (a.toggle_play && m_camera_path && !m_camera_path->empty()) {
     m_playing = !m_playing;
-    if (m_playing) m_path_t = m_camera_index >= 0 ? double(m_camera_index) / m_camera_path->size() : 0.0;
+    if (m_playing) {
+      m_path_t = m_camera_index >= 0 ? double(m_camera_index) / m_camera_path->size() : 0.0;
+      std::fprintf(stderr, "flashgs-viewer: playing the camera path: %zu cameras, %.2f s each\n",
+                   m_camera_path->size(), m_settings.path_seconds_per_camera);
+    }
   }
   if (a.flip_up) m_controller.flip_up();
   if (a.reset_view) {
@@ -318,6 +337,69 @@ void ViewerApp::render_frame(const Camera& camera) {
   m_last_options = options;
   m_have_frame = true;
   if (m_compare.valid) m_compare.stale = true;
+}
+
+void ViewerApp::log_held_input() {
+  // One line per frame while anything is held, each held button or key a token between
+  // spaces (" mouse0 ", " key257 "): a test holds a button until it has seen two such frames.
+  std::string held;
+  for (int button = 0; button <= GLFW_MOUSE_BUTTON_LAST; ++button)
+    if (m_window->mouse_down(button)) held += " mouse" + std::to_string(button);
+  for (int key = GLFW_KEY_SPACE; key <= GLFW_KEY_LAST; ++key)
+    if (m_window->key_down(key)) held += " key" + std::to_string(key);
+  if (held.empty()) return;
+  double x = 0, y = 0;
+  m_window->cursor(&x, &y);
+  std::fprintf(stderr, "flashgs-viewer: frame %d held:%s at %.0f,%.0f\n", m_presented, held.c_str(), x, y);
+}
+
+void ViewerApp::set_notice(const std::string& message) {
+  if (message == m_status) return;  // a refusal repeated every frame is logged once
+  m_status = message;
+  std::fprintf(stderr, "flashgs-viewer: %s\n", message.c_str());
+}
+
+void ViewerApp::choose_render_size(int wanted_width, int wanted_height, int* width, int* height) {
+  *width = wanted_width;
+  *height = wanted_height;
+  if (wanted_width == m_good_width && wanted_height == m_good_height) return;
+  if (wanted_width != m_checked_width || wanted_height != m_checked_height) {
+    m_checked_width = wanted_width;
+    m_checked_height = wanted_height;
+    m_checked_problem = frame_size_problem(wanted_width, wanted_height, m_path->texture_count(), m_max_texture_size,
+                                           available_memory_bytes());
+  }
+  if (m_checked_problem.empty()) return;
+  // Back to the last size that rendered; before the first frame, halves until it fits.
+  int w = m_good_width, h = m_good_height;
+  if (w <= 0 || h <= 0) {
+    w = wanted_width;
+    h = wanted_height;
+    while ((w > 1 || h > 1) && !frame_size_problem(w, h, m_path->texture_count(), m_max_texture_size,
+                                                   available_memory_bytes()).empty()) {
+      w = std::max(1, w / 2);
+      h = std::max(1, h / 2);
+    }
+  }
+  m_settings.render_scale = m_good_scale;  // a typed scale that does not fit is not kept
+  *width = w;
+  *height = h;
+  set_notice("render size " + size_text(wanted_width, wanted_height) + " refused: " + m_checked_problem +
+             "; rendering at " + size_text(w, h));
+}
+
+void ViewerApp::render_failed(int width, int height, const std::string& why) {
+  m_settings.render_scale = m_good_scale;
+  m_settings.forced_width = m_settings.forced_height = 0;
+  m_checked_width = width;  // not tried again at this size
+  m_checked_height = height;
+  m_checked_problem = why;
+  const std::string back = m_good_width > 0 ? "back to " + size_text(m_good_width, m_good_height) : "nothing shown";
+  set_notice("a " + size_text(width, height) + " frame failed: " + why + "; " + back);
+  if (m_scripted) {  // a benchmark at another size would report the wrong numbers
+    m_exit_code = 2;
+    m_window->request_close();
+  }
 }
 
 void ViewerApp::save_screenshot(const std::string& path) {
@@ -435,6 +517,78 @@ void ViewerApp::finish_script() {
   m_settings.vsync = !m_args.no_vsync;
 }
 
+bool ViewerApp::load_first_scene() {
+  // The first scene: generated, the argument, or the demo; interactive runs fall back to a
+  // generated demo scene when it fails.
+  bool loaded = false;
+  if (m_args.generate_demo > 0) {
+    const std::string option = "--generate-demo " + std::to_string(m_args.generate_demo);
+    const int demo_sh_degree = 1;  // what make_demo_scene builds
+    const std::string problem =
+        scene_size_problem(scene_bytes(std::uint64_t(m_args.generate_demo), scene_bytes_per_gaussian(demo_sh_degree)),
+                           available_memory_bytes());
+    try {
+      if (!problem.empty()) throw Error(problem);
+      install_scene(generate_demo_scene(static_cast<std::size_t>(m_args.generate_demo)));
+      loaded = true;
+    } catch (const std::exception& e) {
+      report_failed_load(option + ": " + reason(e));
+    }
+  } else {
+    loaded = open_scene(m_args.scene.empty() ? demo_scene_path() : m_args.scene);
+  }
+  if (loaded) return true;
+  if (m_scripted) {
+    std::fprintf(stderr, "flashgs-viewer: no scene to run the script on\n");
+    return false;
+  }
+  install_scene(generate_demo_scene(30000));
+  m_load_error += "; showing a generated demo scene";
+  std::fprintf(stderr, "flashgs-viewer: showing a generated demo scene instead\n");
+  return true;
+}
+
+bool ViewerApp::apply_start_options() {
+  // Each refusal is one line naming the option; a scripted run stops (its numbers would be
+  // for something else), an interactive one goes on without the option.
+  if (m_args.tile > 1) {
+    const std::string option = "--tile " + std::to_string(m_args.tile);
+    const std::uint64_t gaussians = std::uint64_t(m_scene.scene->size()) * std::uint64_t(m_args.tile);
+    const std::string problem =
+        scene_size_problem(scene_bytes(gaussians, scene_bytes_per_gaussian(m_scene.scene->sh_degree)),
+                           available_memory_bytes());
+    try {
+      if (!problem.empty()) throw Error(problem + " for " + std::to_string(gaussians) + " Gaussians");
+      install_scene(tile_loaded_scene(m_scene, m_args.tile));
+    } catch (const std::exception& e) {
+      set_notice(option + " refused: " + reason(e) + (m_scripted ? "" : "; the scene is shown once"));
+      if (m_scripted) return false;
+    }
+  }
+  if (m_settings.forced_width > 0) {
+    const std::string problem = frame_size_problem(m_settings.forced_width, m_settings.forced_height,
+                                                   m_path->texture_count(), m_max_texture_size, available_memory_bytes());
+    if (!problem.empty()) {
+      set_notice("--render-size " + size_text(m_settings.forced_width, m_settings.forced_height) + " refused: " +
+                 problem + (m_scripted ? "" : "; rendering at the window size"));
+      if (m_scripted) return false;
+      m_settings.forced_width = m_settings.forced_height = 0;
+    }
+  }
+  if (m_args.camera >= 0) {
+    const int count = static_cast<int>(m_scene.cameras.size());
+    if (m_args.camera >= count) {
+      set_notice("--camera " + std::to_string(m_args.camera) + ": " +
+                 (count == 0 ? std::string("the scene has no cameras")
+                             : "the scene has " + std::to_string(count) + " cameras (0.." + std::to_string(count - 1) + ")"));
+      if (m_scripted) return false;
+    } else {
+      snap_to_camera(m_args.camera);
+    }
+  }
+  return true;
+}
+
 int ViewerApp::run() {
   try {
     m_window = std::make_unique<Window>(m_args.window_width, m_args.window_height, "flashgs-viewer");
@@ -444,8 +598,10 @@ int ViewerApp::run() {
     std::fprintf(stderr, "flashgs-viewer: %s\n", e.what());
     return 1;
   }
-  std::fprintf(stderr, "flashgs-viewer: OpenGL %s, %s\n", reinterpret_cast<const char*>(glGetString(GL_VERSION)),
-               reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &m_max_texture_size);
+  std::fprintf(stderr, "flashgs-viewer: OpenGL %s, %s, textures up to %d pixels a side\n",
+               reinterpret_cast<const char*>(glGetString(GL_VERSION)),
+               reinterpret_cast<const char*>(glGetString(GL_RENDERER)), m_max_texture_size);
   float xscale = 1.0f, yscale = 1.0f;
   glfwGetWindowContentScale(m_window->handle(), &xscale, &yscale);
   int fb_w0 = 0, fb_h0 = 0;
@@ -462,37 +618,8 @@ int ViewerApp::run() {
   // responsive (GPU paths render every frame and show their FPS).
   m_settings.continuous = !m_path_is_cpu;
 
-  // The first scene: generated, the argument, or the demo; a failure leaves the generated demo.
-  bool loaded = false;
-  if (m_args.generate_demo > 0) {
-    try {
-      install_scene(generate_demo_scene(static_cast<std::size_t>(m_args.generate_demo)));
-      loaded = true;
-    } catch (const std::exception& e) {
-      m_load_error = e.what();
-    }
-  } else {
-    loaded = open_scene(m_args.scene.empty() ? demo_scene_path() : m_args.scene);
-  }
-  if (!loaded) {
-    if (m_scripted) {
-      std::fprintf(stderr, "flashgs-viewer: no scene to run the script on\n");
-      return 2;
-    }
-    install_scene(generate_demo_scene(30000));
-  }
-  if (m_args.tile > 1) {
-    install_scene(tile_loaded_scene(m_scene, m_args.tile));
-  }
-  if (m_args.camera >= 0) {
-    if (m_args.camera >= static_cast<int>(m_scene.cameras.size())) {
-      std::fprintf(stderr, "flashgs-viewer: camera %d does not exist (the scene has %zu)\n", m_args.camera,
-                   m_scene.cameras.size());
-      if (m_scripted) return 2;
-    } else {
-      snap_to_camera(m_args.camera);
-    }
-  }
+  if (!load_first_scene()) return 2;
+  if (!apply_start_options()) return 2;
   if (m_args.fov > 0) m_settings.fov_x_degrees = m_args.fov;
   if (m_args.path && m_args.frames <= 0) m_args.frames = 120;
   m_window->cursor(&m_last_cursor_x, &m_last_cursor_y);
@@ -519,7 +646,7 @@ int ViewerApp::run() {
 
     UiActions actions;
     NavigationInput nav;
-    gather_input(nav, actions, dt);
+    gather_input(nav, actions);
     if (m_scripted && !m_script.done()) {
       const ScriptFrame step = m_script.next(dt);
       nav = step.nav;
@@ -542,7 +669,7 @@ int ViewerApp::run() {
       model.camera_count = static_cast<int>(m_scene.cameras.size());
       model.scene_note = m_scene.cameras_note;
       model.load_error = m_load_error;
-      model.loading = m_pending_path;
+      model.loading = m_loader.path();
       model.current_camera = m_camera_index;
       model.on_scene_camera = m_controller.on_scene_camera();
       model.playing = m_playing;
@@ -558,8 +685,11 @@ int ViewerApp::run() {
       model.ui_scale = m_ui_scale;
       const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
       for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
+      const ViewerSettings before = m_settings;
       draw_panels(model, m_settings, actions, m_path_buffer, m_shot_buffer);
+      keep_settings_valid(m_settings, before);
     }
+    if (m_args.log_input) log_held_input();
     apply_actions(actions);
     finish_pending_load();
 
@@ -567,8 +697,8 @@ int ViewerApp::run() {
                           nav.look_dx != 0.0f || nav.look_dy != 0.0f || nav.pan_dx != 0.0f || nav.pan_dy != 0.0f;
     if (m_playing && steering) m_playing = false;  // taking the controls stops the path
     if (m_playing && m_camera_path && !m_camera_path->empty()) {
-      m_path_t += dt / (m_settings.path_seconds_per_camera * double(m_camera_path->size()));
-      m_controller.set_pose(m_camera_path->pose_at(m_path_t), 0.0f);
+      m_path_t = m_camera_path->advance(m_path_t, dt, m_settings.path_seconds_per_camera);
+      m_controller.set_pose(m_camera_path->pose_at(m_path_t));
       m_settings.fov_x_degrees = m_camera_path->fov_at(m_path_t);
     }
     bool moving = m_playing;
@@ -576,7 +706,7 @@ int ViewerApp::run() {
     if (m_scripted && m_args.path && m_camera_path && !m_camera_path->empty()) {
       const int timed = std::max(0, m_frame - m_args.warmup);
       const double t = double(timed) / std::max(1, m_args.frames);
-      m_controller.set_pose(m_camera_path->pose_at(t), 0.0f);
+      m_controller.set_pose(m_camera_path->pose_at(t));
       m_settings.fov_x_degrees = m_camera_path->fov_at(t);
     }
 
@@ -586,11 +716,12 @@ int ViewerApp::run() {
     float scale = m_settings.render_scale;
     if (!m_scripted && m_settings.adaptive_resolution && moving && m_full_render_ms > 33.0)
       scale *= static_cast<float>(std::clamp(std::sqrt(33.0 / m_full_render_ms), 0.25, 1.0));
-    const int rw = m_settings.forced_width > 0 ? m_settings.forced_width
-                                               : std::max(1, int(std::lround(fb_w * scale)));
-    const int rh = m_settings.forced_height > 0 ? m_settings.forced_height
-                                                : std::max(1, int(std::lround(fb_h * scale)));
-    ensure_texture(rw, rh);
+    const int wanted_w = m_settings.forced_width > 0 ? m_settings.forced_width
+                                                     : std::max(1, int(std::lround(fb_w * scale)));
+    const int wanted_h = m_settings.forced_height > 0 ? m_settings.forced_height
+                                                      : std::max(1, int(std::lround(fb_h * scale)));
+    int rw = 0, rh = 0;
+    choose_render_size(wanted_w, wanted_h, &rw, &rh);
     const Camera camera = m_controller.render_camera(rw, rh, m_settings.fov_x_degrees);
     RenderOptions wanted = m_settings.options;
     wanted.collect_tile_counts = m_settings.heatmap;
@@ -600,10 +731,22 @@ int ViewerApp::run() {
     const double before_render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_loop).count();
     if (changed || m_settings.continuous || m_scripted) {
       const auto t0 = Clock::now();
-      render_frame(camera);
+      try {
+        ensure_texture(rw, rh);
+        render_frame(camera);
+        rendered = true;
+      } catch (const std::exception& e) {  // out of memory, a texture refused: keep running
+        render_failed(rw, rh, reason(e));
+      }
       render_call_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-      if (scale == m_settings.render_scale) m_full_render_ms = render_call_ms;
-      rendered = true;
+      if (rendered) {
+        if (scale == m_settings.render_scale) {
+          m_full_render_ms = render_call_ms;
+          m_good_scale = m_settings.render_scale;
+        }
+        m_good_width = rw;
+        m_good_height = rh;
+      }
       // Showing the previous frame while this one renders pays only when another frame
       // follows at once; a render on demand (the view changed) is shown now.
       if (!m_settings.continuous && !m_scripted) m_path->present_latest();
@@ -627,6 +770,10 @@ int ViewerApp::run() {
     }
     const auto t_swap = Clock::now();
     m_window->swap(m_settings.vsync);
+    ++m_presented;
+    // ImGui hides a window that sizes itself in its first frame: from the second frame with
+    // panels on, they are all on screen where they stay (tests click them from then on).
+    if (m_settings.show_ui && ++m_ui_frames == 2) std::fprintf(stderr, "flashgs-viewer: UI ready\n");
 
     const auto swapped = Clock::now();
     const double frame_ms = std::chrono::duration<double, std::milli>(swapped - last_swap).count();
@@ -657,6 +804,8 @@ int ViewerApp::run() {
       if (m_frame >= needed && m_script.done()) finish_script();
     }
   }
+  if (m_loader.busy())  // its thread may be blocked in open(): closing does not wait for it
+    std::fprintf(stderr, "flashgs-viewer: closing without waiting for the load of %s\n", m_loader.path().c_str());
   return m_exit_code;
 }
 

@@ -1,7 +1,6 @@
 // ViewerApp: the viewer's frame loop tying together window, scene, navigation, frame path, presenter and panels.
 #pragma once
 
-#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,6 +10,7 @@
 #include "compare_mode.h"
 #include "frame_path.h"
 #include "key_script.h"
+#include "scene_loader.h"
 #include "scene_state.h"
 #include "stats_history.h"
 #include "viewer_args.h"
@@ -36,10 +36,19 @@ class ViewerApp {
   bool open_scene(const std::string& path);  // loads now; false (error kept) on failure
   void request_open(const std::string& path);  // loads in the background (interactive runs)
   void finish_pending_load();
+  void report_failed_load(const std::string& error);
   void install_scene(LoadedScene scene);
+  bool load_first_scene();  // the generated, given or demo scene; false: none (message logged)
+  bool apply_start_options();  // --tile, --render-size, --camera; false: a scripted run must stop
+  // The render size for this frame: `wanted`, or where it does not fit (memory, texture
+  // limit) the last size that rendered, with one message logged and shown.
+  void choose_render_size(int wanted_width, int wanted_height, int* width, int* height);
+  void render_failed(int width, int height, const std::string& why);
+  void set_notice(const std::string& message);  // logged once and shown in the panel
+  void log_held_input();  // --log-input
   void apply_up_choice();
   void snap_to_camera(int index);
-  void gather_input(NavigationInput& nav, UiActions& actions, float dt);
+  void gather_input(NavigationInput& nav, UiActions& actions);
   void apply_actions(const UiActions& actions);
   void ensure_texture(int width, int height);
   void render_frame(const Camera& camera);
@@ -58,9 +67,8 @@ class ViewerApp {
   bool m_path_is_cpu = true;
 
   LoadedScene m_scene;
-  std::string m_load_error;
-  std::future<LoadedScene> m_pending_load;
-  std::string m_pending_path;
+  std::string m_load_error;  // the last failed load and what is shown instead
+  SceneLoader m_loader;
   CameraController m_controller;
   std::unique_ptr<CameraPath> m_camera_path;
   int m_camera_index = -1;
@@ -80,10 +88,19 @@ class ViewerApp {
   float m_ui_scale = 1.0f;
   double m_full_render_ms = 0;  // wall time of the last render at the full render scale
 
+  // The last frame size that rendered, and the render scale it came from: where to fall back
+  // when a new size does not fit.
+  int m_good_width = 0, m_good_height = 0;
+  float m_good_scale = 1.0f;
+  int m_checked_width = 0, m_checked_height = 0;  // the last size checked against memory...
+  std::string m_checked_problem;                  // ...and why it does not fit (empty: fits)
+  int m_max_texture_size = 0;                     // GL_MAX_TEXTURE_SIZE
+  int m_ui_frames = 0;                            // frames presented with the panels
+  int m_presented = 0;                            // frames presented in all
+
   // Input state between frames.
   double m_last_cursor_x = 0, m_last_cursor_y = 0;
   std::string m_path_buffer, m_shot_buffer;
-  int m_screenshot_count = 0;
 
   // Scripted mode.
   bool m_scripted = false;

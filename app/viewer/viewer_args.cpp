@@ -1,19 +1,52 @@
 // Command-line parsing for flashgs-viewer (CLI11).
 #include "viewer_args.h"
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include <CLI/CLI.hpp>
+
+#include "viewer_settings.h"
 
 namespace flashgs::viewer {
 namespace {
 
+std::string number_text(float v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// A finite number in `range`: CLI11's Range lets NaN through (every comparison with it is false).
+CLI::Validator finite_in(ValueRange range) {
+  const std::string wanted = "a finite number in [" + number_text(range.min) + ", " + number_text(range.max) + "]";
+  return CLI::Validator(
+      [range, wanted](std::string& text) {
+        char* end = nullptr;
+        const float v = std::strtof(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || !range.contains(v))
+          return "\"" + text + "\" is not " + wanted;
+        return std::string();
+      },
+      wanted);
+}
+
+constexpr long kMaxSide = 32768;
+
+// "WxH" with both sides in 1..kMaxSide, nothing else (no sign, no trailing text).
 bool parse_size(const std::string& text, int* w, int* h) {
-  char x = 0, extra = 0;
+  const auto x = text.find_first_of("xX");
+  if (x == std::string::npos) return false;
+  auto side = [](const std::string& part, int* out) {
+    if (part.empty() || part.size() > 6 || part.find_first_not_of("0123456789") != std::string::npos) return false;
+    const long v = std::strtol(part.c_str(), nullptr, 10);
+    if (v < 1 || v > kMaxSide) return false;
+    *out = static_cast<int>(v);
+    return true;
+  };
   int a = 0, b = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') || a < 1 || b < 1 ||
-      a > 32768 || b > 32768)
-    return false;
+  if (!side(text.substr(0, x), &a) || !side(text.substr(x + 1), &b)) return false;
   *w = a;
   *h = b;
   return true;
@@ -32,17 +65,23 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
       ->check(CLI::Range(1, 1024));
   app.add_option("--size", size, "window size WxH in screen points (default 1280x800)");
   app.add_option("--render-size", render_size, "render at exactly WxH whatever the window size");
-  app.add_option("--scale", a->scale, "render resolution = framebuffer size * scale")->check(CLI::Range(0.05f, 4.0f));
+  app.add_option("--scale", a->scale, "render resolution = framebuffer size * scale")->check(finite_in(kRenderScaleRange));
   app.add_option("--backend", a->backend, "auto, cpu or cuda")->check(CLI::IsMember({"auto", "cpu", "cuda"}));
   app.add_option("--up", a->up, "world up axis: auto (from the cameras), +x, -x, +y, -y, +z, -z")
       ->check(CLI::IsMember({"auto", "+x", "-x", "+y", "-y", "+z", "-z"}));
   app.add_flag("--flip-up", a->flip_up, "invert the world up axis (scenes that load upside down)");
-  app.add_option("--camera,-c", a->camera, "start at this camera of cameras.json");
-  app.add_option("--fov", a->fov, "horizontal field of view in degrees")->check(CLI::Range(1.0f, 170.0f));
+  app.add_option("--camera,-c", a->camera, "start at this camera of cameras.json")
+      ->check(CLI::Validator([](std::string& text) {
+        return text.empty() || text[0] == '-' ? "\"" + text + "\" is not a camera index (0 or more)" : std::string();
+      }, "INDEX >= 0"));
+  app.add_option("--fov", a->fov, "horizontal field of view in degrees")->check(finite_in(kFovRange));
   app.add_option("--algorithm,-a", a->algorithm, "flash or baseline")->check(CLI::IsMember({"flash", "baseline"}));
-  app.add_option("--tau", a->tau, "alpha threshold of the opacity-aware extent")->check(CLI::Range(1e-6f, 0.99f));
-  app.add_option("--sh-degree", a->sh_degree, "use at most this many SH bands")->check(CLI::Range(0, 3));
-  app.add_option("--background", a->background, "background colour r,g,b in [0, 1]")->delimiter(',')->expected(3);
+  app.add_option("--tau", a->tau, "alpha threshold of the opacity-aware extent")->check(finite_in(kTauRange));
+  app.add_option("--sh-degree", a->sh_degree, "use at most this many SH bands")->check(CLI::Range(0, kMaxShDegree));
+  app.add_option("--background", a->background, "background colour r,g,b in [0, 1]")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(finite_in(kBackgroundRange));
   app.add_flag("--heatmap", a->heatmap, "start with the per-tile pair-count overlay on");
   app.add_flag("--orbit", a->orbit, "start in orbit mode (default: fly)");
   app.add_flag("--no-ui", a->no_ui, "hide the panels (F1 toggles them)");
@@ -63,12 +102,14 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
                "scripted: compare the displayed texture with the backend's host image of the same view "
                "(exit 4 when they differ)");
   app.add_flag("--compare", a->compare, "scripted: compare the last frame with the baseline and print PSNR");
+  app.add_flag("--log-input", a->log_input,
+               "log every frame in which a mouse button is held (for tests that click through X)");
   try {
     app.parse(argc, argv);
     if (!size.empty() && !parse_size(size, &a->window_width, &a->window_height))
-      throw CLI::ValidationError("--size", "expected WxH, e.g. 1280x800");
+      throw CLI::ValidationError("--size", "\"" + size + "\" is not WxH with sides 1.." + std::to_string(kMaxSide) + ", e.g. 1280x800");
     if (!render_size.empty() && !parse_size(render_size, &a->render_width, &a->render_height))
-      throw CLI::ValidationError("--render-size", "expected WxH, e.g. 3840x2160");
+      throw CLI::ValidationError("--render-size", "\"" + render_size + "\" is not WxH with sides 1.." + std::to_string(kMaxSide) + ", e.g. 3840x2160");
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }

@@ -39,6 +39,7 @@ struct ViewerArgs {
   std::string then_open;         // scripted: try to open this scene after the first frame (error-path test)
   bool check_frame = false;      // scripted: check the displayed texture against a host render
   bool compare = false;          // run compare mode once on the last frame and print it
+  bool log_input = false;        // log each frame a mouse button is held (tests driving it through X)
 
   bool scripted() const { return frames > 0 || !keys.empty() || path || !screenshot.empty() ||
                                   !window_screenshot.empty() || exit_after; }

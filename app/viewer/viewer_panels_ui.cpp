@@ -24,7 +24,10 @@ std::string human_count(double v) {
   return text;
 }
 
-void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer) {
+// Every slider clamps what is typed into it (Ctrl+click) to its range, not just what is dragged.
+constexpr ImGuiSliderFlags kClamp = ImGuiSliderFlags_AlwaysClamp;
+
+void scene_panel(const UiModel& m, UiActions& a, std::string& path_buffer) {
   if (!ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) return;
   ImGui::TextWrapped("%s", m.scene_path.c_str());
   ImGui::Text("%s Gaussians, SH degree %d, %d cameras", human_count(double(m.gaussians)).c_str(), m.sh_degree,
@@ -35,13 +38,16 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
                                               ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
   if ((ImGui::Button("Open") || enter) && !path_buffer.empty()) a.open_path = path_buffer;
-  if (!m.loading.empty()) ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1), "loading %s ...", m.loading.c_str());
+  if (!m.loading.empty()) {
+    ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1), "loading %s ...", m.loading.c_str());
+    ImGui::SameLine();
+    if (ImGui::SmallButton("Cancel")) a.cancel_load = true;
+  }
   if (!m.load_error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1));
-    ImGui::TextWrapped("Load failed, previous scene kept: %s", m.load_error.c_str());
+    ImGui::TextWrapped("%s", m.load_error.c_str());
     ImGui::PopStyleColor();
   }
-  (void)s;
 }
 
 void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
@@ -58,20 +64,22 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
     ImGui::SameLine();
     int cam = std::max(m.current_camera, 0);
     ImGui::SetNextItemWidth(ui(110));
-    if (ImGui::SliderInt("##cam", &cam, 0, m.camera_count - 1, "camera %d")) a.snap_camera = cam;
+    if (ImGui::SliderInt("##cam", &cam, 0, m.camera_count - 1, "camera %d", kClamp)) a.snap_camera = cam;
     ImGui::SameLine();
     if (ImGui::ArrowButton("##next", ImGuiDir_Right)) a.next_camera = true;
     ImGui::SameLine();
     if (ImGui::Button(m.playing ? "Stop" : "Play path")) a.toggle_play = true;
     ImGui::SetNextItemWidth(ui(140));
-    ImGui::SliderFloat("s per camera", &s.path_seconds_per_camera, 0.2f, 10.0f, "%.1f");
+    ImGui::SliderFloat("s per camera", &s.path_seconds_per_camera, kPathSecondsRange.min, kPathSecondsRange.max, "%.1f",
+                       kClamp | ImGuiSliderFlags_Logarithmic);
     ImGui::Text(m.on_scene_camera ? "on camera %d (exact)" : "free view (last camera %d)", m.current_camera);
   } else {
     ImGui::TextDisabled("no cameras.json: free navigation");
   }
-  ImGui::SliderFloat("FOV (deg)", &s.fov_x_degrees, 10.0f, 140.0f, "%.1f");
-  ImGui::SliderFloat("Speed", &s.move_speed, 0.01f, 20.0f, "%.2f extents/s", ImGuiSliderFlags_Logarithmic);
-  ImGui::SliderFloat("Render scale", &s.render_scale, 0.1f, 2.0f, "%.2f");
+  ImGui::SliderFloat("FOV (deg)", &s.fov_x_degrees, kFovRange.min, kFovRange.max, "%.1f", kClamp);
+  ImGui::SliderFloat("Speed", &s.move_speed, kMoveSpeedRange.min, kMoveSpeedRange.max, "%.3g extents/s",
+                     kClamp | ImGuiSliderFlags_Logarithmic);
+  ImGui::SliderFloat("Render scale", &s.render_scale, kRenderScaleRange.min, kRenderScaleRange.max, "%.2f", kClamp);
   ImGui::Checkbox("Fewer pixels while moving (slow backends)", &s.adaptive_resolution);
   if (ImGui::Checkbox("Flip world up", &s.flip_up)) a.flip_up = true;
   ImGui::SameLine();
@@ -112,8 +120,10 @@ void render_panel(ViewerSettings& s) {
   float inv_tau = 1.0f / o.tau;
   char tau_label[64];
   std::snprintf(tau_label, sizeof tau_label, "1/tau (tau %.5f)###tau", o.tau);
-  if (ImGui::SliderFloat(tau_label, &inv_tau, 2.0f, 4096.0f, "%.0f", ImGuiSliderFlags_Logarithmic)) o.tau = 1.0f / inv_tau;
-  ImGui::SliderInt("SH degree cap", &o.sh_degree_cap, 0, 3);
+  if (ImGui::SliderFloat(tau_label, &inv_tau, 1.0f / kTauRange.max, 1.0f / kTauRange.min, "%.0f",
+                         kClamp | ImGuiSliderFlags_Logarithmic))
+    o.tau = 1.0f / inv_tau;
+  ImGui::SliderInt("SH degree cap", &o.sh_degree_cap, 0, kMaxShDegree, "%d", kClamp);
   ImGui::ColorEdit3("Background", o.background, ImGuiColorEditFlags_NoInputs);
   ImGui::SameLine();
   ImGui::Checkbox("Every frame", &s.continuous);
@@ -167,7 +177,7 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
   ImGui::SameLine();
   ImGui::Checkbox("log", &s.heatmap_log);
   ImGui::SetNextItemWidth(ui(120));
-  ImGui::SliderFloat("opacity", &s.heatmap_opacity, 0.1f, 1.0f);
+  ImGui::SliderFloat("opacity", &s.heatmap_opacity, kHeatmapOpacityRange.min, kHeatmapOpacityRange.max, "%.2f", kClamp);
   ImGui::SetNextItemWidth(ui(-70));
   ImGui::InputText("##shot", &shot);
   ImGui::SameLine();
@@ -240,7 +250,7 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("flashgs-viewer");
   ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels
-  scene_panel(m, s, a, path_buffer);
+  scene_panel(m, a, path_buffer);
   view_panel(m, s, a);
   render_panel(s);
   compare_panel(m, a);

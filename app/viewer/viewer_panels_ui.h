@@ -18,7 +18,7 @@ struct UiModel {
   int sh_degree = 0;
   int camera_count = 0;
   std::string scene_note;         // loader report / cameras problem
-  std::string load_error;         // the last failed load (the scene shown is the previous one)
+  std::string load_error;         // the last failed load and what is shown instead, one sentence
   std::string loading;            // the file being loaded in the background, if any
   int current_camera = -1;        // the scene camera the view sits on, -1 when moved
   bool on_scene_camera = false;
@@ -38,6 +38,7 @@ struct UiModel {
 
 struct UiActions {
   std::string open_path;          // non-empty: load this scene
+  bool cancel_load = false;       // stop waiting for the scene being loaded
   int snap_camera = -1;           // >= 0: go to this camera
   bool next_camera = false, previous_camera = false;
   bool toggle_play = false;
@@ -47,7 +48,8 @@ struct UiActions {
   std::string screenshot_path;    // non-empty: save the rendered image here
 };
 
-// Draws every panel for this frame. `path_buffer` and `screenshot_buffer` hold the text fields'
+// Draws every panel for this frame (the caller puts typed values back in range afterwards:
+// keep_settings_valid). `path_buffer` and `screenshot_buffer` hold the text fields'
 // contents between frames.
 void draw_panels(const UiModel& model, ViewerSettings& settings, UiActions& actions, std::string& path_buffer,
                  std::string& screenshot_buffer);

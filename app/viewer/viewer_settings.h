@@ -1,4 +1,4 @@
-// ViewerSettings: every user-facing choice of the viewer in one plain struct (the UI and the script both edit it).
+// ViewerSettings: every user-facing choice of the viewer in one plain struct (the UI and the script both edit it), with the range of each value.
 #pragma once
 
 #include "flashgs/options.h"
@@ -6,6 +6,25 @@
 namespace flashgs::viewer {
 
 enum class NavigationMode { fly, orbit };
+
+// The allowed interval of a numeric setting: the sliders, the command line and
+// keep_settings_valid() all use these, so a typed value cannot leave them.
+struct ValueRange {
+  float min, max;
+  // `value` clamped into the range; a NaN or infinite value gives `fallback` (clamped too).
+  float clamp(float value, float fallback) const;
+  bool contains(float value) const { return value >= min && value <= max; }  // false for NaN
+};
+
+inline constexpr ValueRange kFovRange{1.0f, 170.0f};             // horizontal degrees
+inline constexpr ValueRange kRenderScaleRange{0.05f, 4.0f};
+inline constexpr ValueRange kMoveSpeedRange{1e-4f, 1e4f};        // scene extents per second
+inline constexpr ValueRange kLookSensitivityRange{1e-5f, 1.0f};  // radians per window point
+inline constexpr ValueRange kHeatmapOpacityRange{0.1f, 1.0f};
+inline constexpr ValueRange kPathSecondsRange{0.1f, 60.0f};      // seconds per camera of the path
+inline constexpr ValueRange kTauRange{1e-6f, 0.99f};             // alpha threshold
+inline constexpr ValueRange kBackgroundRange{0.0f, 1.0f};        // each colour channel
+inline constexpr int kMaxShDegree = 3;
 
 struct ViewerSettings {
   RenderOptions options;            // algorithm, every optimisation, tau, background, SH cap
@@ -25,5 +44,10 @@ struct ViewerSettings {
   bool show_ui = true;
   float path_seconds_per_camera = 2.0f;
 };
+
+// Puts every numeric setting back into its range after the panels edited it: a NaN or
+// infinite value (ImGui parses "nan" and "inf" in a Ctrl+click field) takes the value it had
+// in `before`, anything else is clamped.
+void keep_settings_valid(ViewerSettings& settings, const ViewerSettings& before);
 
 }  // namespace flashgs::viewer

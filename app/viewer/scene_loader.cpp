@@ -1,0 +1,83 @@
+// Background scene loads on detached threads: the thread and the viewer share the job, so whichever finishes last frees it.
+#include "scene_loader.h"
+
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <new>
+#include <thread>
+
+namespace flashgs::viewer {
+namespace {
+
+std::atomic<int> g_running{0};
+
+}  // namespace
+
+struct SceneLoader::Job {
+  std::mutex mutex;
+  bool done = false;
+  LoadedScene scene;
+  std::string error;
+};
+
+SceneLoader::SceneLoader(LoadFunction load) : m_load(std::move(load)) {}
+
+SceneLoader::~SceneLoader() { abandon(); }
+
+int SceneLoader::running() { return g_running.load(); }
+
+bool SceneLoader::start(const std::string& path) {
+  if (m_job) return false;
+  auto job = std::make_shared<Job>();
+  ++g_running;
+  try {
+    // Detached: a thread blocked in open() cannot be interrupted, and the viewer must be able
+    // to close anyway; the job outlives whichever side lets go of it first.
+    std::thread([job, load = m_load, path] {
+      LoadedScene scene;
+      std::string error;
+      try {
+        scene = load(path);
+      } catch (const std::bad_alloc&) {
+        error = path + ": out of memory while loading";
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      {
+        std::lock_guard<std::mutex> lock(job->mutex);
+        job->scene = std::move(scene);
+        job->error = std::move(error);
+        job->done = true;
+      }
+      --g_running;
+    }).detach();
+  } catch (const std::exception& e) {  // no thread could be started
+    --g_running;
+    job->done = true;
+    job->error = path + ": the loader thread could not start (" + e.what() + ")";
+  }
+  m_job = std::move(job);
+  m_path = path;
+  return true;
+}
+
+bool SceneLoader::take(LoadedScene* scene, std::string* error) {
+  if (!m_job) return false;
+  {
+    std::lock_guard<std::mutex> lock(m_job->mutex);
+    if (!m_job->done) return false;
+    *scene = std::move(m_job->scene);
+    *error = std::move(m_job->error);
+  }
+  m_job.reset();
+  m_path.clear();
+  return true;
+}
+
+void SceneLoader::abandon() {
+  m_job.reset();
+  m_path.clear();
+}
+
+}  // namespace flashgs::viewer
