@@ -10,9 +10,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "backend_factory.h"
 #include "commands.h"
 #include "flashgs/error.h"
 #include "flashgs/io.h"
+#include "flashgs/parse.h"
+#include "option_checks.h"
 #include "scene_source.h"
 
 namespace flashgs::cli {
@@ -111,17 +114,23 @@ struct ConfigRun {
 nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 void run(const BenchArgs& args) {
+  // Everything that can be wrong with the arguments is found before the first frame.
+  check_output_file("--json", args.json_path);
+  std::vector<Resolution> resolutions;
+  for (const std::string& text : args.resolutions) resolutions.push_back(parse_resolution(text));
   const std::string scene_path = args.scene.resolved_scene();
   auto scene = load_scene_verbose(scene_path);
-  const std::vector<Camera> all_cameras = load_cameras(args.scene.resolved_cameras());
+  const std::string cameras_path = args.scene.resolved_cameras();
+  const std::vector<Camera> all_cameras = load_cameras(cameras_path);
   std::vector<int> camera_ids = args.cameras;
   if (camera_ids.empty())
     for (int i = 0; i <= 34; i += 2) camera_ids.push_back(i);
-  for (int id : camera_ids)
-    if (id < 0 || id >= static_cast<int>(all_cameras.size()))
-      throw Error("bench: camera " + std::to_string(id) + " does not exist (" + std::to_string(all_cameras.size()) +
-                  " in the file)");
-  auto probe = make_backend(args.backend);
+  check_camera_indices(args.cameras.empty() ? "the default --camera-list" : "--camera-list", camera_ids,
+                       all_cameras.size(), cameras_path);
+  auto probe = create_backend(args.backend);
+  for (const Resolution& size : resolutions)
+    check_frame_fits(*probe, all_cameras[camera_ids.front()].resized(size.width, size.height), scene->size(),
+                     "--resolutions");
   const bool cpu = probe->name().rfind("cpu", 0) == 0;
   const std::string backend_name = probe->name();
   probe.reset();
@@ -146,16 +155,16 @@ void run(const BenchArgs& args) {
               args.warmup, args.repeat);
 
   std::string table;
-  for (const std::string& resolution : args.resolutions) {
-    int width = 0, height = 0;
-    parse_resolution(resolution, &width, &height);
+  for (std::size_t k = 0; k < resolutions.size(); ++k) {
+    const std::string& resolution = args.resolutions[k];
+    const int width = resolutions[k].width, height = resolutions[k].height;
     // One renderer per config, so each one's memory is its own high-water mark.
     std::vector<ConfigRun> runs;
     for (const auto& [name, options] : configs) {
       ConfigRun r;
       r.name = name;
       r.options = options;
-      r.renderer = make_backend(args.backend);
+      r.renderer = create_backend(args.backend);
       r.renderer->set_scene(scene);
       runs.push_back(std::move(r));
     }

@@ -8,6 +8,7 @@
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
 #include "flashgs/stress_scenes.h"
+#include "option_checks.h"
 #include "scene_source.h"
 
 namespace flashgs::cli {
@@ -21,17 +22,52 @@ struct GenerateArgs {
   std::size_t count = 30000;
   std::string stress;  // stress: the case name
   bool list = false;
+  bool force = false;  // overwrite a scene already in output_dir
 };
 
+namespace fs = std::filesystem;
+
+// Writes `path` through a temporary file beside it, renamed over it once complete: a failed
+// or interrupted write leaves the old file (for `tile`, possibly its own source) intact.
+template <class Write>
+void write_atomically(const std::string& path, Write&& write) {
+  const std::string partial = path + ".partial";
+  std::error_code ec;
+  try {
+    write(partial);
+  } catch (...) {
+    fs::remove(partial, ec);
+    throw;
+  }
+  fs::rename(partial, path, ec);
+  if (ec) {
+    fs::remove(partial, ec);
+    throw Error(path + ": cannot replace it (" + ec.message() + ")");
+  }
+}
+
+// Refuses, before any work, an output folder that already holds a scene (unless --force).
+void check_output_scene(const GenerateArgs& args) {
+  check_output_folder("--output", args.output_dir);
+  if (args.force) return;
+  for (const char* name : {"point_cloud.ply", "cameras.json"}) {
+    const fs::path existing = fs::path(args.output_dir) / name;
+    if (fs::exists(existing))
+      throw Error("--output " + args.output_dir + ": already holds " + existing.string() +
+                  " (give --force to overwrite it)");
+  }
+}
+
 void write_scene(const Scene& scene, const std::vector<Camera>& cameras, const std::string& dir) {
-  std::filesystem::create_directories(dir);
-  save_ply(scene, dir + "/point_cloud.ply");
-  save_cameras(cameras, dir + "/cameras.json");
+  write_atomically(dir + "/point_cloud.ply", [&](const std::string& path) { save_ply(scene, path); });
+  write_atomically(dir + "/cameras.json", [&](const std::string& path) { save_cameras(cameras, path); });
   std::printf("wrote %s/point_cloud.ply (%zu Gaussians, SH degree %d) and %s/cameras.json (%zu cameras)\n",
               dir.c_str(), scene.size(), scene.sh_degree, dir.c_str(), cameras.size());
 }
 
 void run(const GenerateArgs& args) {
+  const bool lists_only = args.kind == "stress" && (args.list || args.stress.empty());
+  if (!lists_only && (args.kind == "demo" || args.kind == "tile" || args.kind == "stress")) check_output_scene(args);
   if (args.kind == "demo") {
     const Scene scene = make_demo_scene(args.count);
     const float target[3] = {0, 0.7f, 0}, up[3] = {0, 1, 0};  // the demo scene is y-up
@@ -62,13 +98,14 @@ void run(const GenerateArgs& args) {
     StressCase c = make_stress_case(args.stress);
     if (!c.raw_ply.empty()) {
       // The degenerate-file case is the file itself: written byte for byte, NaNs included.
-      std::filesystem::create_directories(args.output_dir);
       const std::string ply = args.output_dir + "/point_cloud.ply";
-      std::FILE* f = std::fopen(ply.c_str(), "wb");
-      if (!f || std::fwrite(c.raw_ply.data(), 1, c.raw_ply.size(), f) != c.raw_ply.size())
-        throw Error(ply + ": cannot write");
-      std::fclose(f);
-      save_cameras(c.cameras, args.output_dir + "/cameras.json");
+      write_atomically(ply, [&](const std::string& path) {
+        std::FILE* f = std::fopen(path.c_str(), "wb");
+        const bool written = f && std::fwrite(c.raw_ply.data(), 1, c.raw_ply.size(), f) == c.raw_ply.size();
+        if ((f && std::fclose(f) != 0) || !written) throw Error(path + ": cannot write");
+      });
+      write_atomically(args.output_dir + "/cameras.json",
+                       [&](const std::string& path) { save_cameras(c.cameras, path); });
       std::printf("wrote %s (raw, with NaN/Inf records) and %s/cameras.json\n", ply.c_str(), args.output_dir.c_str());
     } else {
       write_scene(c.scene, c.cameras, args.output_dir);
@@ -94,7 +131,8 @@ void register_generate(CLI::App& app) {
   sub->add_option("--output,-o", args->output_dir, "output folder");
   sub->add_option("--input,-i", args->input, "tile: the scene to copy");
   sub->add_option("--copies,-n", args->copies, "tile: number of copies")->check(CLI::Range(1, 1024));
-  sub->add_option("--count", args->count, "demo: number of Gaussians");
+  sub->add_option("--count", args->count, "demo: number of Gaussians")->check(CLI::Range(1, 200000000));
+  sub->add_flag("--force", args->force, "overwrite a scene already in the output folder");
   sub->callback([args] { run(*args); });
 }
 

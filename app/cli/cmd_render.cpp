@@ -1,9 +1,11 @@
 // `flashgs render`: one frame of a scene to an image file, with its statistics.
 #include <cstdio>
 
+#include "backend_factory.h"
 #include "commands.h"
 #include "flashgs/image_io.h"
 #include "flashgs/io.h"
+#include "option_checks.h"
 #include "scene_source.h"
 #include "stats_format.h"
 
@@ -18,10 +20,12 @@ struct RenderCommand {
   int repeat = 1;
 
   void run() const {
+    check_output_image("--output", output);  // before the render, which may take long
     const std::string scene_path = scene.resolved_scene();
     auto loaded = load_scene_verbose(scene_path);
     const Camera cam = camera.select(scene.resolved_cameras());
-    auto renderer = make_backend(render.backend);
+    auto renderer = create_backend(render.backend);
+    check_frame_fits(*renderer, cam, loaded->size(), camera.resolution.empty() ? "the camera's size" : "--resolution");
     renderer->set_scene(loaded);
     const RenderOptions options = render.options();
     Image image;

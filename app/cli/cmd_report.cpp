@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -16,7 +17,9 @@
 #include "commands.h"
 #include "flashgs/error.h"
 #include "flashgs/io.h"
+#include "flashgs/parse.h"
 #include "flashgs/reference_renderer.h"
+#include "option_checks.h"
 #include "report_plot.h"
 #include "report_sweep.h"
 #include "scene_source.h"
@@ -26,7 +29,7 @@ namespace {
 
 struct ReportArgs {
   SceneArgs scene;
-  std::string camera_list;  // "0,2,4"; empty: 0, 2, ..., 34 (as in ANCHORS.md)
+  std::vector<int> camera_list;  // empty: 0, 2, ..., 34 (as in ANCHORS.md)
   int max_cameras = 0;      // 0: all of the list
   std::string resolution;
   int repeat = 3;
@@ -38,15 +41,6 @@ struct ReportArgs {
   std::string replot;    // re-plot this report.csv instead of measuring
   std::string subtitle;  // for --replot
 };
-
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(std::stoi(item));
-  return out;
-}
 
 std::string cpu_model() {
   std::ifstream in("/proc/cpuinfo");
@@ -86,7 +80,17 @@ void replot(const ReportArgs& args) {
   const std::size_t c_backend = column("backend"), c_config = column("config"), c_group = column("group"),
                     c_median = column("median_ms"), c_p95 = column("p95_ms"), c_psnr = column("psnr_vs_fp64_db");
   std::vector<SweepResult> results;
+  int line_number = 1;
+  auto number = [&](const std::string& cell) {
+    if (cell == "inf") return static_cast<double>(INFINITY);
+    char* end = nullptr;
+    const double v = std::strtod(cell.c_str(), &end);
+    if (cell.empty() || *end != '\0' || std::isnan(v))
+      throw Error(args.replot + ": line " + std::to_string(line_number) + ": \"" + cell + "\" is not a number");
+    return v;
+  };
   while (std::getline(in, line)) {
+    ++line_number;
     std::vector<std::string> cells;
     std::stringstream row(line);
     std::string cell;
@@ -96,9 +100,9 @@ void replot(const ReportArgs& args) {
     r.backend = cells[c_backend];
     r.config.name = cells[c_config];
     r.config.group = cells[c_group];
-    r.median_ms = std::stod(cells[c_median]);
-    r.p95_ms = std::stod(cells[c_p95]);
-    r.vs_reference.psnr_db = cells[c_psnr] == "inf" ? INFINITY : std::stod(cells[c_psnr]);
+    r.median_ms = number(cells[c_median]);
+    r.p95_ms = number(cells[c_p95]);
+    r.vs_reference.psnr_db = number(cells[c_psnr]);
     results.push_back(r);
   }
   const std::string dir = std::filesystem::path(args.replot).parent_path().string();
@@ -117,28 +121,41 @@ void replot(const ReportArgs& args) {
 
 void run(const ReportArgs& args) {
   if (!args.replot.empty()) return replot(args);
+  // Everything that can be wrong with the arguments is found before the first frame.
+  check_output_folder("--output-dir", args.output_dir);
+  const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
   const std::string scene_path = args.scene.resolved_scene();
   auto scene = load_scene_verbose(scene_path);
-  const std::vector<Camera> all_cameras = load_cameras(args.scene.resolved_cameras());
-  std::vector<int> indices = parse_list(args.camera_list);
-  if (indices.empty())
-    for (int i = 0; i <= 34; i += 2) indices.push_back(i);
-  std::vector<int> kept;
-  for (int i : indices)
-    if (i >= 0 && i < static_cast<int>(all_cameras.size())) kept.push_back(i);
+  const std::string cameras_path = args.scene.resolved_cameras();
+  const std::vector<Camera> all_cameras = load_cameras(cameras_path);
+  std::vector<int> kept = args.camera_list;
+  if (kept.empty()) {
+    // The default list (the views of ANCHORS.md), as far as the file has them.
+    for (int i = 0; i <= 34 && i < static_cast<int>(all_cameras.size()); i += 2) kept.push_back(i);
+    if (kept.empty()) throw Error(cameras_path + ": holds no camera");
+  }
+  check_camera_indices("--camera-list", kept, all_cameras.size(), cameras_path);
   if (args.max_cameras > 0 && static_cast<int>(kept.size()) > args.max_cameras) kept.resize(args.max_cameras);
-  if (kept.empty()) throw Error("report: no camera of the list exists in " + args.scene.resolved_cameras());
 
   SweepFrames frames;
   for (int i : kept) {
     Camera c = all_cameras[i];
-    if (!args.resolution.empty()) {
-      int w, h;
-      parse_resolution(args.resolution, &w, &h);
-      c = c.resized(w, h);
-    }
+    if (!args.resolution.empty()) c = c.resized(size.width, size.height);
     frames.cameras.push_back(c);
   }
+  std::vector<std::pair<std::string, std::unique_ptr<Renderer>>> backends;
+  for (const char* name : {"cpu", "cuda"}) {
+    if (args.backend != "all" && args.backend != name) continue;
+    try {
+      backends.emplace_back(name, create_backend(name));
+    } catch (const Error& e) {
+      if (args.backend == name) throw;
+      std::fprintf(stderr, "note: backend %s not measured: %s\n", name, e.what());
+    }
+  }
+  for (auto& [name, renderer] : backends)
+    check_frame_fits(*renderer, frames.cameras.front(), scene->size(),
+                     args.resolution.empty() ? "the cameras' size" : "--resolution");
   const int width = frames.cameras[0].width, height = frames.cameras[0].height;
   // fp64 reference windows: the centre and two off-centre squares. The reference costs
   // pixels x Gaussians, so it is evaluated on these windows of the first few cameras only.
@@ -164,16 +181,6 @@ void run(const ReportArgs& args) {
   std::fprintf(stderr, "fp64 reference: %zu cameras x %zu windows of %dx%d in %.1f s\n", ref_cameras,
                frames.windows.size(), s, s, ref_seconds);
 
-  std::vector<std::pair<std::string, std::unique_ptr<Renderer>>> backends;
-  for (const char* name : {"cpu", "cuda"}) {
-    if (args.backend != "all" && args.backend != name) continue;
-    try {
-      backends.emplace_back(name, create_backend(name));
-    } catch (const Error& e) {
-      if (args.backend == name) throw;
-      std::fprintf(stderr, "note: backend %s not measured: %s\n", name, e.what());
-    }
-  }
   std::vector<SweepResult> results;
   std::vector<std::string> backend_names;
   for (auto& [name, renderer] : backends) {
@@ -196,7 +203,6 @@ void run(const ReportArgs& args) {
     }
   }
 
-  std::filesystem::create_directories(args.output_dir);
   const std::string stem = args.output_dir + "/report";
   // CSV: one row per (backend, configuration).
   {
@@ -291,8 +297,9 @@ void register_report(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "report", "sweep configurations (error vs run time): CSV, Markdown table and SVG plot with the Pareto front");
   args->scene.add_to(sub);
-  sub->add_option("--camera-list", args->camera_list, "camera indices, e.g. 0,2,4 (default 0,2,...,34)");
-  sub->add_option("--max-cameras", args->max_cameras, "use only the first N cameras of the list");
+  sub->add_option("--camera-list", args->camera_list, "camera indices, e.g. 0,2,4 (default 0,2,...,34)")->delimiter(',');
+  sub->add_option("--max-cameras", args->max_cameras, "use only the first N cameras of the list")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--resolution,-r", args->resolution, "render size WxH (field of view kept)");
   sub->add_option("--repeat", args->repeat, "timed frames per camera (after one warm-up)")->check(CLI::Range(1, 1000));
   sub->add_option("--backend", args->backend, "all (every backend present), cpu or cuda")

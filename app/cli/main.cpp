@@ -1,5 +1,6 @@
 // flashgs: render, inspect, generate, benchmark and check 3D Gaussian Splatting scenes.
 #include <cstdio>
+#include <new>
 
 #include "commands.h"
 #include "flashgs/error.h"
@@ -7,6 +8,8 @@
 int main(int argc, char** argv) {
   CLI::App app{"flashgs: a FlashGS 3D Gaussian Splatting renderer (CPU and CUDA)"};
   app.require_subcommand(1);
+  // One line per error, naming the option (CLI11's default adds a "Run with --help" line).
+  app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("error: ") + e.what() + "\n"; });
   flashgs::cli::register_render(app);
   flashgs::cli::register_info(app);
   flashgs::cli::register_generate(app);
@@ -19,6 +22,10 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const flashgs::Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    // The renderers name the frame that did not fit; this is anything else that ran out.
+    std::fprintf(stderr, "error: out of memory\n");
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -4,10 +4,11 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "backend_factory.h"
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
+#include "flashgs/parse.h"
+#include "option_checks.h"
 
 namespace flashgs::cli {
 
@@ -49,8 +50,9 @@ void RenderArgs::add_to(CLI::App* command) {
   command->add_flag("--no-sort-bits", no_sort_bits, "CUDA flash: sort all 64 key bits");
   command->add_flag("--no-pipelined-blend", no_pipelined_blend, "CUDA flash: no prefetch in the render loop");
   command->add_flag("--no-exp2-alpha", no_exp2_alpha, "CUDA flash: expf instead of exp2 of a pre-scaled form");
-  command->add_option("--tau", tau, "alpha threshold of the opacity-aware extent")->check(CLI::Range(1e-6, 0.99));
-  command->add_option("--background", background, "background colour r,g,b")->delimiter(',')->expected(3);
+  command->add_option("--tau", tau, "alpha threshold of the opacity-aware extent")->check(finite_in(1e-6, 0.99));
+  command->add_option("--background", background, "background colour r,g,b in [0, 1]")
+      ->delimiter(',')->expected(3)->check(finite_in(0.0, 1.0));
   command->add_option("--sh-degree", sh_degree, "use at most this many SH bands")->check(CLI::Range(0, 3));
   command->add_option("--backend", backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
 }
@@ -76,29 +78,23 @@ RenderOptions RenderArgs::options() const {
 void CameraArgs::add_to(CLI::App* command) {
   command->add_option("--camera,-c", index, "camera index in cameras.json");
   command->add_option("--resolution,-r", resolution, "render size WxH (field of view kept)");
-  auto* eye_option = command->add_option("--eye", eye, "explicit camera: position x,y,z")->delimiter(',')->expected(3);
-  command->add_option("--look-at", look_at, "explicit camera: target x,y,z")->delimiter(',')->expected(3)->needs(eye_option);
+  const CLI::Validator coordinate = finite_in(-kMaxCoordinate, kMaxCoordinate);
+  auto* eye_option = command->add_option("--eye", eye, "explicit camera: position x,y,z")
+      ->delimiter(',')->expected(3)->check(coordinate);
+  command->add_option("--look-at", look_at, "explicit camera: target x,y,z")
+      ->delimiter(',')->expected(3)->check(coordinate)->needs(eye_option);
   eye_option->needs("--look-at");
   command->add_option("--up", up, "explicit camera: world up x,y,z (default 0,-1,0: y down, as in most 3DGS scenes)")
-      ->delimiter(',')->expected(3);
-  command->add_option("--fov", fov_degrees, "explicit camera: horizontal field of view in degrees")->check(CLI::Range(1.0, 179.0));
-}
-
-void parse_resolution(const std::string& text, int* width, int* height) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 || h < 1 ||
-      w > 65536 || h > 65536)
-    throw Error("resolution \"" + text + "\": expected WxH with 1 <= W, H <= 65536");
-  *width = w;
-  *height = h;
+      ->delimiter(',')->expected(3)->check(coordinate);
+  command->add_option("--fov", fov_degrees, "explicit camera: horizontal field of view in degrees")
+      ->check(finite_in(1.0, 179.0));
 }
 
 Camera CameraArgs::select(const std::string& cameras_path) const {
   if (is_explicit()) {
-    int w = 1920, h = 1080;
-    if (!resolution.empty()) parse_resolution(resolution, &w, &h);
-    Camera camera = look_at_camera(eye.data(), look_at.data(), up.data(), w, h, fov_degrees);
+    check_look_at(eye, look_at, up);
+    const Resolution size = resolution.empty() ? Resolution{1920, 1080} : parse_resolution(resolution);
+    Camera camera = look_at_camera(eye.data(), look_at.data(), up.data(), size.width, size.height, fov_degrees);
     camera.name = "explicit";
     return camera;
   }
@@ -108,13 +104,10 @@ Camera CameraArgs::select(const std::string& cameras_path) const {
                 ": 0.." + std::to_string(cameras.size() - 1) + ")");
   Camera camera = cameras[index];
   if (!resolution.empty()) {
-    int w, h;
-    parse_resolution(resolution, &w, &h);
-    camera = camera.resized(w, h);
+    const Resolution size = parse_resolution(resolution);
+    camera = camera.resized(size.width, size.height);
   }
   return camera;
 }
-
-std::unique_ptr<Renderer> make_backend(const std::string& which) { return create_backend(which); }
 
 }  // namespace flashgs::cli

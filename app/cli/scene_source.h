@@ -9,7 +9,6 @@
 
 #include "flashgs/camera.h"
 #include "flashgs/options.h"
-#include "flashgs/renderer.h"
 #include "flashgs/scene.h"
 
 namespace flashgs::cli {
@@ -41,6 +40,9 @@ struct RenderArgs {
   RenderOptions options() const;
 };
 
+// The largest |coordinate| --eye, --look-at and --up accept (float range).
+constexpr double kMaxCoordinate = 3.4e38;
+
 struct CameraArgs {
   int index = 0;
   std::string resolution;  // "WxH"; empty: the camera's own
@@ -52,11 +54,5 @@ struct CameraArgs {
   // The explicit camera, or camera `index` of the file at `cameras_path` (read only then).
   Camera select(const std::string& cameras_path) const;
 };
-
-// "1920x1080" -> (1920, 1080); throws flashgs::Error on anything else.
-void parse_resolution(const std::string& text, int* width, int* height);
-
-// "cpu", "cuda" or "auto" (CUDA when a device is present, otherwise the CPU).
-std::unique_ptr<Renderer> make_backend(const std::string& which);
 
 }  // namespace flashgs::cli

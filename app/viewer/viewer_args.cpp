@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "flashgs/error.h"
+#include "flashgs/parse.h"
 #include "viewer_settings.h"
 
 namespace flashgs::viewer {
@@ -32,24 +34,18 @@ CLI::Validator finite_in(ValueRange range) {
       wanted);
 }
 
-constexpr long kMaxSide = 32768;
+constexpr int kMaxSide = 32768;
 
-// "WxH" with both sides in 1..kMaxSide, nothing else (no sign, no trailing text).
-bool parse_size(const std::string& text, int* w, int* h) {
-  const auto x = text.find_first_of("xX");
-  if (x == std::string::npos) return false;
-  auto side = [](const std::string& part, int* out) {
-    if (part.empty() || part.size() > 6 || part.find_first_not_of("0123456789") != std::string::npos) return false;
-    const long v = std::strtol(part.c_str(), nullptr, 10);
-    if (v < 1 || v > kMaxSide) return false;
-    *out = static_cast<int>(v);
-    return true;
-  };
-  int a = 0, b = 0;
-  if (!side(text.substr(0, x), &a) || !side(text.substr(x + 1), &b)) return false;
-  *w = a;
-  *h = b;
-  return true;
+// "WxH" with both sides in 1..kMaxSide (the parser shared with the CLI); a ValidationError
+// naming `option` otherwise.
+void parse_size(const std::string& option, const std::string& text, int* w, int* h) {
+  try {
+    const Resolution size = parse_resolution(text, kMaxSide);
+    *w = size.width;
+    *h = size.height;
+  } catch (const Error& e) {
+    throw CLI::ValidationError(option, e.what());
+  }
 }
 
 }  // namespace
@@ -106,10 +102,8 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
                "log every frame in which a mouse button is held (for tests that click through X)");
   try {
     app.parse(argc, argv);
-    if (!size.empty() && !parse_size(size, &a->window_width, &a->window_height))
-      throw CLI::ValidationError("--size", "\"" + size + "\" is not WxH with sides 1.." + std::to_string(kMaxSide) + ", e.g. 1280x800");
-    if (!render_size.empty() && !parse_size(render_size, &a->render_width, &a->render_height))
-      throw CLI::ValidationError("--render-size", "\"" + render_size + "\" is not WxH with sides 1.." + std::to_string(kMaxSide) + ", e.g. 3840x2160");
+    if (!size.empty()) parse_size("--size", size, &a->window_width, &a->window_height);
+    if (!render_size.empty()) parse_size("--render-size", render_size, &a->render_width, &a->render_height);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }

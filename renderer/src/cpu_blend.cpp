@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "cpu_frame.h"
+#include "parallel_errors.h"
 
 namespace flashgs {
 namespace cpu {
@@ -84,12 +85,15 @@ void blend_tile(const Frame& frame, const std::uint64_t* keys, std::uint64_t cou
 void blend(const RenderOptions& options, Frame& frame, float* rgb) {
   const int tiles_x = frame.camera.tiles_x;
   const std::int64_t tiles = static_cast<std::int64_t>(tiles_x) * frame.camera.tiles_y;
+  ParallelErrors errors;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(frame.threads)
-  for (std::int64_t tile = 0; tile < tiles; ++tile) {
-    const std::uint64_t begin = frame.tile_start[tile], end = frame.tile_start[tile + 1];
-    blend_tile(frame, frame.sorted_keys.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
-               static_cast<int>(tile / tiles_x), options.background, rgb);
-  }
+  for (std::int64_t tile = 0; tile < tiles; ++tile)
+    errors.capture([&] {
+      const std::uint64_t begin = frame.tile_start[tile], end = frame.tile_start[tile + 1];
+      blend_tile(frame, frame.sorted_keys.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
+                 static_cast<int>(tile / tiles_x), options.background, rgb);
+    });
+  errors.rethrow();
 }
 
 }  // namespace cpu

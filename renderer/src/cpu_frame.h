@@ -40,7 +40,9 @@ struct Frame {
   std::vector<BlendGaussian> blend_data;   // [gaussians]
 
   // Emission: each thread's pairs (tile, key) for its static chunk of Gaussians, and its
-  // per-tile histogram. key = depth bits << 32 | Gaussian id.
+  // per-tile histogram. key = depth bits << 32 | Gaussian id. Only the first emit_chunks
+  // entries (the team the emit region was granted) belong to this frame.
+  int emit_chunks = 0;
   std::vector<std::vector<std::uint32_t>> thread_tiles;
   std::vector<std::vector<std::uint64_t>> thread_keys;
   std::vector<std::vector<std::uint32_t>> thread_tile_counts;  // [thread][tile]

@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "cpu_frame.h"
+#include "parallel_errors.h"
 
 namespace flashgs {
 namespace cpu {
@@ -12,32 +13,35 @@ void project_all(const Scene& scene, Frame& frame) {
   const std::int64_t n = static_cast<std::int64_t>(scene.size());
   const int rest_n = scene.sh_rest_per_gaussian();
   const float* rest = scene.sh_rest.data();
+  ParallelErrors errors;
 #pragma omp parallel for schedule(static) num_threads(frame.threads)
-  for (std::int64_t i = 0; i < n; ++i) {
-    gm::Footprint& f = frame.footprints[i];
-    const float opacity = scene.opacities[i];
-    const gm::CullReason reason =
-        gm::project(frame.camera, frame.geometry, &scene.positions[i * 3], &scene.scales[i * 3],
-                    &scene.rotations[i * 4], opacity, f);
-    frame.cull[i] = reason;
-    if (reason != gm::kVisible) continue;
-    BlendGaussian& g = frame.blend_data[i];
-    g.mean_x = f.mean_x;
-    g.mean_y = f.mean_y;
-    for (int k = 0; k < 4; ++k) g.whiten[k] = f.whiten[k];
-    g.opacity = opacity;
-    g.power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
-    // (a c - b^2) / a = det(W)^2 / a (Lagrange's identity); det(W) = w0 w3 - w1 w2 adds two
-    // non-negative terms, so a needle (a nearly singular conic) keeps an accurate row minimum.
-    const double w0 = f.whiten[0], w1 = f.whiten[1], w2 = f.whiten[2], w3 = f.whiten[3];
-    const double conic_a = w0 * w0 + w2 * w2, det_w = w0 * w3 - w1 * w2;
-    g.row_q_coeff = static_cast<float>(det_w * det_w / conic_a);
-    g.row_slope = static_cast<float>(-(w0 * w1 + w2 * w3) / conic_a);
-    g.inv_conic_a = static_cast<float>(1.0 / conic_a);
-    g.q_cut = -2.0f * g.power_cut;
-    gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], &scene.sh_dc[i * 3],
-                          DEGREE > 0 ? rest + i * rest_n : nullptr, g.rgb);
-  }
+  for (std::int64_t i = 0; i < n; ++i)
+    errors.capture([&] {
+      gm::Footprint& f = frame.footprints[i];
+      const float opacity = scene.opacities[i];
+      const gm::CullReason reason =
+          gm::project(frame.camera, frame.geometry, &scene.positions[i * 3], &scene.scales[i * 3],
+                      &scene.rotations[i * 4], opacity, f);
+      frame.cull[i] = reason;
+      if (reason != gm::kVisible) return;
+      BlendGaussian& g = frame.blend_data[i];
+      g.mean_x = f.mean_x;
+      g.mean_y = f.mean_y;
+      for (int k = 0; k < 4; ++k) g.whiten[k] = f.whiten[k];
+      g.opacity = opacity;
+      g.power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
+      // (a c - b^2) / a = det(W)^2 / a (Lagrange's identity); det(W) = w0 w3 - w1 w2 adds two
+      // non-negative terms, so a needle (a nearly singular conic) keeps an accurate row minimum.
+      const double w0 = f.whiten[0], w1 = f.whiten[1], w2 = f.whiten[2], w3 = f.whiten[3];
+      const double conic_a = w0 * w0 + w2 * w2, det_w = w0 * w3 - w1 * w2;
+      g.row_q_coeff = static_cast<float>(det_w * det_w / conic_a);
+      g.row_slope = static_cast<float>(-(w0 * w1 + w2 * w3) / conic_a);
+      g.inv_conic_a = static_cast<float>(1.0 / conic_a);
+      g.q_cut = -2.0f * g.power_cut;
+      gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], &scene.sh_dc[i * 3],
+                            DEGREE > 0 ? rest + i * rest_n : nullptr, g.rgb);
+    });
+  errors.rethrow();
 }
 
 }  // namespace

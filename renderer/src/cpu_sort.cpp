@@ -3,13 +3,14 @@
 #include <chrono>
 
 #include "cpu_frame.h"
+#include "parallel_errors.h"
 
 namespace flashgs {
 namespace cpu {
 
 void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms) {
   using Clock = std::chrono::steady_clock;
-  const int threads = frame.threads;
+  const int chunks = frame.emit_chunks;  // the emit stage's per-thread pair lists
   const std::size_t tiles = static_cast<std::size_t>(frame.camera.tiles_x) * frame.camera.tiles_y;
 
   // Ranges: tile_start from the per-thread histograms, and each thread's write cursor per tile.
@@ -18,7 +19,7 @@ void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms) {
   std::uint64_t running = 0;
   for (std::size_t tile = 0; tile < tiles; ++tile) {
     frame.tile_start[tile] = running;
-    for (int t = 0; t < threads; ++t) {
+    for (int t = 0; t < chunks; ++t) {
       const std::uint32_t c = frame.thread_tile_counts[t][tile];
       frame.thread_tile_counts[t][tile] = static_cast<std::uint32_t>(running - frame.tile_start[tile]);
       running += c;
@@ -29,22 +30,26 @@ void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms) {
 
   if (frame.sorted_keys.size() < running) frame.sorted_keys.resize(running);
   std::uint64_t* sorted = frame.sorted_keys.data();
-#pragma omp parallel for schedule(static, 1) num_threads(threads)
-  for (int t = 0; t < threads; ++t) {
-    const std::vector<std::uint32_t>& tile_of = frame.thread_tiles[t];
-    const std::vector<std::uint64_t>& keys = frame.thread_keys[t];
-    std::vector<std::uint32_t>& cursor = frame.thread_tile_counts[t];
-    for (std::size_t k = 0; k < keys.size(); ++k) {
-      const std::uint32_t tile = tile_of[k];
-      sorted[frame.tile_start[tile] + cursor[tile]++] = keys[k];
-    }
-  }
+  ParallelErrors errors;
+#pragma omp parallel for schedule(static, 1) num_threads(frame.threads)
+  for (int t = 0; t < chunks; ++t)
+    errors.capture([&] {
+      const std::vector<std::uint32_t>& tile_of = frame.thread_tiles[t];
+      const std::vector<std::uint64_t>& keys = frame.thread_keys[t];
+      std::vector<std::uint32_t>& cursor = frame.thread_tile_counts[t];
+      for (std::size_t k = 0; k < keys.size(); ++k) {
+        const std::uint32_t tile = tile_of[k];
+        sorted[frame.tile_start[tile] + cursor[tile]++] = keys[k];
+      }
+    });
+  errors.rethrow();
   // The key holds the Gaussian id below the depth, so equal depths sort by id: the order,
   // and the image, do not depend on how the work was split.
   const std::int64_t tile_count = static_cast<std::int64_t>(tiles);
-#pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
+#pragma omp parallel for schedule(dynamic, 16) num_threads(frame.threads)
   for (std::int64_t tile = 0; tile < tile_count; ++tile)
-    std::sort(sorted + frame.tile_start[tile], sorted + frame.tile_start[tile + 1]);
+    errors.capture([&] { std::sort(sorted + frame.tile_start[tile], sorted + frame.tile_start[tile + 1]); });
+  errors.rethrow();
 
   stats.max_tile_pairs = 0;
   for (std::size_t tile = 0; tile < tiles; ++tile)

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "flashgs/error.h"
+
 namespace flashgs {
 namespace {
 
@@ -105,7 +107,7 @@ Camera look_at_camera(const float eye[3], const float target[3], const float up[
                       float fov_degrees) {
   float forward[3];
   for (int k = 0; k < 3; ++k) forward[k] = target[k] - eye[k];
-  normalize(forward);
+  if (!normalize(forward)) throw Error("look-at camera: the eye is at the target (no view direction)");
   // OpenCV axes: x right, y down, z forward; right = forward x up.
   float right[3];
   cross(forward, up, right);

@@ -1,9 +1,9 @@
 // Image metrics: PSNR, max abs error, fraction of pixels off by more than 1/255.
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <string>
 
+#include "flashgs/error.h"
 #include "flashgs/image.h"
 
 namespace flashgs {
@@ -16,9 +16,8 @@ std::size_t count_non_finite(const Image& image) {
 
 ImageDifference compare_images(const Image& a, const Image& b) {
   if (a.width != b.width || a.height != b.height)
-    throw std::invalid_argument("cannot compare a " + std::to_string(a.width) + "x" +
-                                std::to_string(a.height) + " image with a " +
-                                std::to_string(b.width) + "x" + std::to_string(b.height) + " one");
+    throw Error("cannot compare a " + std::to_string(a.width) + "x" + std::to_string(a.height) + " image with a " +
+                std::to_string(b.width) + "x" + std::to_string(b.height) + " one");
   ImageDifference d;
   d.non_finite = count_non_finite(a) + count_non_finite(b);
   double sum_sq = 0;

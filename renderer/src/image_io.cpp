@@ -36,6 +36,18 @@ bool image_io_has_oiio() {
 #endif
 }
 
+bool image_format_writable(const std::string& path) {
+  const std::string ext = extension_of(path);
+  if (ext == "ppm" || ext == "pfm") return true;
+#ifdef FLASHGS_HAVE_OIIO
+  if (!ext.empty() && OIIO::ImageOutput::create(path)) return true;
+  OIIO::geterror();  // clears the message, so that a later error does not carry it
+  return false;
+#else
+  return false;
+#endif
+}
+
 void write_image(const Image& image, const std::string& path) {
   const std::string ext = extension_of(path);
   if (ext == "ppm") return write_ppm(image, path);

@@ -27,11 +27,4 @@ std::string RenderOptions::label() const {
 
 const char* algorithm_name(Algorithm a) { return a == Algorithm::baseline ? "baseline" : "flash"; }
 
-bool parse_algorithm(const std::string& text, Algorithm* out) {
-  if (text == "baseline") *out = Algorithm::baseline;
-  else if (text == "flash") *out = Algorithm::flash;
-  else return false;
-  return true;
-}
-
 }  // namespace flashgs

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "flashgs/gaussian_math.h"
+#include "parallel_errors.h"
 
 namespace flashgs {
 namespace {
@@ -207,26 +208,30 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
 
   Image image;
   image.resize(window.width, window.height);
+  ParallelErrors errors;
 #pragma omp parallel for schedule(dynamic, 1)
   for (int y = 0; y < window.height; ++y)
-    for (int x = 0; x < window.width; ++x) {
-      const double px = window.x0 + x, py = window.y0 + y;
-      double t = 1.0, rgb[3] = {0, 0, 0};
-      for (const RefGaussian& g : gaussians) {
-        if (px < g.px0 || px >= g.px1 || py < g.py0 || py >= g.py1) continue;
-        const double dx = px - g.mean_x, dy = py - g.mean_y;
-        const double power = -0.5 * (g.a * dx * dx + g.c * dy * dy) - g.b * dx * dy;
-        if (power > 0) continue;
-        const double alpha = std::min(kAlphaMax, g.opacity * std::exp(power));
-        if (alpha < kAlphaMin) continue;
-        const double next_t = t * (1 - alpha);
-        if (next_t < kTransmittanceMin) break;
-        for (int ch = 0; ch < 3; ++ch) rgb[ch] += g.rgb[ch] * alpha * t;
-        t = next_t;
+    errors.capture([&] {
+      for (int x = 0; x < window.width; ++x) {
+        const double px = window.x0 + x, py = window.y0 + y;
+        double t = 1.0, rgb[3] = {0, 0, 0};
+        for (const RefGaussian& g : gaussians) {
+          if (px < g.px0 || px >= g.px1 || py < g.py0 || py >= g.py1) continue;
+          const double dx = px - g.mean_x, dy = py - g.mean_y;
+          const double power = -0.5 * (g.a * dx * dx + g.c * dy * dy) - g.b * dx * dy;
+          if (power > 0) continue;
+          const double alpha = std::min(kAlphaMax, g.opacity * std::exp(power));
+          if (alpha < kAlphaMin) continue;
+          const double next_t = t * (1 - alpha);
+          if (next_t < kTransmittanceMin) break;
+          for (int ch = 0; ch < 3; ++ch) rgb[ch] += g.rgb[ch] * alpha * t;
+          t = next_t;
+        }
+        float* out = image.pixel(x, y);
+        for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<float>(rgb[ch] + t * options.background[ch]);
       }
-      float* out = image.pixel(x, y);
-      for (int ch = 0; ch < 3; ++ch) out[ch] = static_cast<float>(rgb[ch] + t * options.background[ch]);
-    }
+    });
+  errors.rethrow();
   return image;
 }
 

@@ -14,7 +14,7 @@ namespace flashgs {
 Scene make_demo_scene(std::size_t count = 30000, std::uint32_t seed = 7);
 
 // A camera at `eye` looking at `target` with `up` pointing up in the image (OpenCV axes),
-// horizontal field of view `fov_degrees`.
+// horizontal field of view `fov_degrees`. Throws flashgs::Error when eye and target coincide.
 Camera look_at_camera(const float eye[3], const float target[3], const float up[3], int width, int height,
                       float fov_degrees);
 

@@ -30,7 +30,7 @@ struct ImageDifference {
   std::size_t non_finite = 0;      // NaN/Inf values in either image
 };
 
-// Compares two images of the same size; throws std::invalid_argument otherwise.
+// Compares two images of the same size; throws flashgs::Error otherwise.
 ImageDifference compare_images(const Image& a, const Image& b);
 std::size_t count_non_finite(const Image& image);
 

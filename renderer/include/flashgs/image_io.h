@@ -12,6 +12,9 @@ namespace flashgs {
 void write_image(const Image& image, const std::string& path);
 // Reads an image as float RGB (8-bit formats scaled to [0, 1]).
 Image read_image(const std::string& path);
+// Whether write_image knows the format of `path`'s extension (checked before rendering, so
+// that a typo in the name does not cost a whole render).
+bool image_format_writable(const std::string& path);
 // Whether PNG/EXR are available (built with OpenImageIO).
 bool image_io_has_oiio();
 

@@ -40,7 +40,5 @@ struct RenderOptions {
 };
 
 const char* algorithm_name(Algorithm a);
-// Parses "baseline" / "flash"; returns false on anything else.
-bool parse_algorithm(const std::string& text, Algorithm* out);
 
 }  // namespace flashgs

@@ -1,0 +1,95 @@
+// Checks of the CLI's inputs made before any work starts (see option_checks.h).
+#include "option_checks.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include "flashgs/error.h"
+#include "flashgs/frame_memory.h"
+#include "flashgs/image_io.h"
+
+namespace flashgs::cli {
+
+namespace fs = std::filesystem;
+
+CLI::Validator finite_in(double low, double high) {
+  const std::string range = "[" + CLI::detail::to_string(low) + ", " + CLI::detail::to_string(high) + "]";
+  return CLI::Validator(
+      [low, high, range](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0') return "\"" + text + "\" is not a number";
+        if (!std::isfinite(v)) return "\"" + text + "\" is not a finite number";
+        if (v < low || v > high) return text + " is outside " + range;
+        return "";
+      },
+      "FINITE in " + range, "FINITE");
+}
+
+void check_camera_indices(const std::string& option, const std::vector<int>& indices, std::size_t count,
+                          const std::string& cameras_path) {
+  for (int i : indices)
+    if (i < 0 || static_cast<std::size_t>(i) >= count)
+      throw Error(option + ": camera " + std::to_string(i) + " does not exist (" + cameras_path + " has " +
+                  std::to_string(count) + (count ? ": 0.." + std::to_string(count - 1) : std::string()) + ")");
+}
+
+void check_output_file(const std::string& option, const std::string& path) {
+  if (path.empty()) throw Error(option + ": the output path is empty");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw Error(option + " " + path + ": is a folder, not a file");
+  const fs::path parent = fs::path(path).parent_path();
+  const std::string folder = parent.empty() ? "." : parent.string();
+  if (!fs::is_directory(folder, ec)) throw Error(option + " " + path + ": the folder " + folder + " does not exist");
+  if (access(folder.c_str(), W_OK) != 0) throw Error(option + " " + path + ": the folder " + folder + " is not writable");
+}
+
+void check_output_image(const std::string& option, const std::string& path) {
+  check_output_file(option, path);
+  if (!image_format_writable(path))
+    throw Error(option + " " + path + ": unknown image format (the extension picks it: " +
+                (image_io_has_oiio() ? std::string(".png, .exr, .jpg, .tif, ") : std::string()) + ".ppm or .pfm)");
+}
+
+void check_output_folder(const std::string& option, const std::string& dir) {
+  if (dir.empty()) throw Error(option + ": the output folder is empty");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw Error(option + " " + dir + ": cannot create the folder (" + ec.message() + ")");
+  if (access(dir.c_str(), W_OK) != 0) throw Error(option + " " + dir + ": the folder is not writable");
+}
+
+void check_frame_fits(const Renderer& renderer, const Camera& camera, std::size_t gaussians,
+                      const std::string& option) {
+  const bool cpu = renderer.name().rfind("cpu", 0) == 0;
+  // The pairs are unknown before the frame: one per Gaussian is the floor of a scene in view.
+  const FrameMemory need =
+      estimate_frame_memory(cpu ? BackendKind::cpu : BackendKind::cuda, gaussians, camera.width, camera.height,
+                            gaussians, static_cast<int>(std::thread::hardware_concurrency()));
+  const AvailableMemory available = available_host_memory();
+  const std::string shortfall = frame_memory_shortfall(need, camera.width, camera.height, available);
+  if (!shortfall.empty()) throw Error(option + ": " + shortfall);
+  if (need.host > 1000000000ull)
+    std::fprintf(stderr, "note: a %dx%d frame needs about %s of memory (%s available)\n", camera.width, camera.height,
+                 format_bytes(need.host).c_str(),
+                 available.limited_by.empty() ? "unknown" : format_bytes(available.bytes).c_str());
+}
+
+void check_look_at(const std::vector<float>& eye, const std::vector<float>& target, const std::vector<float>& up) {
+  const double f[3] = {double(target[0]) - eye[0], double(target[1]) - eye[1], double(target[2]) - eye[2]};
+  const double u[3] = {up[0], up[1], up[2]};
+  const double f_len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+  const double u_len = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  if (!(f_len > 0)) throw Error("--eye and --look-at are the same point: there is no view direction");
+  if (!(u_len > 0)) throw Error("--up is the zero vector");
+  const double c[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2], f[0] * u[1] - f[1] * u[0]};
+  const double sin_angle = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) / (f_len * u_len);
+  if (!(sin_angle > 1e-6)) throw Error("--up is parallel to the view direction (--look-at minus --eye)");
+}
+
+}  // namespace flashgs::cli

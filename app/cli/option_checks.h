@@ -1,0 +1,43 @@
+// Checks of the CLI's inputs made before any work starts: finite option values, camera
+// indices, output paths, and whether a frame fits in memory. Each failure is one line naming
+// the option or file.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "flashgs/camera.h"
+#include "flashgs/renderer.h"
+
+namespace flashgs::cli {
+
+// A CLI11 validator: the value is a finite number in [low, high] (CLI::Range lets NaN through,
+// since every comparison with NaN is false). Applies to each element of a vector option.
+CLI::Validator finite_in(double low, double high);
+
+// Throws flashgs::Error naming `option` and `cameras_path` when an index is not a camera of
+// the file (which holds `count`).
+void check_camera_indices(const std::string& option, const std::vector<int>& indices, std::size_t count,
+                          const std::string& cameras_path);
+
+// The output file `path` (given with `option`) can be created: a name, not a folder, in a
+// folder that exists and is writable. Throws flashgs::Error otherwise.
+void check_output_file(const std::string& option, const std::string& path);
+// Same, and write_image knows the format of its extension.
+void check_output_image(const std::string& option, const std::string& path);
+// Creates the folder `dir` (given with `option`) if needed and checks that it is writable.
+void check_output_folder(const std::string& option, const std::string& dir);
+
+// Refuses (flashgs::Error naming the option) a frame of `camera` whose estimated working
+// memory on `renderer` exceeds what this process can still allocate; prints the estimate
+// when the frame is large (above 1 GB) and fits.
+void check_frame_fits(const Renderer& renderer, const Camera& camera, std::size_t gaussians,
+                      const std::string& option);
+
+// Turns an explicit camera's --eye / --look-at / --up into an error naming them when they do
+// not define a view (eye at the target, or looking along up).
+void check_look_at(const std::vector<float>& eye, const std::vector<float>& target, const std::vector<float>& up);
+
+}  // namespace flashgs::cli
