@@ -2,6 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "flashgs/io.h"
 #include "flashgs/reference_renderer.h"
@@ -79,6 +84,36 @@ TEST(CpuDeterminism, SameFrameTwiceAndAnyThreadCountGiveTheSameBytes) {
     EXPECT_EQ(a.image.rgb, d.image.rgb);
     EXPECT_EQ(a.stats.kv_pairs, d.stats.kv_pairs);
   }
+}
+
+// OpenMP may grant fewer threads than a renderer asks for (OMP_THREAD_LIMIT, OMP_DYNAMIC, a
+// render called inside another parallel region): the frame is still the single-thread one.
+// Here each of two outer threads renders with 4 threads asked; with one active level allowed,
+// every inner region gets one.
+TEST(CpuDeterminism, FewerThreadsGrantedThanAskedGiveTheSameFrame) {
+#ifdef _OPENMP
+  const auto scene = test::load_demo_scene();
+  const Camera camera = test::load_demo_cameras()[3].resized(320, 180);
+  const Frame single = render(scene, camera, RenderOptions{}, 1);
+  const int levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(1);
+  std::vector<Frame> frames(2);
+  int outer_team = 0;
+#pragma omp parallel num_threads(2)
+  {
+    outer_team = omp_get_num_threads();
+    frames[omp_get_thread_num()] = render(scene, camera, RenderOptions{}, 4);
+  }
+  omp_set_max_active_levels(levels);
+  ASSERT_EQ(outer_team, 2) << "the outer region needs two threads for the inner ones to get one";
+  for (const Frame& f : frames) {
+    EXPECT_EQ(f.stats.kv_pairs, single.stats.kv_pairs);
+    EXPECT_EQ(f.stats.visible, single.stats.visible);
+    EXPECT_EQ(f.image.rgb, single.image.rgb);
+  }
+#else
+  GTEST_SKIP() << "built without OpenMP";
+#endif
 }
 
 TEST(CpuStats, TileCountsSumToThePairs) {

@@ -1,0 +1,230 @@
+// The `flashgs` binary on bad input: one line naming the option or file, a non-zero exit, no
+// crash, and nothing written or rendered first.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "flashgs/io.h"
+#include "ply_builder.h"
+#include "test_support.h"
+
+namespace flashgs {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliResult {
+  int exit_code = -1;  // -1 when killed by a signal
+  int signal = 0;
+  std::string output;  // stdout and stderr together
+  std::vector<std::string> error_lines() const {
+    std::vector<std::string> lines;
+    std::istringstream in(output);
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind("error", 0) == 0) lines.push_back(line);
+    return lines;
+  }
+};
+
+double children_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_CHILDREN, &usage);
+  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+std::string scratch_dir(const std::string& name) {
+  const std::string dir = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/cli/" + name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Runs `flashgs <arguments>` through the shell, with the address space limited to
+// `address_space_bytes` when non-zero (setrlimit in the child, as `prlimit --as` would).
+CliResult run_cli(const std::string& arguments, std::size_t address_space_bytes = 0) {
+  const std::string log = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/cli/last_run.log";
+  fs::create_directories(fs::path(log).parent_path());
+  const std::string command = std::string(FLASHGS_CLI) + " " + arguments;
+  const pid_t child = fork();
+  if (child == 0) {
+    if (address_space_bytes) {
+      const rlimit limit{address_space_bytes, address_space_bytes};
+      setrlimit(RLIMIT_AS, &limit);
+    }
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    // exec, not the shell's own fork: the status is the binary's, a signal included.
+    execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  CliResult r;
+  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
+  std::ifstream in(log);
+  r.output.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return r;
+}
+
+// The failure every bad input must give: a non-zero exit (not a signal), and exactly one
+// error line, which contains `fragment` (the option or file, and the problem).
+void expect_one_line_error(const CliResult& r, const std::string& fragment, const std::string& what) {
+  EXPECT_EQ(r.signal, 0) << what << ": killed by signal " << r.signal << "\n" << r.output;
+  EXPECT_GT(r.exit_code, 0) << what << "\n" << r.output;
+  const std::vector<std::string> lines = r.error_lines();
+  EXPECT_EQ(lines.size(), 1u) << what << "\n" << r.output;
+  std::size_t all_lines = 0;
+  for (char c : r.output) all_lines += c == '\n';
+  EXPECT_EQ(all_lines, 1u) << what << ": more than the error line\n" << r.output;
+  EXPECT_NE(r.output.find(fragment), std::string::npos) << what << ": no \"" << fragment << "\" in\n" << r.output;
+}
+
+TEST(CliOptions, NonFiniteValuesAreRejected) {
+  const std::string out = scratch_dir("non_finite") + "/x.ppm";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--tau nan", "--tau"},
+      {"--tau inf", "--tau"},
+      {"--background nan,0,0", "--background"},
+      {"--background 0,inf,0", "--background"},
+      {"--background 0,0,2", "--background"},
+      {"--fov nan", "--fov"},
+      {"--eye nan,0,0 --look-at 0,0,1", "--eye"},
+      {"--eye 0,0,0 --look-at 0,-inf,1", "--look-at"},
+      {"--eye 0,0,0 --look-at 0,0,1 --up 0,nan,0", "--up"},
+  };
+  for (const auto& [arguments, option] : cases) {
+    const CliResult r = run_cli("render -r 64x36 -o " + out + " " + arguments);
+    expect_one_line_error(r, option, arguments);
+    EXPECT_FALSE(fs::exists(out)) << arguments << ": an image was written";
+  }
+}
+
+TEST(CliOptions, DegenerateLookAtIsRejected) {
+  const std::string out = scratch_dir("look_at") + "/x.ppm";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--eye 1,2,3 --look-at 1,2,3", "--eye and --look-at are the same point"},
+      {"--eye 0,0,0 --look-at 0,5,0", "--up is parallel to the view direction"},  // up = 0,-1,0
+      {"--eye 0,0,0 --look-at 0,0,1 --up 0,0,0", "--up is the zero vector"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    const CliResult r = run_cli("render -r 64x36 -o " + out + " " + arguments);
+    expect_one_line_error(r, message, arguments);
+    EXPECT_EQ(r.exit_code, 2) << arguments;
+    EXPECT_FALSE(fs::exists(out)) << arguments;
+  }
+}
+
+TEST(CliOptions, ResolutionIsRangeChecked) {
+  const std::string out = scratch_dir("resolution") + "/x.ppm";
+  // 4294967312 = 2^32 + 16: sscanf's %d wrapped it to 16.
+  for (const char* text : {"4294967312x9", "16x4294967305", "65537x2", "0x9", "-16x9", "16x9x", "16 x9"}) {
+    const CliResult r = run_cli(std::string("render -o ") + out + " '--resolution=" + text + "'");
+    expect_one_line_error(r, std::string("resolution \"") + text + "\"", text);
+    EXPECT_FALSE(fs::exists(out)) << text;
+  }
+}
+
+TEST(CliOptions, OutputPathIsCheckedBeforeRendering) {
+  const std::string dir = scratch_dir("output_path");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {dir + "/missing/x.png", "the folder " + dir + "/missing does not exist"},
+      {dir + "/x.unknown_format", "unknown image format"},
+      {dir, "is a folder"},
+      {"''", "--output: the output path is empty"},
+  };
+  for (const auto& [path, fragment] : cases) {
+    // A frame that costs seconds of CPU to render: the error must come before it.
+    const double cpu_before = children_cpu_seconds();
+    const CliResult r = run_cli("render -r 4096x2304 -o " + path);
+    const double seconds = children_cpu_seconds() - cpu_before;
+    expect_one_line_error(r, fragment, path);
+    EXPECT_LT(seconds, 1.5) << path << ": rendered first";
+  }
+}
+
+TEST(CliOptions, CameraListsAreCheckedAgainstTheFile) {
+  const std::string dir = scratch_dir("camera_list");
+  const std::string cameras = std::string(FLASHGS_ASSET_DIR) + "/demo/cameras.json";
+  const std::size_t count = load_cameras(cameras).size();
+  const std::string missing = std::to_string(count + 63);
+  const std::string quick = " --backend cpu -r 32x18 ";
+  expect_one_line_error(run_cli("report --camera-list 0," + missing + quick + "--repeat 1 -o " + dir),
+                        "--camera-list: camera " + missing + " does not exist (" + cameras, "report 0," + missing);
+  expect_one_line_error(run_cli("report --camera-list abc" + quick + "-o " + dir), "--camera-list", "report abc");
+  expect_one_line_error(run_cli("bench --camera-list 1," + missing + quick + "--json " + dir + "/b.json"),
+                        "--camera-list: camera " + missing + " does not exist (" + cameras, "bench 1," + missing);
+  EXPECT_FALSE(fs::exists(dir + "/report.csv"));
+}
+
+// The demo scene at 51200x28800: 17.7 GB of image alone. Under a 2 GB address-space limit
+// the frame is refused before rendering, with the estimate and what is available (it was a
+// std::bad_alloc inside an OpenMP region: std::terminate, SIGABRT).
+TEST(CliMemory, FrameTooLargeForTheAddressSpaceIsRefused) {
+  const std::string out = scratch_dir("too_large") + "/x.ppm";
+  const CliResult r = run_cli("render --backend cpu -r 51200x28800 -o " + out, std::size_t{2} << 30);
+  expect_one_line_error(r, "--resolution: a 51200x28800 frame needs about", "51200x28800");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("is available (the address-space limit, RLIMIT_AS)"), std::string::npos) << r.output;
+}
+
+// A frame whose image is small but whose Gaussian-tile pairs are not: 20000 Gaussians, each
+// covering all 8192 tiles of a 2048x1024 frame, are 164M pairs (2 GB) that run out of address
+// space inside the emit stage's parallel region. That is an error naming the frame, exit 2.
+TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
+  const std::string dir = scratch_dir("pairs_oom");
+  test::PlyBuilder b = test::PlyBuilder::inria(0, 20000);
+  for (std::size_t i = 0; i < b.vertices.size(); ++i) {
+    b.vertices[i][b.index_of("x")] = 0;
+    b.vertices[i][b.index_of("z")] = 0.001 * static_cast<double>(i);
+    for (const char* s : {"scale_0", "scale_1", "scale_2"}) b.vertices[i][b.index_of(s)] = std::log(20.0);
+  }
+  std::ofstream(dir + "/point_cloud.ply", std::ios::binary) << b.bytes();
+  const CliResult r = run_cli("render " + dir + "/point_cloud.ply --backend cpu --eye 0,0,-5 --look-at 0,0,0 -r 2048x1024 -o " +
+                                  dir + "/x.ppm",
+                              std::size_t{1} << 30);
+  expect_one_line_error(r, "out of memory for a 2048x1024 frame", "pairs out of memory");
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+TEST(CliGenerate, RefusesToOverwriteAScene) {
+  const std::string dir = scratch_dir("overwrite");
+  ASSERT_EQ(run_cli("generate demo --count 300 -o " + dir).exit_code, 0);
+  const std::string ply = dir + "/point_cloud.ply";
+  const auto size = fs::file_size(ply);
+
+  expect_one_line_error(run_cli("generate demo --count 100 -o " + dir), "already holds " + ply, "demo again");
+  // The source scene as the output: refused, and the source is intact.
+  expect_one_line_error(run_cli("generate tile -i " + ply + " -n 4 -o " + dir), "--force", "tile onto its source");
+  EXPECT_EQ(fs::file_size(ply), size);
+  EXPECT_EQ(load_ply(ply).size(), 300u);
+
+  // With --force: the source read first, the result renamed over it, nothing partial left.
+  ASSERT_EQ(run_cli("generate tile -i " + ply + " -n 4 -o " + dir + " --force").exit_code, 0);
+  EXPECT_EQ(load_ply(ply).size(), 4 * 300u);
+  for (const auto& entry : fs::directory_iterator(dir))
+    EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
+}
+
+TEST(CliGenerate, CountMustBePositive) {
+  const std::string dir = scratch_dir("count");
+  for (const char* count : {"0", "-1", "nan", "1e99"}) {
+    expect_one_line_error(run_cli(std::string("generate demo --count ") + count + " -o " + dir), "--count", count);
+    EXPECT_FALSE(fs::exists(dir + "/point_cloud.ply")) << count;
+  }
+}
+
+}  // namespace
+}  // namespace flashgs
