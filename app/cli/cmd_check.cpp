@@ -12,6 +12,7 @@
 #include "flashgs/image_io.h"
 #include "flashgs/stress_check.h"
 #include "flashgs/stress_scenes.h"
+#include "option_checks.h"
 
 namespace flashgs::cli {
 namespace {
@@ -45,6 +46,9 @@ std::vector<Backend> present_backends(const std::string& which) {
 }
 
 int run(const CheckArgs& args) {
+  // Output paths first: a failure after the cases have run would waste minutes.
+  if (!args.csv.empty()) check_output_file("--csv", args.csv);
+  if (!args.images_dir.empty()) check_output_folder("--images", args.images_dir);
   std::vector<std::string> names = args.cases;
   if (names.empty())
     for (const std::string& name : stress_case_names()) {
