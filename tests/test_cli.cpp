@@ -192,8 +192,8 @@ TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
     for (const char* s : {"scale_0", "scale_1", "scale_2"}) b.vertices[i][b.index_of(s)] = std::log(20.0);
   }
   std::ofstream(dir + "/point_cloud.ply", std::ios::binary) << b.bytes();
-  const CliResult r = run_cli("render " + dir + "/point_cloud.ply --backend cpu --eye 0,0,-5 --look-at 0,0,0 -r 2048x1024 -o " +
-                                  dir + "/x.ppm",
+  const CliResult r = run_cli("render " + dir + "/point_cloud.ply --backend cpu --eye 0,0,-5 --look-at 0,0,0 " +
+                                  "-r 2048x1024 -o " + dir + "/x.ppm",
                               std::size_t{1} << 30);
   expect_one_line_error(r, "out of memory for a 2048x1024 frame", "pairs out of memory");
   EXPECT_EQ(r.exit_code, 2);

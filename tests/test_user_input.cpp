@@ -30,7 +30,8 @@ TEST(ParseResolution, RejectsAnythingElseWithOneMessage) {
       parse_resolution(text);
       ADD_FAILURE() << "accepted \"" << text << "\"";
     } catch (const Error& e) {
-      EXPECT_EQ(std::string(e.what()), std::string("resolution \"") + text + "\": expected WxH with 1 <= W, H <= 65536");
+      EXPECT_EQ(std::string(e.what()),
+                std::string("resolution \"") + text + "\": expected WxH with 1 <= W, H <= 65536");
     }
   }
   EXPECT_THROW(parse_resolution("301x200", 300), Error);

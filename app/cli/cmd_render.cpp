@@ -25,7 +25,8 @@ struct RenderCommand {
     auto loaded = load_scene_verbose(scene_path);
     const Camera cam = camera.select(scene.resolved_cameras());
     auto renderer = create_backend(render.backend);
-    check_frame_fits(*renderer, cam, loaded->size(), camera.resolution.empty() ? "the camera's size" : "--resolution");
+    check_frame_fits(*renderer, cam, loaded->size(),
+                     camera.resolution.empty() ? "the camera's size" : "--resolution");
     renderer->set_scene(loaded);
     const RenderOptions options = render.options();
     Image image;

@@ -17,6 +17,8 @@ namespace flashgs::cli {
 
 namespace fs = std::filesystem;
 
+constexpr double kFloatMax = 3.4028234663852886e38;
+
 CLI::Validator finite_in(double low, double high) {
   const std::string range = "[" + CLI::detail::to_string(low) + ", " + CLI::detail::to_string(high) + "]";
   return CLI::Validator(
@@ -46,7 +48,8 @@ void check_output_file(const std::string& option, const std::string& path) {
   const fs::path parent = fs::path(path).parent_path();
   const std::string folder = parent.empty() ? "." : parent.string();
   if (!fs::is_directory(folder, ec)) throw Error(option + " " + path + ": the folder " + folder + " does not exist");
-  if (access(folder.c_str(), W_OK) != 0) throw Error(option + " " + path + ": the folder " + folder + " is not writable");
+  if (access(folder.c_str(), W_OK) != 0)
+    throw Error(option + " " + path + ": the folder " + folder + " is not writable");
 }
 
 void check_output_image(const std::string& option, const std::string& path) {
@@ -60,7 +63,8 @@ void check_output_folder(const std::string& option, const std::string& dir) {
   if (dir.empty()) throw Error(option + ": the output folder is empty");
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw Error(option + " " + dir + ": cannot create the folder (" + ec.message() + ")");
+  if (ec || !fs::is_directory(dir))
+    throw Error(option + " " + dir + ": cannot create the folder (" + ec.message() + ")");
   if (access(dir.c_str(), W_OK) != 0) throw Error(option + " " + dir + ": the folder is not writable");
 }
 
@@ -86,6 +90,7 @@ void check_look_at(const std::vector<float>& eye, const std::vector<float>& targ
   const double f_len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
   const double u_len = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
   if (!(f_len > 0)) throw Error("--eye and --look-at are the same point: there is no view direction");
+  if (!(f_len < kFloatMax)) throw Error("--look-at minus --eye is beyond float range");
   if (!(u_len > 0)) throw Error("--up is the zero vector");
   const double c[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2], f[0] * u[1] - f[1] * u[0]};
   const double sin_angle = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) / (f_len * u_len);

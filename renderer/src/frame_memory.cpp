@@ -64,9 +64,10 @@ bool read_cgroup_left(std::uint64_t* bytes) {
 
 FrameMemory estimate_frame_memory(BackendKind backend, std::size_t gaussians, int width, int height,
                                   std::uint64_t pairs, int threads) {
-  const std::uint64_t pixels = static_cast<std::uint64_t>(std::max(width, 0)) * static_cast<std::uint64_t>(std::max(height, 0));
-  const std::uint64_t tiles = ((static_cast<std::uint64_t>(std::max(width, 0)) + gm::kTileSize - 1) / gm::kTileSize) *
-                              ((static_cast<std::uint64_t>(std::max(height, 0)) + gm::kTileSize - 1) / gm::kTileSize);
+  const std::uint64_t w = static_cast<std::uint64_t>(std::max(width, 0));
+  const std::uint64_t h = static_cast<std::uint64_t>(std::max(height, 0));
+  const std::uint64_t pixels = w * h;
+  const std::uint64_t tiles = ((w + gm::kTileSize - 1) / gm::kTileSize) * ((h + gm::kTileSize - 1) / gm::kTileSize);
   const std::uint64_t n = gaussians;
   FrameMemory m;
   m.image = pixels * 3 * sizeof(float);
