@@ -13,6 +13,7 @@
 
 #include "flashgs/image.h"
 #include "flashgs/image_io.h"
+#include "flashgs/frame_memory.h"
 #include "memory_budget.h"
 #include "test_support.h"
 
@@ -467,8 +468,8 @@ TEST(Viewer, AGeneratedOrTiledSceneBeyondMemoryIsRefused) {
   namespace fv = flashgs::viewer;
   // 200 M demo Gaussians (SH degree 1); a machine with room for them would really build them.
   const std::uint64_t need = fv::scene_bytes(200000000, fv::scene_bytes_per_gaussian(1));
-  if (double(need) <= fv::kMemoryShare * double(fv::available_memory_bytes()))
-    GTEST_SKIP() << "this machine has memory for " << fv::memory_text(need) << ": nothing to refuse";
+  if (double(need) <= fv::kMemoryShare * double(flashgs::system_available_memory()))
+    GTEST_SKIP() << "this machine has memory for " << flashgs::format_bytes(need) << ": nothing to refuse";
   const RunResult a = run(prefix + viewer() + " --backend cpu --size 320x180 --generate-demo 200000000 --frames 1 --exit");
   EXPECT_EQ(a.exit_code, 2) << a.output;
   // The reason first, then what follows from it (the run has no scene).

@@ -18,6 +18,7 @@
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
 #include "key_script.h"
+#include "flashgs/frame_memory.h"
 #include "memory_budget.h"
 #include "scene_loader.h"
 #include "scene_state.h"
@@ -376,7 +377,7 @@ TEST(ViewerMemory, TooLargeFramesAreRefusedWithTheirFigures) {
   // 20000 x 20000 on a machine with 8 GB free: over 8 GB needed, refused by memory alone.
   const std::string over_memory = fv::frame_size_problem(20000, 20000, 1, 0, 8000000000ull);
   EXPECT_GT(fv::frame_bytes(20000, 20000, 1), 8000000000ull);
-  EXPECT_NE(over_memory.find("needs about " + fv::memory_text(fv::frame_bytes(20000, 20000, 1))), std::string::npos)
+  EXPECT_NE(over_memory.find("needs about " + flashgs::format_bytes(fv::frame_bytes(20000, 20000, 1))), std::string::npos)
       << over_memory;
   EXPECT_NE(over_memory.find("8.0 GB is available"), std::string::npos) << over_memory;
   // Ordinary frames fit; unknown memory (0) is not held against them.
@@ -389,7 +390,7 @@ TEST(ViewerMemory, TooLargeFramesAreRefusedWithTheirFigures) {
   EXPECT_NE(fv::scene_size_problem(fv::scene_bytes(200000000, per), 20000000000ull).find(" GB of memory"),
             std::string::npos);
   EXPECT_EQ(fv::scene_size_problem(fv::scene_bytes(30000, per), 20000000000ull), "");
-  EXPECT_GT(fv::available_memory_bytes(), 0u);
+  EXPECT_GT(flashgs::system_available_memory(), 0u);
 }
 
 // Loads with a time limit: a load that blocks fails the test instead of hanging it.

@@ -19,20 +19,6 @@ namespace fs = std::filesystem;
 
 constexpr double kFloatMax = 3.4028234663852886e38;
 
-CLI::Validator finite_in(double low, double high) {
-  const std::string range = "[" + CLI::detail::to_string(low) + ", " + CLI::detail::to_string(high) + "]";
-  return CLI::Validator(
-      [low, high, range](std::string& text) -> std::string {
-        char* end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || *end != '\0') return "\"" + text + "\" is not a number";
-        if (!std::isfinite(v)) return "\"" + text + "\" is not a finite number";
-        if (v < low || v > high) return text + " is outside " + range;
-        return "";
-      },
-      "FINITE in " + range, "FINITE");
-}
-
 void check_camera_indices(const std::string& option, const std::vector<int>& indices, std::size_t count,
                           const std::string& cameras_path) {
   for (int i : indices)

@@ -8,14 +8,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include "finite_option.h"
 #include "flashgs/camera.h"
 #include "flashgs/renderer.h"
 
 namespace flashgs::cli {
 
-// A CLI11 validator: the value is a finite number in [low, high] (CLI::Range lets NaN through,
-// since every comparison with NaN is false). Applies to each element of a vector option.
-CLI::Validator finite_in(double low, double high);
+using flashgs::finite_in;  // app/common/finite_option.h
 
 // Throws flashgs::Error naming `option` and `cameras_path` when an index is not a camera of
 // the file (which holds `count`).

@@ -17,6 +17,7 @@
 #include "gl_headers_gl.h"
 #include "image_presenter_gl.h"
 #include "imgui_layer_ui.h"
+#include "flashgs/frame_memory.h"
 #include "memory_budget.h"
 #include "viewer_panels_ui.h"
 #include "window_gl.h"
@@ -367,7 +368,7 @@ void ViewerApp::choose_render_size(int wanted_width, int wanted_height, int* wid
     m_checked_width = wanted_width;
     m_checked_height = wanted_height;
     m_checked_problem = frame_size_problem(wanted_width, wanted_height, m_path->texture_count(), m_max_texture_size,
-                                           available_memory_bytes());
+                                           system_available_memory());
   }
   if (m_checked_problem.empty()) return;
   // Back to the last size that rendered; before the first frame, halves until it fits.
@@ -376,7 +377,7 @@ void ViewerApp::choose_render_size(int wanted_width, int wanted_height, int* wid
     w = wanted_width;
     h = wanted_height;
     while ((w > 1 || h > 1) && !frame_size_problem(w, h, m_path->texture_count(), m_max_texture_size,
-                                                   available_memory_bytes()).empty()) {
+                                                   system_available_memory()).empty()) {
       w = std::max(1, w / 2);
       h = std::max(1, h / 2);
     }
@@ -526,7 +527,7 @@ bool ViewerApp::load_first_scene() {
     const int demo_sh_degree = 1;  // what make_demo_scene builds
     const std::string problem =
         scene_size_problem(scene_bytes(std::uint64_t(m_args.generate_demo), scene_bytes_per_gaussian(demo_sh_degree)),
-                           available_memory_bytes());
+                           system_available_memory());
     try {
       if (!problem.empty()) throw Error(problem);
       install_scene(generate_demo_scene(static_cast<std::size_t>(m_args.generate_demo)));
@@ -556,7 +557,7 @@ bool ViewerApp::apply_start_options() {
     const std::uint64_t gaussians = std::uint64_t(m_scene.scene->size()) * std::uint64_t(m_args.tile);
     const std::string problem =
         scene_size_problem(scene_bytes(gaussians, scene_bytes_per_gaussian(m_scene.scene->sh_degree)),
-                           available_memory_bytes());
+                           system_available_memory());
     try {
       if (!problem.empty()) throw Error(problem + " for " + std::to_string(gaussians) + " Gaussians");
       install_scene(tile_loaded_scene(m_scene, m_args.tile));
@@ -567,7 +568,7 @@ bool ViewerApp::apply_start_options() {
   }
   if (m_settings.forced_width > 0) {
     const std::string problem = frame_size_problem(m_settings.forced_width, m_settings.forced_height,
-                                                   m_path->texture_count(), m_max_texture_size, available_memory_bytes());
+                                                   m_path->texture_count(), m_max_texture_size, system_available_memory());
     if (!problem.empty()) {
       set_notice("--render-size " + size_text(m_settings.forced_width, m_settings.forced_height) + " refused: " +
                  problem + (m_scripted ? "" : "; rendering at the window size"));

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "finite_option.h"
 #include "flashgs/error.h"
 #include "flashgs/parse.h"
 #include "viewer_settings.h"
@@ -14,25 +15,8 @@
 namespace flashgs::viewer {
 namespace {
 
-std::string number_text(float v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
-
-// A finite number in `range`: CLI11's Range lets NaN through (every comparison with it is false).
-CLI::Validator finite_in(ValueRange range) {
-  const std::string wanted = "a finite number in [" + number_text(range.min) + ", " + number_text(range.max) + "]";
-  return CLI::Validator(
-      [range, wanted](std::string& text) {
-        char* end = nullptr;
-        const float v = std::strtof(text.c_str(), &end);
-        if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || !range.contains(v))
-          return "\"" + text + "\" is not " + wanted;
-        return std::string();
-      },
-      wanted);
-}
+// A finite number in `range` (app/common/finite_option.h).
+CLI::Validator finite_in(ValueRange range) { return flashgs::finite_in(range.min, range.max); }
 
 constexpr int kMaxSide = 32768;
 

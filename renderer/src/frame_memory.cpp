@@ -106,6 +106,11 @@ AvailableMemory available_host_memory() {
   return out;
 }
 
+std::uint64_t system_available_memory() {
+  std::uint64_t bytes = 0;
+  return read_mem_available(&bytes) ? bytes : 0;
+}
+
 std::string format_bytes(std::uint64_t bytes) {
   char text[32];
   if (bytes >= 1000000000ull)

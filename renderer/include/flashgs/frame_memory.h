@@ -36,6 +36,10 @@ struct AvailableMemory {
   std::string limited_by;
 };
 AvailableMemory available_host_memory();
+// The system's part of it alone (MemAvailable; 0 when unknown): the viewer checks a window's
+// frames against it and leaves a process limit to the allocation that fails (it then falls
+// back to the last size that rendered).
+std::uint64_t system_available_memory();
 
 // "a 51200x28800 frame needs about 18.1 GB (image 17.7 GB, tiles 0.4 GB, ...) but 3.9 GB is
 // available (address-space limit)" when the estimate's host part exceeds `available`;
