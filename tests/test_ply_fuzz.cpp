@@ -3,6 +3,7 @@
 // bounds.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <random>
 
@@ -19,7 +20,15 @@ Outcome try_parse(const std::string& bytes) {
   // An exact-size heap copy, so ASan sees any read past the end.
   std::vector<char> copy(bytes.begin(), bytes.end());
   try {
-    parse_ply(copy.data(), copy.size(), "fuzz.ply");
+    const Scene scene = parse_ply(copy.data(), copy.size(), "fuzz.ply");
+    // What loads is what a renderer can use: every stored value a finite float.
+    for (const std::vector<float>* values :
+         {&scene.positions, &scene.scales, &scene.rotations, &scene.opacities, &scene.sh_dc, &scene.sh_rest})
+      for (float v : *values)
+        if (!std::isfinite(v)) {
+          ADD_FAILURE() << "a loaded file holds a non-finite value";
+          return Outcome::loaded;
+        }
     return Outcome::loaded;
   } catch (const Error&) {
     return Outcome::rejected;

@@ -16,7 +16,7 @@ namespace {
 using nlohmann::json;
 
 // Real camera files hold a few hundred cameras in a few hundred KB.
-constexpr std::size_t kMaxCameraFileBytes = 64u << 20;
+constexpr std::size_t kMaxCameraFileBytes = 64000000;
 // Longest img_name kept; longer names are cut (they are only shown).
 constexpr std::size_t kMaxCameraNameBytes = 200;
 // Focal lengths in pixels outside this range are not a camera (a zero or denormal one divides by zero).
