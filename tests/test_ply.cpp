@@ -255,6 +255,14 @@ TEST(PlyMalformed, FileTextInMessagesIsEscapedAndCut) {
   expect_error(b.bytes(), "unknown property type \"\\x1b[31mbogusaaa");
 }
 
+TEST(PrintableFileText, EscapesControlsAndInvalidUtf8KeepsTextAndUnicode) {
+  EXPECT_EQ(printable_file_text("plain \"x\" \\"), "plain \\\"x\\\" \\\\");
+  EXPECT_EQ(printable_file_text("caf\xc3\xa9 \xe2\x82\xac"), "caf\xc3\xa9 \xe2\x82\xac");
+  EXPECT_EQ(printable_file_text(std::string("a\0\n\x1b\x7f", 5)), "a\\x00\\x0a\\x1b\\x7f");
+  EXPECT_EQ(printable_file_text("\xc2\x85 \xff \xc3"), "\\xc2\\x85 \\xff \\xc3");  // C1 control, invalid bytes
+  EXPECT_EQ(printable_file_text(std::string(100, 'z'), 10), "zzzzzzzzzz... (100 bytes)");
+}
+
 TEST(PlyMalformed, NotAPlyFile) { expect_error("hello world\n", "not a PLY file"); }
 
 TEST(PlyMalformed, EmptyFile) { expect_error("", "not a PLY file (it is empty)"); }
