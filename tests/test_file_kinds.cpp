@@ -200,7 +200,9 @@ struct CliRun {
 };
 
 CliRun run_cli(const std::string& args) {
-  const std::string log = (fs::path(FLASHGS_TEST_OUTPUT_DIR) / "file_kinds" / "cli.log").string();
+  // One log per test, so that tests run in parallel (ctest -j) do not share one.
+  const std::string test_name = testing::UnitTest::GetInstance()->current_test_info()->name();
+  const std::string log = (fs::path(FLASHGS_TEST_OUTPUT_DIR) / "file_kinds" / (test_name + ".log")).string();
   const std::string command =
       "timeout " + std::to_string(kHangSeconds) + " " + FLASHGS_CLI + " " + args + " > " + log + " 2>&1";
   const int status = std::system(command.c_str());
