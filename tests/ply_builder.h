@@ -15,6 +15,8 @@ struct PlyBuilder {
   std::vector<std::pair<std::string, std::string>> properties;  // (type, name)
   std::vector<std::vector<double>> vertices;
   long long declared_count = -1;  // -1: the real count
+  // Other elements: header lines and data bytes, before and after the vertex element.
+  std::string leading_elements, leading_data, trailing_elements, trailing_data;
 
   // The INRIA layout with SH degree `degree` and `n` plausible Gaussians.
   static PlyBuilder inria(int degree, int n) {
@@ -48,15 +50,15 @@ struct PlyBuilder {
 
   std::string header() const {
     std::ostringstream h;
-    h << "ply\nformat " << format << " 1.0\ncomment built by the flashgs tests\n";
+    h << "ply\nformat " << format << " 1.0\ncomment built by the flashgs tests\n" << leading_elements;
     h << "element vertex " << (declared_count >= 0 ? declared_count : static_cast<long long>(vertices.size())) << "\n";
     for (const auto& [type, name] : properties) h << "property " << type << " " << name << "\n";
-    h << "end_header\n";
+    h << trailing_elements << "end_header\n";
     return h.str();
   }
 
   std::string bytes() const {
-    std::string out = header();
+    std::string out = header() + leading_data;
     const bool big = format == "binary_big_endian";
     for (const auto& v : vertices) {
       if (format == "ascii") {
@@ -75,7 +77,7 @@ struct PlyBuilder {
         for (int b = 0; b < n; ++b) out += static_cast<char>(big ? raw[n - 1 - b] : raw[b]);
       }
     }
-    return out;
+    return out + trailing_data;
   }
 
  private:

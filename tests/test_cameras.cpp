@@ -75,6 +75,28 @@ TEST(CamerasBad, ReflectionIsNotARotation) {
 TEST(CamerasBad, BadSize) { expect_error(replace(kGood, "\"width\": 64", "\"width\": 0"), "width"); }
 TEST(CamerasBad, NegativeFocal) { expect_error(replace(kGood, "\"fx\": 50", "\"fx\": -5"), "positive"); }
 
+// Doubles that JSON holds but a float does not: checked after the conversion.
+TEST(CamerasBad, FocalBeyondTheFloatRange) { expect_error(replace(kGood, "\"fx\": 50", "\"fx\": 1e300"), "fx"); }
+TEST(CamerasBad, FocalThatIsZeroAsAFloat) {
+  expect_error(replace(kGood, "\"fy\": 50", "\"fy\": 1e-300"), "fx and fy must be between 0.001 and 1e+09 pixels");
+}
+TEST(CamerasBad, DenormalFocal) { expect_error(replace(kGood, "\"fx\": 50", "\"fx\": 1e-40"), "fy = 50"); }
+TEST(CamerasBad, PositionBeyondTheFloatRange) {
+  expect_error(replace(kGood, "[1, 2, 3]", "[1, 1e300, 3]"), "\"position\"[1] is not a finite float (1e+300)");
+}
+TEST(CamerasBad, EmptyText) { expect_error(" \n", "the file is empty"); }
+
+// img_name is shown in messages and the viewer: control characters escaped, length cut.
+TEST(Cameras, NameIsMadePrintableAndShort) {
+  const Camera odd = parse_cameras(replace(kGood, "\"a\"", "\"a\\u001b[2J\\nb\""), "cams.json")[0];
+  EXPECT_EQ(odd.name, "a\\x1b[2J\\x0ab");
+  const Camera unicode = parse_cameras(replace(kGood, "\"a\"", "\"caf\u00e9\""), "cams.json")[0];
+  EXPECT_EQ(unicode.name, "caf\u00e9");
+  const Camera huge = parse_cameras(replace(kGood, "\"a\"", "\"" + std::string(1 << 20, 'n') + "\""), "cams.json")[0];
+  EXPECT_LT(huge.name.size(), 250u);
+  EXPECT_NE(huge.name.find("(1048576 bytes)"), std::string::npos) << huge.name;
+}
+
 TEST(CamerasReal, EverySharedSceneHas52Cameras) {
   FLASHGS_REQUIRE_SHARED_SCENES();
   for (const std::string& name : test::shared_scene_names()) EXPECT_EQ(test::load_shared_cameras(name).size(), 52u) << name;

@@ -137,9 +137,135 @@ TEST(PlyLoad, ExtremeButFiniteValuesLoad) {
   EXPECT_GE(s.scales[6], 0.0f);
 }
 
+// 3DGS files from some tools carry other elements (a face list, a camera record) around the
+// vertices: they are walked over by their declared size, never read as Gaussians.
+TEST(PlyLoad, BinaryElementsAroundTheVerticesAreSkipped) {
+  PlyBuilder b = PlyBuilder::inria(0, 10);
+  b.leading_elements = "element camera 1\nproperty float focal\nproperty uchar kind\n";
+  b.leading_data = std::string(5, '\x7f');
+  b.trailing_elements = "element face 2\nproperty list uchar int vertex_indices\nproperty uchar flag\n";
+  b.trailing_data = std::string("\x03") + std::string(12, '\0') + "\x01" + std::string("\x02") + std::string(8, '\0') + "\x01";
+  const Scene s = parse(b.bytes());
+  EXPECT_EQ(s.size(), 10u);
+  EXPECT_EQ(s.positions, parse(PlyBuilder::inria(0, 10).bytes()).positions);
+}
+
+TEST(PlyLoad, AsciiElementsAroundTheVerticesAreSkipped) {
+  PlyBuilder b = PlyBuilder::inria(0, 10);
+  b.format = "ascii";
+  b.leading_elements = "element camera 1\nproperty float focal\nproperty uchar kind\n";
+  b.leading_data = "1.5 7\n";
+  b.trailing_elements = "element face 2\nproperty list uchar int vertex_indices\n";
+  b.trailing_data = "3 0 1 2\n2 4 5\n";
+  const Scene s = parse(b.bytes());
+  EXPECT_EQ(s.size(), 10u);
+  EXPECT_EQ(s.positions, parse(PlyBuilder::inria(0, 10).bytes()).positions);
+}
+
+// A double that is finite but beyond the float range is stored as Inf: it is non-finite.
+TEST(PlyLoad, DoublesBeyondTheFloatRangeDropTheGaussianAndAreCounted) {
+  PlyBuilder b = PlyBuilder::inria(1, 5);
+  for (const char* name : {"x", "f_dc_0", "f_rest_3"}) b.properties[b.index_of(name)].first = "double";
+  b.vertices[0][b.index_of("f_rest_3")] = 1e300;
+  b.vertices[1][b.index_of("x")] = -1e300;
+  b.vertices[2][b.index_of("f_dc_0")] = 1e39;
+  LoadReport report;
+  const Scene s = parse(b.bytes(), &report);
+  EXPECT_EQ(s.size(), 2u);
+  EXPECT_EQ(report.dropped_non_finite, 3u);
+  for (const std::vector<float>* values : {&s.positions, &s.sh_dc, &s.sh_rest})
+    for (float v : *values) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(PlyMalformed, AsciiCountSmallerThanData) {
+  PlyBuilder b = PlyBuilder::inria(0, 10);
+  b.format = "ascii";
+  b.declared_count = 9;
+  expect_error(b.bytes(), "declares 9 vertices but more data follows, \"0.9");
+}
+
+TEST(PlyMalformed, AsciiDataAfterTheLastElement) {
+  PlyBuilder b = PlyBuilder::inria(0, 3);
+  b.format = "ascii";
+  b.trailing_elements = "element face 1\nproperty list uchar int vertex_indices\n";
+  b.trailing_data = "3 0 1 2\nleftover\n";
+  expect_error(b.bytes(), "3 vertices, then 1 \"face\" but more data follows, \"leftover");
+  b.trailing_data = "3 0 1\n";
+  expect_error(b.bytes(), "ASCII data ends inside element \"face\"");
+}
+
+TEST(PlyMalformed, BinaryBytesAfterATrailingElement) {
+  PlyBuilder b = PlyBuilder::inria(0, 10);
+  b.trailing_elements = "element face 1\nproperty list uchar int vertex_indices\n";
+  b.trailing_data = std::string("\x01") + std::string(4, '\0') + "junk";
+  expect_error(b.bytes(), "then 1 \"face\" (685 bytes of data) but the file has 689 bytes after the header, "
+                          "\"junk\" following: the element counts do not match the file size");
+}
+
+TEST(PlyMalformed, BinaryTrailingElementRunsPastTheEnd) {
+  PlyBuilder b = PlyBuilder::inria(0, 10);
+  b.trailing_elements = "element face 3\nproperty list uchar int vertex_indices\n";
+  b.trailing_data = std::string("\x01") + std::string(4, '\0') + "\x01" + std::string(4, '\0');
+  expect_error(b.bytes(), "element \"face\" (3 records) runs past the end of the file");
+}
+
+TEST(PlyMalformed, TwoVertexElements) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  b.trailing_elements = "element vertex 1\nproperty float x\n";
+  b.trailing_data = std::string(4, '\0');
+  expect_error(b.bytes(), "two vertex elements");
+}
+
+TEST(PlyMalformed, HeaderOverOneMegabyte) {
+  std::string bytes = PlyBuilder::inria(0, 2).bytes();
+  const std::string comment = "comment " + std::string(1000, 'c') + "\n";
+  std::string comments;
+  while (comments.size() < (1u << 20)) comments += comment;
+  bytes.insert(bytes.find("element"), comments);
+  expect_error(bytes, "no end_header line in the first 1 MB");
+}
+
+TEST(PlyMalformed, CrOnlyLineEndings) {
+  std::string bytes = PlyBuilder::inria(0, 2).bytes();
+  const std::size_t header_end = bytes.find("end_header\n") + 11;
+  for (std::size_t i = 0; i < header_end; ++i)
+    if (bytes[i] == '\n') bytes[i] = '\r';
+  expect_error(bytes, "lines ending in CR alone");
+}
+
+// Text from the file in a message is escaped and cut short: one readable line.
+TEST(PlyMalformed, FileTextInMessagesIsEscapedAndCut) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  b.properties[0].first = "\x1b[31mbogus" + std::string(100000, 'a');
+  PlyBuilder ascii = PlyBuilder::inria(0, 2);
+  ascii.format = "ascii";
+  std::string ascii_bytes = ascii.bytes();
+  ascii_bytes.insert(ascii_bytes.find("end_header\n") + 11, std::string(1 << 20, 'q') + "\a ");
+  for (const std::string& bytes : {b.bytes(), ascii_bytes}) {
+    try {
+      parse(bytes);
+      ADD_FAILURE() << "expected an error";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_LT(message.size(), 300u) << message.substr(0, 300);
+      for (char c : message) EXPECT_GE(static_cast<unsigned char>(c), 0x20) << message.substr(0, 300);
+      EXPECT_NE(message.find("..."), std::string::npos) << message.substr(0, 300);
+    }
+  }
+  expect_error(b.bytes(), "unknown property type \"\\x1b[31mbogusaaa");
+}
+
+TEST(PrintableFileText, EscapesControlsAndInvalidUtf8KeepsTextAndUnicode) {
+  EXPECT_EQ(printable_file_text("plain \"x\" \\"), "plain \\\"x\\\" \\\\");
+  EXPECT_EQ(printable_file_text("caf\xc3\xa9 \xe2\x82\xac"), "caf\xc3\xa9 \xe2\x82\xac");
+  EXPECT_EQ(printable_file_text(std::string("a\0\n\x1b\x7f", 5)), "a\\x00\\x0a\\x1b\\x7f");
+  EXPECT_EQ(printable_file_text("\xc2\x85 \xff \xc3"), "\\xc2\\x85 \\xff \\xc3");  // C1 control, invalid bytes
+  EXPECT_EQ(printable_file_text(std::string(100, 'z'), 10), "zzzzzzzzzz... (100 bytes)");
+}
+
 TEST(PlyMalformed, NotAPlyFile) { expect_error("hello world\n", "not a PLY file"); }
 
-TEST(PlyMalformed, EmptyFile) { expect_error("", "not a PLY file"); }
+TEST(PlyMalformed, EmptyFile) { expect_error("", "not a PLY file (it is empty)"); }
 
 TEST(PlyMalformed, HeaderWithoutEnd) { expect_error("ply\nformat binary_little_endian 1.0\nelement vertex 3\n", "end_header"); }
 
@@ -238,6 +364,11 @@ TEST(PlyMalformed, CommandLineExitsNonZeroWithTheMessage) {
   for (auto& v : no_opacity.vertices) v.erase(v.begin() + opacity);
   PlyBuilder all_nan = PlyBuilder::inria(0, 2);
   for (auto& v : all_nan.vertices) v[0] = NAN;
+  PlyBuilder ascii_too_many = PlyBuilder::inria(0, 10), trailing_bytes = ascii_too_many;
+  ascii_too_many.format = "ascii";
+  ascii_too_many.declared_count = 9;
+  trailing_bytes.trailing_elements = "element face 1\nproperty uchar flag\n";
+  trailing_bytes.trailing_data = "\x01junk";
   const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
       {"truncated", good.substr(0, good.size() - 3), "truncated"},
       {"count_mismatch", too_many.bytes(), "does not match the file size"},
@@ -245,6 +376,8 @@ TEST(PlyMalformed, CommandLineExitsNonZeroWithTheMessage) {
       {"missing_property", no_opacity.bytes(), "no property \"opacity\""},
       {"uchar_property", uchar.bytes(), "opacity has type uchar"},
       {"all_nan", all_nan.bytes(), "NaN or Inf"},
+      {"ascii_count_mismatch", ascii_too_many.bytes(), "declares 9 vertices but more data follows"},
+      {"trailing_bytes", trailing_bytes.bytes(), "the element counts do not match the file size"},
       {"not_ply", "GIF89a....", "not a PLY file"}};
   for (const auto& [name, bytes, fragment] : cases) {
     const std::string ply = dir + "/" + name + ".ply";

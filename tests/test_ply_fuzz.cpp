@@ -1,8 +1,9 @@
 // Randomised mutation fuzzing of the PLY parser, built with AddressSanitizer and UBSan:
-// every mutated file must either load or throw flashgs::Error, never crash or read out of
-// bounds.
+// every mutated file must either load to finite values or throw flashgs::Error, never crash
+// or read out of bounds.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <random>
 
@@ -19,7 +20,15 @@ Outcome try_parse(const std::string& bytes) {
   // An exact-size heap copy, so ASan sees any read past the end.
   std::vector<char> copy(bytes.begin(), bytes.end());
   try {
-    parse_ply(copy.data(), copy.size(), "fuzz.ply");
+    const Scene scene = parse_ply(copy.data(), copy.size(), "fuzz.ply");
+    // What loads is what a renderer can use: every stored value a finite float.
+    for (const std::vector<float>* values :
+         {&scene.positions, &scene.scales, &scene.rotations, &scene.opacities, &scene.sh_dc, &scene.sh_rest})
+      for (float v : *values)
+        if (!std::isfinite(v)) {
+          ADD_FAILURE() << "a loaded file holds a non-finite value";
+          return Outcome::loaded;
+        }
     return Outcome::loaded;
   } catch (const Error&) {
     return Outcome::rejected;
@@ -67,6 +76,18 @@ TEST(PlyFuzz, MutatedFilesLoadOrFailCleanly) {
     b.format = "binary_big_endian";
     seeds.push_back(b.bytes());
   }
+  // Doubles, and other elements around the vertices (walked over by their declared size).
+  test::PlyBuilder extra = test::PlyBuilder::inria(1, 7);
+  for (auto& property : extra.properties) property.first = "double";
+  extra.leading_elements = "element camera 1\nproperty float focal\n";
+  extra.leading_data = std::string(4, '\x01');
+  extra.trailing_elements = "element face 2\nproperty list uchar int vertex_indices\n";
+  extra.trailing_data = std::string("\x01") + std::string(4, '\0') + "\x02" + std::string(8, '\0');
+  seeds.push_back(extra.bytes());
+  extra.format = "ascii";
+  extra.leading_data = "1.5\n";
+  extra.trailing_data = "1 0\n2 3 4\n";
+  seeds.push_back(extra.bytes());
   int loaded = 0, rejected = 0;
   for (int i = 0; i < 30000; ++i) {
     const std::string input = mutate(seeds[i % seeds.size()], rng);

@@ -2,7 +2,6 @@
 #include "scene_source.h"
 
 #include <cstdio>
-#include <filesystem>
 
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
@@ -18,15 +17,24 @@ std::string demo_scene_path() {
 }
 
 void SceneArgs::add_to(CLI::App* command) {
-  command->add_option("scene", scene_path, "3DGS PLY file (default: the bundled demo scene)");
-  command->add_option("--cameras", cameras_path, "cameras.json (default: the one beside the PLY)");
+  m_scene_option = command->add_option("scene", scene_path,
+                                       "3DGS PLY file, a folder holding point_cloud.ply, or a 3DGS training output "
+                                       "folder (default: the bundled demo scene)");
+  m_cameras_option = command->add_option("--cameras", cameras_path, "cameras.json (default: the scene's own)");
 }
 
-std::string SceneArgs::resolved_scene() const { return scene_path.empty() ? demo_scene_path() : scene_path; }
-
-std::string SceneArgs::resolved_cameras() const {
-  if (!cameras_path.empty()) return cameras_path;
-  return (std::filesystem::path(resolved_scene()).parent_path() / "cameras.json").string();
+SceneLocation SceneArgs::locate() const {
+  // Only a scene left out means the demo: an empty one is a mistake (an unset shell variable).
+  const bool scene_given = m_scene_option && m_scene_option->count() > 0;
+  if (scene_given && scene_path.empty())
+    throw Error("the scene path is empty: name a PLY file or a scene folder, or leave it out for the demo scene");
+  SceneLocation location = scene_given ? locate_scene(scene_path)
+                                       : SceneLocation{demo_scene_path(), default_cameras_path(demo_scene_path())};
+  if (m_cameras_option && m_cameras_option->count() > 0) {
+    if (cameras_path.empty()) throw Error("--cameras: the path is empty");
+    location.cameras = cameras_path;
+  }
+  return location;
 }
 
 std::shared_ptr<const Scene> load_scene_verbose(const std::string& path) {

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "flashgs/camera.h"
+#include "flashgs/io.h"
 #include "flashgs/options.h"
 #include "flashgs/scene.h"
 
@@ -17,11 +18,18 @@ namespace flashgs::cli {
 std::string demo_scene_path();
 
 struct SceneArgs {
-  std::string scene_path;    // empty: the demo scene
-  std::string cameras_path;  // empty: cameras.json beside the PLY
+  std::string scene_path;    // a PLY or a scene folder; not given: the demo scene
+  std::string cameras_path;  // not given: the scene's own cameras.json
   void add_to(CLI::App* command);
-  std::string resolved_scene() const;
-  std::string resolved_cameras() const;
+  // The PLY and cameras.json to use (see locate_scene); throws flashgs::Error for a path given
+  // empty, or one that names no usable scene.
+  SceneLocation locate() const;
+  std::string resolved_scene() const { return locate().ply; }
+  std::string resolved_cameras() const { return locate().cameras; }
+
+ private:
+  CLI::Option* m_scene_option = nullptr;
+  CLI::Option* m_cameras_option = nullptr;
 };
 
 // Loads the scene, printing what the loader dropped to stderr.

@@ -1,11 +1,13 @@
 // cameras.json in the 3DGS training-output format: read with validation, and written back.
 #include <cmath>
+#include <cstdio>
 #include <fstream>
-#include <sstream>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
 #include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "flashgs/io.h"
 
 namespace flashgs {
@@ -13,12 +15,28 @@ namespace {
 
 using nlohmann::json;
 
+// Real camera files hold a few hundred cameras in a few hundred KB.
+constexpr std::size_t kMaxCameraFileBytes = 64000000;
+// Longest img_name kept; longer names are cut (they are only shown).
+constexpr std::size_t kMaxCameraNameBytes = 200;
+// Focal lengths in pixels outside this range are not a camera (a zero or denormal one divides by zero).
+constexpr double kMinFocal = 1e-3, kMaxFocal = 1e9;
+
+// A float holds the value: a double of 1e300 is finite, its float is not.
+bool fits_float(double v) { return std::abs(v) <= static_cast<double>(std::numeric_limits<float>::max()); }
+
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
 double number_field(const json& entry, const char* field, const std::string& where) {
   if (!entry.contains(field)) throw Error(where + ": missing field \"" + field + "\"");
   const json& v = entry.at(field);
   if (!v.is_number()) throw Error(where + ": field \"" + field + "\" is not a number");
   const double d = v.get<double>();
-  if (!std::isfinite(d)) throw Error(where + ": field \"" + field + "\" is not finite");
+  if (!fits_float(d)) throw Error(where + ": field \"" + field + "\" is not a finite float (" + number_text(d) + ")");
   return d;
 }
 
@@ -31,18 +49,22 @@ void read_vector(const json& entry, const char* field, int n, double* out, const
     // JSON has no NaN/Inf literals; nlohmann writes them as null, so null means non-finite.
     if (!v[i].is_number()) throw Error(where + ": \"" + field + "\"[" + std::to_string(i) + "] is not a finite number");
     out[i] = v[i].get<double>();
-    if (!std::isfinite(out[i])) throw Error(where + ": \"" + field + "\" is not finite");
+    if (!fits_float(out[i]))
+      throw Error(where + ": \"" + field + "\"[" + std::to_string(i) + "] is not a finite float (" +
+                  number_text(out[i]) + ")");
   }
 }
 
 }  // namespace
 
 std::vector<Camera> parse_cameras(const std::string& json_text, const std::string& name) {
+  if (json_text.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw Error(name + ": the file is empty (expected a JSON array of cameras)");
   json doc;
   try {
     doc = json::parse(json_text);
   } catch (const json::exception& e) {  // parse errors, and numbers beyond double range
-    throw Error(name + ": not valid JSON (" + e.what() + ")");
+    throw Error(name + ": not valid JSON (" + printable_file_text(e.what(), 200) + ")");
   }
   if (!doc.is_array()) throw Error(name + ": expected a JSON array of cameras");
   if (doc.empty()) throw Error(name + ": the camera list is empty");
@@ -59,6 +81,9 @@ std::vector<Camera> parse_cameras(const std::string& json_text, const std::strin
     const double fx = number_field(entry, "fx", where);
     const double fy = number_field(entry, "fy", where);
     if (!(fx > 0) || !(fy > 0)) throw Error(where + ": fx and fy must be positive");
+    if (fx < kMinFocal || fy < kMinFocal || fx > kMaxFocal || fy > kMaxFocal)
+      throw Error(where + ": fx and fy must be between " + number_text(kMinFocal) + " and " + number_text(kMaxFocal) +
+                  " pixels (fx = " + number_text(fx) + ", fy = " + number_text(fy) + ")");
     double position[3];
     read_vector(entry, "position", 3, position, where);
     if (!entry.contains("rotation") || !entry.at("rotation").is_array() || entry.at("rotation").size() != 3)
@@ -92,8 +117,9 @@ std::vector<Camera> parse_cameras(const std::string& json_text, const std::strin
     for (int k = 0; k < 3; ++k) c[k] = static_cast<float>(position[k]);
     Camera camera = Camera::from_pose(static_cast<int>(width), static_cast<int>(height),
                                       static_cast<float>(fx), static_cast<float>(fy), r, c);
+    // The name is only shown, in messages and the viewer: kept printable and short.
     camera.name = entry.contains("img_name") && entry["img_name"].is_string()
-                      ? entry["img_name"].get<std::string>()
+                      ? printable_file_text(entry["img_name"].get<std::string>(), kMaxCameraNameBytes)
                       : "camera " + std::to_string(i);
     cameras.push_back(camera);
   }
@@ -101,11 +127,8 @@ std::vector<Camera> parse_cameras(const std::string& json_text, const std::strin
 }
 
 std::vector<Camera> load_cameras(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw Error(path + ": cannot open the camera file (missing or not readable)");
-  std::stringstream text;
-  text << file.rdbuf();
-  return parse_cameras(text.str(), path);
+  const std::vector<char> bytes = read_regular_file(path, kMaxCameraFileBytes);
+  return parse_cameras(std::string(bytes.begin(), bytes.end()), path);
 }
 
 void save_cameras(const std::vector<Camera>& cameras, const std::string& path) {

@@ -10,9 +10,11 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "flashgs/io.h"
 
 namespace flashgs {
@@ -22,21 +24,27 @@ enum class Format { binary_little_endian, binary_big_endian, ascii };
 
 struct Property {
   std::string name;
-  std::string type;  // canonical: char uchar short ushort int uint float double
-  int size = 0;      // bytes in binary formats
+  std::string type;  // canonical: char uchar short ushort int uint float double, or "list"
+  int size = 0;      // bytes in binary formats (of one item, for a list)
   int kind = 0;      // index into kTypeNames, so the per-value read does no string compares
-  std::size_t offset = 0;  // byte offset inside one binary record
+  int count_size = 0, count_kind = 0;  // a list's item count: its bytes and type
+  std::size_t offset = 0;  // byte offset inside one binary record (elements without lists)
+  bool is_list() const { return count_size != 0; }
 };
 
 struct Element {
   std::string name;
   std::size_t count = 0;
   std::vector<Property> properties;
-  std::size_t record_size = 0;
+  std::size_t record_size = 0;  // bytes of the properties that are not lists
+  bool has_list() const {
+    return std::any_of(properties.begin(), properties.end(), [](const Property& p) { return p.is_list(); });
+  }
 };
 
 // Largest header we accept; real headers are about 2 KB.
 constexpr std::size_t kMaxHeaderBytes = 1 << 20;
+constexpr const char* kCrOnlyLines = "the header has lines ending in CR alone; PLY header lines end in LF or CR LF";
 
 const char* const kTypeNames[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double"};
 
@@ -67,6 +75,9 @@ std::string canonical_type(const std::string& type) {
   throw Error(name + ": " + problem);
 }
 
+// File text inside a message: quoted, escaped and cut short.
+std::string quoted(std::string_view text) { return "\"" + printable_file_text(text) + "\""; }
+
 struct Header {
   Format format = Format::binary_little_endian;
   std::vector<Element> elements;
@@ -75,8 +86,11 @@ struct Header {
 
 Header parse_header(const char* data, std::size_t size, const std::string& name) {
   Header header;
+  if (size == 0) fail(name, "not a PLY file (it is empty)");
   if (size < 4 || std::memcmp(data, "ply", 3) != 0 || (data[3] != '\n' && data[3] != '\r'))
     fail(name, "not a PLY file (it does not start with \"ply\")");
+  if (data[3] == '\r' && (size < 5 || data[4] != '\n'))
+    fail(name, kCrOnlyLines);
   const std::size_t limit = std::min(size, kMaxHeaderBytes);
   std::size_t pos = 0;
   bool saw_format = false, saw_end = false;
@@ -87,6 +101,8 @@ Header parse_header(const char* data, std::size_t size, const std::string& name)
     if (eol == limit) break;
     std::string line(data + pos, eol - pos);
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find('\r') != std::string::npos)
+      fail(name, kCrOnlyLines);
     pos = eol + 1;
     ++line_number;
     std::istringstream words(line);
@@ -99,7 +115,7 @@ Header parse_header(const char* data, std::size_t size, const std::string& name)
       if (format == "binary_little_endian") header.format = Format::binary_little_endian;
       else if (format == "binary_big_endian") header.format = Format::binary_big_endian;
       else if (format == "ascii") header.format = Format::ascii;
-      else fail(name, "unknown PLY format \"" + format + "\"");
+      else fail(name, "unknown PLY format " + quoted(format));
       saw_format = true;
     } else if (keyword == "comment" || keyword == "obj_info" || keyword.empty()) {
       continue;
@@ -110,8 +126,7 @@ Header parse_header(const char* data, std::size_t size, const std::string& name)
       if (element.name.empty() || count_text.empty() ||
           count_text.find_first_not_of("0123456789") != std::string::npos ||
           count_text.size() > 19)
-        fail(name, "header line " + std::to_string(line_number) + ": bad element line \"" + line +
-                       "\"");
+        fail(name, "header line " + std::to_string(line_number) + ": bad element line " + quoted(line));
       element.count = std::stoull(count_text);
       header.elements.push_back(element);
     } else if (keyword == "property") {
@@ -123,30 +138,41 @@ Header parse_header(const char* data, std::size_t size, const std::string& name)
       if (type == "list") {
         std::string count_type, item_type;
         words >> count_type >> item_type >> prop_name;
+        count_type = canonical_type(count_type);
+        item_type = canonical_type(item_type);
         property.type = "list";
+        property.count_size = type_size(count_type);
+        property.count_kind = type_kind(count_type);
+        property.size = type_size(item_type);
+        property.kind = type_kind(item_type);
+        if (property.count_size == 0 || property.count_kind > 5 || property.size == 0)
+          fail(name, "header line " + std::to_string(line_number) + ": bad list property " + quoted(line) +
+                         " (the count needs an integer type, the items a known type)");
       } else {
         words >> prop_name;
         property.type = canonical_type(type);
         property.size = type_size(property.type);
         property.kind = type_kind(property.type);
         if (property.size == 0)
-          fail(name, "header line " + std::to_string(line_number) + ": unknown property type \"" +
-                         type + "\"");
+          fail(name, "header line " + std::to_string(line_number) + ": unknown property type " + quoted(type));
       }
       if (prop_name.empty())
         fail(name, "header line " + std::to_string(line_number) + ": property without a name");
       property.name = prop_name;
       Element& element = header.elements.back();
       property.offset = element.record_size;
-      element.record_size += static_cast<std::size_t>(property.size);
+      if (!property.is_list()) element.record_size += static_cast<std::size_t>(property.size);
       element.properties.push_back(property);
     } else if (keyword == "end_header") {
       saw_end = true;
       break;
     } else {
-      fail(name, "header line " + std::to_string(line_number) + ": unexpected \"" + keyword + "\"");
+      fail(name, "header line " + std::to_string(line_number) + ": unexpected " + quoted(keyword));
     }
   }
+  if (!saw_end && limit < size)
+    fail(name, "no end_header line in the first " + std::to_string(kMaxHeaderBytes >> 20) +
+                   " MB (real PLY headers are a few KB)");
   if (!saw_end) fail(name, "the header has no end_header line (truncated or not a PLY file)");
   if (!saw_format) fail(name, "the header has no format line");
   header.data_offset = pos;
@@ -183,11 +209,11 @@ Layout find_layout(const Element& vertex, const std::string& name, LoadReport* r
     else if (p.name.compare(0, 7, "f_rest_") == 0 && p.name.size() > 7 && p.name.size() < 11 &&
              p.name.find_first_not_of("0123456789", 7) == std::string::npos) {
       const int k = std::stoi(p.name.substr(7));
-      if (rest_by_index.count(k)) fail(name, "property " + p.name + " appears twice");
+      if (rest_by_index.count(k)) fail(name, "property " + quoted(p.name) + " appears twice");
       rest_by_index[k] = index;
     }
     if (slot) {
-      if (*slot != -1) fail(name, "property " + p.name + " appears twice");
+      if (*slot != -1) fail(name, "property " + quoted(p.name) + " appears twice");
       *slot = index;
     } else if (p.name.compare(0, 7, "f_rest_") != 0 && report) {
       report->ignored_properties++;
@@ -231,12 +257,12 @@ bool host_is_little_endian() {
   return first == 1;
 }
 
-// Reads one binary value as double, swapping bytes when the file's order differs.
-double read_binary(const unsigned char* at, const Property& property, bool swap) {
+// Reads one binary value of type `kind` (`size` bytes) as double, swapping bytes when the
+// file's order differs. Forced inline: in the per-value loop it is most of the load time.
+__attribute__((always_inline)) inline double read_binary(const unsigned char* at, int kind, int size, bool swap) {
   unsigned char bytes[8];
-  const int n = property.size;
-  for (int i = 0; i < n; ++i) bytes[i] = swap ? at[n - 1 - i] : at[i];
-  switch (property.kind) {
+  for (int i = 0; i < size; ++i) bytes[i] = swap ? at[size - 1 - i] : at[i];
+  switch (kind) {
     case 0: { std::int8_t v; std::memcpy(&v, bytes, 1); return v; }
     case 1: { std::uint8_t v; std::memcpy(&v, bytes, 1); return v; }
     case 2: { std::int16_t v; std::memcpy(&v, bytes, 2); return v; }
@@ -248,12 +274,99 @@ double read_binary(const unsigned char* at, const Property& property, bool swap)
   }
 }
 
+// "10 vertices", or "10 vertices, then 4 \"face\"" when other elements follow.
+std::string declared_counts(const Header& header) {
+  std::string text;
+  for (const Element& e : header.elements) {
+    if (!text.empty()) text += ", then ";
+    text += e.name == "vertex" ? std::to_string(e.count) + " vertices" : std::to_string(e.count) + " " + quoted(e.name);
+  }
+  return text;
+}
+
+// Bytes an element takes in binary data starting at `at` (`available` bytes there), walking
+// the item counts of list properties; throws when the element runs past the end of the file.
+std::size_t binary_element_size(const Element& e, const unsigned char* at, std::size_t available, bool swap,
+                                const std::string& name) {
+  const std::string too_large = "element " + quoted(e.name) + " (" + std::to_string(e.count) +
+                                " records) runs past the end of the file: truncated file or wrong count";
+  std::size_t min_record = e.record_size;
+  for (const Property& p : e.properties) min_record += static_cast<std::size_t>(p.count_size);
+  if (min_record == 0) return 0;
+  if (e.count > available / min_record) fail(name, too_large);
+  if (!e.has_list()) return e.count * e.record_size;
+  std::size_t pos = 0;
+  for (std::size_t r = 0; r < e.count; ++r)
+    for (const Property& p : e.properties) {
+      if (!p.is_list()) {
+        if (static_cast<std::size_t>(p.size) > available - pos) fail(name, too_large);
+        pos += static_cast<std::size_t>(p.size);
+        continue;
+      }
+      if (static_cast<std::size_t>(p.count_size) > available - pos) fail(name, too_large);
+      const double items = read_binary(at + pos, p.count_kind, p.count_size, swap);
+      pos += static_cast<std::size_t>(p.count_size);
+      if (items < 0) fail(name, "element " + quoted(e.name) + ", record " + std::to_string(r) + ": list " +
+                                    quoted(p.name) + " has a negative length");
+      if (items > static_cast<double>((available - pos) / static_cast<std::size_t>(p.size))) fail(name, too_large);
+      pos += static_cast<std::size_t>(items) * static_cast<std::size_t>(p.size);
+    }
+  return pos;
+}
+
+// Whitespace-separated tokens of ASCII PLY data.
+class AsciiTokens {
+ public:
+  AsciiTokens(const char* begin, const char* end) : cursor_(begin), begin_(begin), end_(end) {}
+  // The next token; empty at the end of the data.
+  std::string_view next() {
+    skip_space();
+    const char* start = cursor_;
+    while (cursor_ < end_ && !is_space(*cursor_)) ++cursor_;
+    return std::string_view(start, static_cast<std::size_t>(cursor_ - start));
+  }
+  // What is left after the whitespace at the cursor (empty when only whitespace is left).
+  std::string_view rest() {
+    skip_space();
+    return std::string_view(cursor_, static_cast<std::size_t>(end_ - cursor_));
+  }
+  std::size_t offset() const { return static_cast<std::size_t>(cursor_ - begin_); }
+
+ private:
+  static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+  void skip_space() {
+    while (cursor_ < end_ && is_space(*cursor_)) ++cursor_;
+  }
+  const char* cursor_;
+  const char* begin_;
+  const char* end_;
+};
+
+// Moves the tokens past every record of an element that is not read (lists included).
+void skip_ascii_element(const Element& e, AsciiTokens& tokens, const std::string& name) {
+  if (e.properties.empty()) return;
+  const std::string truncated = "ASCII data ends inside element " + quoted(e.name) + " (truncated file)";
+  for (std::size_t r = 0; r < e.count; ++r)
+    for (const Property& p : e.properties) {
+      const std::string_view token = tokens.next();
+      if (token.empty()) fail(name, truncated);
+      if (!p.is_list()) continue;
+      if (token.find_first_not_of("0123456789") != std::string_view::npos || token.size() > 19)
+        fail(name, "element " + quoted(e.name) + ", record " + std::to_string(r) + ": list length " + quoted(token) +
+                       " is not a whole number");
+      for (std::size_t items = std::stoull(std::string(token)); items > 0; --items)
+        if (tokens.next().empty()) fail(name, truncated);
+    }
+}
+
 // Per Gaussian raw attribute values in file order, for one vertex record.
 class RecordSource {
  public:
   virtual ~RecordSource() = default;
   // Fills `values` (one per vertex property) for record i; records are read in order.
   virtual void read(std::size_t i, std::vector<double>& values) = 0;
+  // After the last vertex: checks that what follows is what the header declared.
+  virtual void finish() {}
 };
 
 class BinarySource : public RecordSource {
@@ -262,8 +375,10 @@ class BinarySource : public RecordSource {
       : records_(records), vertex_(vertex), swap_(swap) {}
   void read(std::size_t i, std::vector<double>& values) override {
     const unsigned char* record = records_ + i * vertex_.record_size;
-    for (std::size_t p = 0; p < vertex_.properties.size(); ++p)
-      values[p] = read_binary(record + vertex_.properties[p].offset, vertex_.properties[p], swap_);
+    for (std::size_t p = 0; p < vertex_.properties.size(); ++p) {
+      const Property& property = vertex_.properties[p];
+      values[p] = read_binary(record + property.offset, property.kind, property.size, swap_);
+    }
   }
 
  private:
@@ -274,30 +389,69 @@ class BinarySource : public RecordSource {
 
 class AsciiSource : public RecordSource {
  public:
-  AsciiSource(const char* begin, const char* end, const std::string& name)
-      : cursor_(begin), end_(end), name_(name) {}
+  // `tokens` is at the first vertex; the elements after the vertex element are skipped by finish().
+  AsciiSource(AsciiTokens tokens, const Header& header, std::size_t vertex_index, const std::string& name)
+      : tokens_(tokens), header_(header), vertex_index_(vertex_index), name_(name) {}
   void read(std::size_t i, std::vector<double>& values) override {
     for (double& v : values) {
-      while (cursor_ < end_ && (*cursor_ == ' ' || *cursor_ == '\t' || *cursor_ == '\n' || *cursor_ == '\r'))
-        ++cursor_;
-      const char* start = cursor_;
-      while (cursor_ < end_ && !(*cursor_ == ' ' || *cursor_ == '\t' || *cursor_ == '\n' || *cursor_ == '\r'))
-        ++cursor_;
-      if (start == cursor_)
+      const std::string_view token_view = tokens_.next();
+      if (token_view.empty())
         fail(name_, "ASCII data ends in vertex " + std::to_string(i) + " (truncated file)");
-      const std::string token(start, cursor_);
+      const std::string token(token_view);
       char* parsed_end = nullptr;
       v = std::strtod(token.c_str(), &parsed_end);
       if (parsed_end != token.c_str() + token.size())
-        fail(name_, "vertex " + std::to_string(i) + ": \"" + token + "\" is not a number");
+        fail(name_, "vertex " + std::to_string(i) + ": " + quoted(token) + " is not a number");
     }
+  }
+  void finish() override {
+    for (std::size_t e = vertex_index_ + 1; e < header_.elements.size(); ++e)
+      skip_ascii_element(header_.elements[e], tokens_, name_);
+    const std::size_t at = tokens_.offset();
+    const std::string_view rest = tokens_.rest();
+    if (!rest.empty())
+      fail(name_, "the header declares " + declared_counts(header_) + " but more data follows, " +
+                      quoted(rest.substr(0, 40)) + " at byte " + std::to_string(header_.data_offset + at) +
+                      " after the header: a wrong count, or extra data");
   }
 
  private:
-  const char* cursor_;
-  const char* end_;
+  AsciiTokens tokens_;
+  const Header& header_;
+  std::size_t vertex_index_;
   std::string name_;
 };
+
+// Binary data: the vertex records located, and the total size of all elements checked
+// against the file before anything is read.
+std::unique_ptr<RecordSource> binary_source(const Header& header, std::size_t vertex_index, const char* data,
+                                            std::size_t size, const std::string& name) {
+  const Element& vertex = header.elements[vertex_index];
+  const bool swap = (header.format == Format::binary_little_endian) != host_is_little_endian();
+  const auto* start = reinterpret_cast<const unsigned char*>(data + header.data_offset);
+  const std::size_t available = size - header.data_offset;
+  std::size_t offset = 0;  // bytes of the elements before the vertex element
+  for (std::size_t i = 0; i < vertex_index; ++i)
+    offset += binary_element_size(header.elements[i], start + offset, available - offset, swap, name);
+  if (vertex.count > (available - offset) / vertex.record_size)
+    fail(name, "the header declares " + std::to_string(vertex.count) + " vertices of " +
+                   std::to_string(vertex.record_size) + " bytes (" +
+                   std::to_string(static_cast<double>(vertex.count) * vertex.record_size / 1e6) +
+                   " MB) but the file holds only " + std::to_string(available - offset) +
+                   " bytes after the header: truncated file or wrong vertex count");
+  std::size_t expected = offset + vertex.count * vertex.record_size;
+  for (std::size_t i = vertex_index + 1; i < header.elements.size(); ++i)
+    expected += binary_element_size(header.elements[i], start + expected, available - expected, swap, name);
+  if (expected != available) {
+    const bool vertex_only = header.elements.size() == 1;
+    fail(name, "the header declares " + declared_counts(header) + " (" + std::to_string(expected) +
+                   " bytes of data) but the file has " + std::to_string(available) + " bytes after the header, " +
+                   quoted(std::string_view(data + header.data_offset + expected, std::min<std::size_t>(available - expected, 16))) +
+                   " following: " + (vertex_only ? "the vertex count does not match the file size"
+                                                 : "the element counts do not match the file size"));
+  }
+  return std::make_unique<BinarySource>(start + offset, vertex, swap);
+}
 
 float sigmoid(double logit) { return static_cast<float>(1.0 / (1.0 + std::exp(-logit))); }
 
@@ -312,49 +466,29 @@ Scene parse_ply(const char* data, std::size_t size, const std::string& name, Loa
   const Header header = parse_header(data, size, name);
   std::size_t vertex_index = header.elements.size();
   for (std::size_t i = 0; i < header.elements.size(); ++i)
-    if (header.elements[i].name == "vertex") vertex_index = i;
+    if (header.elements[i].name == "vertex") {
+      if (vertex_index != header.elements.size()) fail(name, "the header declares two vertex elements");
+      vertex_index = i;
+    }
   if (vertex_index == header.elements.size()) fail(name, "the header declares no vertex element");
   const Element& vertex = header.elements[vertex_index];
   for (const Property& p : vertex.properties)
-    if (p.type == "list") fail(name, "the vertex element has a list property (" + p.name + ")");
+    if (p.is_list()) fail(name, "the vertex element has a list property (" + quoted(p.name) + ")");
   const Layout layout = find_layout(vertex, name, report);
   if (vertex.count == 0) fail(name, "the header declares 0 vertices: there are no Gaussians");
 
-  const std::size_t available = size - header.data_offset;
   std::unique_ptr<RecordSource> source;
   if (header.format == Format::ascii) {
-    if (vertex_index != 0) fail(name, "ASCII files with elements before the vertex element are not supported");
+    const std::size_t available = size - header.data_offset;
     // Each ASCII value takes at least two bytes (a digit and a separator).
     if (vertex.count > available / (2 * vertex.properties.size()))
       fail(name, "the header declares " + std::to_string(vertex.count) + " vertices but the file has only " +
                      std::to_string(available) + " bytes of ASCII data");
-    source = std::make_unique<AsciiSource>(data + header.data_offset, data + size, name);
+    AsciiTokens tokens(data + header.data_offset, data + size);
+    for (std::size_t i = 0; i < vertex_index; ++i) skip_ascii_element(header.elements[i], tokens, name);
+    source = std::make_unique<AsciiSource>(tokens, header, vertex_index, name);
   } else {
-    std::size_t offset = 0;  // bytes of elements before the vertex element
-    for (std::size_t i = 0; i < vertex_index; ++i) {
-      const Element& e = header.elements[i];
-      for (const Property& p : e.properties)
-        if (p.type == "list")
-          fail(name, "element \"" + e.name + "\" before the vertices has a list property; cannot locate the vertex data");
-      if (e.record_size && e.count > available / e.record_size) fail(name, "element \"" + e.name + "\" is larger than the file");
-      offset += e.count * e.record_size;
-    }
-    if (vertex.count > (available - std::min(offset, available)) / vertex.record_size)
-      fail(name, "the header declares " + std::to_string(vertex.count) + " vertices of " +
-                     std::to_string(vertex.record_size) + " bytes (" +
-                     std::to_string(static_cast<double>(vertex.count) * vertex.record_size / 1e6) +
-                     " MB) but the file holds only " + std::to_string(available - std::min(offset, available)) +
-                     " bytes after the header: truncated file or wrong vertex count");
-    const bool trailing_elements = vertex_index + 1 < header.elements.size();
-    const std::size_t expected = offset + vertex.count * vertex.record_size;
-    if (!trailing_elements && expected != available)
-      fail(name, "the header declares " + std::to_string(vertex.count) + " vertices (" + std::to_string(expected) +
-                     " bytes of data) but the file has " + std::to_string(available) +
-                     " bytes after the header: the vertex count does not match the file size");
-    const bool file_little = header.format == Format::binary_little_endian;
-    source = std::make_unique<BinarySource>(
-        reinterpret_cast<const unsigned char*>(data + header.data_offset + offset), vertex,
-        file_little != host_is_little_endian());
+    source = binary_source(header, vertex_index, data, size, name);
   }
 
   Scene scene;
@@ -366,28 +500,27 @@ Scene parse_ply(const char* data, std::size_t size, const std::string& name, Loa
   const int per_channel = rest_n / 3;
   std::vector<double> values(vertex.properties.size());
   std::vector<float> rest(static_cast<std::size_t>(rest_n));
+  const int xyz[3] = {layout.x, layout.y, layout.z};
   for (std::size_t i = 0; i < vertex.count; ++i) {
     source->read(i, values);
-    const double pos[3] = {values[layout.x], values[layout.y], values[layout.z]};
-    double scale[3], quat[4], dc[3];
-    for (int k = 0; k < 3; ++k) scale[k] = std::exp(values[layout.scale[k]]);
+    // Every value is checked as the float it is stored as: a double of 1e300 is finite, its float is not.
+    float pos[3], scale[3], dc[3];
+    for (int k = 0; k < 3; ++k) pos[k] = static_cast<float>(values[xyz[k]]);
+    for (int k = 0; k < 3; ++k) scale[k] = static_cast<float>(std::exp(values[layout.scale[k]]));
+    for (int k = 0; k < 3; ++k) dc[k] = static_cast<float>(values[layout.dc[k]]);
+    double quat[4];
     for (int k = 0; k < 4; ++k) quat[k] = values[layout.rot[k]];
-    for (int k = 0; k < 3; ++k) dc[k] = values[layout.dc[k]];
     const double opacity_logit = values[layout.opacity];
-    // INRIA stores f_rest channel-major (all R, then G, then B); we keep [k][channel].
     bool finite = std::isfinite(opacity_logit);
+    // INRIA stores f_rest channel-major (all R, then G, then B); we keep [k][channel].
     for (int k = 0; k < per_channel; ++k)
       for (int ch = 0; ch < 3; ++ch) {
-        const double v = values[layout.rest[ch * per_channel + k]];
-        finite = finite && std::isfinite(v);
-        rest[k * 3 + ch] = static_cast<float>(v);
+        rest[k * 3 + ch] = static_cast<float>(values[layout.rest[ch * per_channel + k]]);
+        finite &= std::isfinite(rest[k * 3 + ch]);
       }
-    for (int k = 0; k < 3; ++k)
-      finite = finite && std::isfinite(pos[k]) && std::isfinite(dc[k]) &&
-               std::isfinite(static_cast<float>(scale[k])) && std::abs(pos[k]) < 3.0e38 &&
-               std::abs(dc[k]) < 3.0e38;
-    for (int k = 0; k < 4; ++k) finite = finite && std::isfinite(quat[k]);
-    if (!finite) {  // NaN/Inf in the file, or a log-scale whose exp overflows float
+    for (int k = 0; k < 3; ++k) finite &= std::isfinite(pos[k]) & std::isfinite(scale[k]) & std::isfinite(dc[k]);
+    for (int k = 0; k < 4; ++k) finite &= std::isfinite(quat[k]);
+    if (!finite) {  // NaN/Inf in the file, a double beyond float range, or a log-scale whose exp overflows
       report->dropped_non_finite++;
       continue;
     }
@@ -398,28 +531,21 @@ Scene parse_ply(const char* data, std::size_t size, const std::string& name, Loa
       quat[0] = 1; quat[1] = quat[2] = quat[3] = 0;
       norm = 1;
     }
-    for (int k = 0; k < 3; ++k) {
-      scene.positions.push_back(static_cast<float>(pos[k]));
-      scene.scales.push_back(static_cast<float>(scale[k]));
-      scene.sh_dc.push_back(static_cast<float>(dc[k]));
-    }
+    scene.positions.insert(scene.positions.end(), pos, pos + 3);
+    scene.scales.insert(scene.scales.end(), scale, scale + 3);
+    scene.sh_dc.insert(scene.sh_dc.end(), dc, dc + 3);
     for (int k = 0; k < 4; ++k) scene.rotations.push_back(static_cast<float>(quat[k] / norm));
     scene.opacities.push_back(sigmoid(opacity_logit));
     scene.sh_rest.insert(scene.sh_rest.end(), rest.begin(), rest.end());
   }
+  source->finish();
   if (scene.size() == 0)
     fail(name, "all " + std::to_string(vertex.count) + " Gaussians have NaN or Inf attributes");
   return scene;
 }
 
 Scene load_ply(const std::string& path, LoadReport* report) {
-  std::ifstream file(path, std::ios::binary | std::ios::ate);
-  if (!file) fail(path, "cannot open the file (missing or not readable)");
-  const std::streamoff size = file.tellg();
-  if (size < 0) fail(path, "cannot determine the file size");
-  std::vector<char> bytes(static_cast<std::size_t>(size));
-  file.seekg(0);
-  if (size > 0 && !file.read(bytes.data(), size)) fail(path, "read error");
+  const std::vector<char> bytes = read_regular_file(path);
   return parse_ply(bytes.data(), bytes.size(), path, report);
 }
 

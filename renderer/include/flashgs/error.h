@@ -1,8 +1,10 @@
 // Error: the one exception type for bad input; its message names the file and the problem.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace flashgs {
 
@@ -10,5 +12,10 @@ class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
+
+// Text taken from a file (a header line, a token, an img_name), made safe to put in a message:
+// control bytes and invalid UTF-8 become \xNN, and text longer than `max_bytes` is cut with
+// "..." and its full length, so a message stays one short line whatever the file holds.
+std::string printable_file_text(std::string_view text, std::size_t max_bytes = 80);
 
 }  // namespace flashgs

@@ -9,6 +9,20 @@
 
 namespace flashgs {
 
+// Where a scene named by the user lives: the PLY to load and its cameras.json.
+struct SceneLocation {
+  std::string ply;
+  std::string cameras;  // may not exist
+};
+// `path` is a PLY file, a folder holding point_cloud.ply, or a 3DGS training output folder
+// (point_cloud/iteration_<N>/point_cloud.ply, the highest N). Throws flashgs::Error with one
+// line naming the path and the problem for an empty path, a missing path, a folder holding
+// no scene, or a FIFO, device or link loop where the PLY should be; no file is opened.
+SceneLocation locate_scene(const std::string& path);
+// cameras.json beside the PLY, or at the model root of a training output
+// (<model>/point_cloud/iteration_<N>/point_cloud.ply -> <model>/cameras.json).
+std::string default_cameras_path(const std::string& ply_path);
+
 // Reads a 3DGS PLY, layout taken from its header. Throws flashgs::Error naming the file and
 // the problem on anything it cannot read exactly. Gaussians with NaN/Inf attributes are
 // dropped and counted in `report`.
@@ -19,8 +33,9 @@ Scene parse_ply(const char* data, std::size_t size, const std::string& name,
 // Writes the INRIA layout (binary little endian, logit opacity, log scales).
 void save_ply(const Scene& scene, const std::string& path);
 
-// Reads cameras.json. Throws flashgs::Error on a missing file, bad JSON, a missing field, a
-// non-finite value or a rotation that is not orthonormal.
+// Reads cameras.json (at most 64 MB, a regular file). Throws flashgs::Error on a missing file,
+// bad JSON, a missing field, a value that is not a finite float, an absurd focal length or
+// size, or a rotation that is not orthonormal.
 std::vector<Camera> load_cameras(const std::string& path);
 // Parses the JSON text directly (`name` is used in messages).
 std::vector<Camera> parse_cameras(const std::string& json_text, const std::string& name);

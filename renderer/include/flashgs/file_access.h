@@ -1,0 +1,28 @@
+// Checking and reading the files a user names, so that a folder, FIFO, device, symbolic-link
+// loop or oversized file gets one clear message and nothing ever blocks.
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace flashgs {
+
+// What a path names once symbolic links are followed.
+enum class PathKind { regular_file, folder, other };
+
+// Throws flashgs::Error "<path>: cannot open: ..." for a missing path, a dangling link, a
+// link loop or a path that may not be searched; otherwise says what the path names.
+PathKind path_kind(const std::string& path);
+
+// Throws flashgs::Error "<path>: ..." unless `path` names a regular file (after links):
+// folders, FIFOs, devices and sockets are refused without being opened.
+void check_regular_file(const std::string& path);
+
+// The whole content of the regular file at `path`, checked as above and opened without
+// blocking; throws flashgs::Error when it holds more than `max_bytes`.
+std::vector<char> read_regular_file(const std::string& path,
+                                    std::size_t max_bytes = std::numeric_limits<std::size_t>::max());
+
+}  // namespace flashgs

@@ -1,0 +1,109 @@
+// The file-type checks and the non-blocking whole-file read behind every scene and camera file.
+#include "flashgs/file_access.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "flashgs/error.h"
+
+namespace flashgs {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& problem) { throw Error(path + ": " + problem); }
+
+// Why stat() or open() failed, in words.
+[[noreturn]] void fail_to_open(const std::string& path, int error) {
+  struct stat link {};
+  switch (error) {
+    case ENOENT:
+      if (::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode))
+        fail(path, "cannot open: a symbolic link whose target does not exist");
+      fail(path, "cannot open: no such file or folder");
+    case ENOTDIR: fail(path, "cannot open: a part of the path is not a folder");
+    case ELOOP: fail(path, "cannot open: a loop of symbolic links");
+    case EACCES:
+    case EPERM: fail(path, "cannot open: permission denied");
+    case ENAMETOOLONG: fail(path, "cannot open: the path is too long");
+    default: fail(path, std::string("cannot open: ") + std::strerror(error));
+  }
+}
+
+void check_regular(const std::string& path, mode_t mode) {
+  if (S_ISREG(mode)) return;
+  if (S_ISDIR(mode)) fail(path, "is a folder, not a file");
+  if (S_ISFIFO(mode)) fail(path, "is a FIFO (named pipe), not a regular file");
+  if (S_ISCHR(mode) || S_ISBLK(mode)) fail(path, "is a device, not a regular file");
+  if (S_ISSOCK(mode)) fail(path, "is a socket, not a regular file");
+  fail(path, "is not a regular file");
+}
+
+struct stat stat_or_fail(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) fail_to_open(path, errno);
+  return st;
+}
+
+std::string megabytes(std::size_t bytes) { return std::to_string(bytes / 1000000 + (bytes % 1000000 != 0)) + " MB"; }
+
+// Reads until `size` bytes or the end of the file; returns the bytes read.
+std::size_t read_fully(const std::string& path, int fd, char* into, std::size_t size) {
+  std::size_t filled = 0;
+  while (filled < size) {
+    const ssize_t n = ::read(fd, into + filled, size - filled);
+    if (n == 0) break;
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail(path, std::string("read error: ") + std::strerror(errno));
+    filled += static_cast<std::size_t>(n);
+  }
+  return filled;
+}
+
+// Closes the descriptor on every path out of read_regular_file.
+struct FileDescriptor {
+  int fd;
+  ~FileDescriptor() { ::close(fd); }
+};
+
+}  // namespace
+
+PathKind path_kind(const std::string& path) {
+  const struct stat st = stat_or_fail(path);
+  if (S_ISREG(st.st_mode)) return PathKind::regular_file;
+  if (S_ISDIR(st.st_mode)) return PathKind::folder;
+  return PathKind::other;
+}
+
+void check_regular_file(const std::string& path) { check_regular(path, stat_or_fail(path).st_mode); }
+
+std::vector<char> read_regular_file(const std::string& path, std::size_t max_bytes) {
+  check_regular_file(path);
+  // O_NONBLOCK: should the path become a FIFO after the check, open() still returns at once.
+  const FileDescriptor file{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)};
+  if (file.fd < 0) fail_to_open(path, errno);
+  struct stat st {};
+  if (::fstat(file.fd, &st) != 0) fail_to_open(path, errno);
+  check_regular(path, st.st_mode);
+  const auto size = static_cast<std::size_t>(st.st_size);
+  if (size > max_bytes) fail(path, "the file is " + megabytes(size) + ", more than the " + megabytes(max_bytes) +
+                                       " this kind of file may have");
+  std::vector<char> bytes(size);
+  const std::size_t filled = read_fully(path, file.fd, bytes.data(), size);
+  if (filled < size) {  // the file shrank since fstat
+    bytes.resize(filled);
+    return bytes;
+  }
+  // Files of /proc and the like report size 0 yet have content, and a file may have grown.
+  char chunk[1 << 16];
+  while (const std::size_t n = read_fully(path, file.fd, chunk, sizeof chunk)) {
+    if (n > max_bytes - bytes.size())
+      fail(path, "the file holds more than the " + megabytes(max_bytes) + " this kind of file may have");
+    bytes.insert(bytes.end(), chunk, chunk + n);
+  }
+  return bytes;
+}
+
+}  // namespace flashgs
