@@ -285,7 +285,7 @@ TEST(Viewer, ADroppedFifoIsRefusedAndTheWindowClosesPromptly) {
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
                             "[ $status -eq 0 ] && { \"$drop\" 600 300 \"" + fifo + "\" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"load failed, scene kept: " + fifo +
-                            ": a FIFO\" || status=12; }\n"
+                            ": is a FIFO\" || status=12; }\n"
                             "[ $status -eq 0 ] && { close_window || status=14; }\n"
                             "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=15\n";
   const RunResult r = run_live_viewer(prefix, "drop_fifo", "--backend cpu --size 800x450", steps, 13);
@@ -306,12 +306,12 @@ TEST(Viewer, AFifoSceneIsRefusedInScriptedRuns) {
   // `timeout`: before the fix the viewer blocked in open() for ever.
   const RunResult a = run(prefix + "timeout 120 " + viewer() + " " + fifo + " --backend cpu --size 320x180 --frames 1 --exit");
   EXPECT_EQ(a.exit_code, 2) << a.output;
-  EXPECT_NE(a.output.find("load failed (no scene loaded yet): " + fifo + ": a FIFO"), std::string::npos) << a.output;
+  EXPECT_NE(a.output.find("load failed (no scene loaded yet): " + fifo + ": is a FIFO"), std::string::npos) << a.output;
   EXPECT_NE(a.output.find("no scene to run the script on"), std::string::npos) << a.output;
   const RunResult b = run(prefix + "timeout 120 " + viewer() + " --backend cpu --size 320x180 --frames 2 --then-open " +
                           fifo + " --exit");
   EXPECT_EQ(b.exit_code, 0) << b.output;
-  EXPECT_NE(b.output.find("load failed, scene kept: " + fifo + ": a FIFO"), std::string::npos) << b.output;
+  EXPECT_NE(b.output.find("load failed, scene kept: " + fifo + ": is a FIFO"), std::string::npos) << b.output;
   std::filesystem::remove(fifo);
 }
 

@@ -414,14 +414,14 @@ TEST(ViewerScene, AFifoOrDeviceIsRefusedWithoutOpeningIt) {
   const std::string fifo = dir + "/scene.ply";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   const std::string e = load_error_within(fifo, std::chrono::seconds(20)).what();
-  EXPECT_NE(e.find(fifo + ": a FIFO"), std::string::npos) << e;
+  EXPECT_NE(e.find(fifo + ": is a FIFO"), std::string::npos) << e;
   // A folder whose point_cloud.ply is a FIFO, and a device.
   std::filesystem::create_directories(dir + "/folder");
   ASSERT_EQ(mkfifo((dir + "/folder/point_cloud.ply").c_str(), 0600), 0);
   const std::string f = load_error_within(dir + "/folder", std::chrono::seconds(20)).what();
-  EXPECT_NE(f.find("point_cloud.ply: a FIFO"), std::string::npos) << f;
+  EXPECT_NE(f.find("point_cloud.ply: is a FIFO"), std::string::npos) << f;
   const std::string d = load_error_within("/dev/zero", std::chrono::seconds(20)).what();
-  EXPECT_NE(d.find("/dev/zero: a device"), std::string::npos) << d;
+  EXPECT_NE(d.find("/dev/zero: is a device"), std::string::npos) << d;
 }
 
 TEST(ViewerScene, AFifoAsCamerasJsonIsNotedAndTheSceneLoads) {
@@ -433,7 +433,7 @@ TEST(ViewerScene, AFifoAsCamerasJsonIsNotedAndTheSceneLoads) {
   const fv::LoadedScene scene = result.get();
   EXPECT_GT(scene.scene->size(), 0u);
   EXPECT_TRUE(scene.cameras.empty());
-  EXPECT_NE(scene.cameras_note.find("cameras.json: a FIFO"), std::string::npos) << scene.cameras_note;
+  EXPECT_NE(scene.cameras_note.find("cameras.json: is a FIFO"), std::string::npos) << scene.cameras_note;
 }
 
 TEST(ViewerSceneLoader, LoadsInTheBackgroundAndReportsErrors) {

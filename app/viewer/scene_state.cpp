@@ -39,20 +39,6 @@ void frame_scene(LoadedScene& s) {
 
 }  // namespace
 
-std::string file_type_problem(const std::filesystem::file_status& status) {
-  using std::filesystem::file_type;
-  switch (status.type()) {
-    case file_type::regular: return "";
-    case file_type::not_found: return "no such file";
-    case file_type::directory: return "a folder, not a file";
-    case file_type::fifo: return "a FIFO (named pipe), not a regular file";
-    case file_type::socket: return "a socket, not a regular file";
-    case file_type::block:
-    case file_type::character: return "a device, not a regular file";
-    default: return "not a regular file";
-  }
-}
-
 glm::vec3 guess_up(const std::vector<Camera>& cameras) {
   glm::vec3 sum(0.0f);
   for (const Camera& c : cameras) sum -= glm::vec3(c.rotation[3], c.rotation[4], c.rotation[5]);  // row 1 = camera y (down)
@@ -67,33 +53,22 @@ glm::vec3 guess_up(const std::vector<Camera>& cameras) {
   return up;
 }
 
-LoadedScene load_scene(const std::string& ply_path, const std::string& cameras_path) {
+LoadedScene load_scene(const std::string& path, const std::string& cameras_path) {
+  // A PLY, a folder holding point_cloud.ply or a 3DGS training output (the library's rule, as
+  // in the command-line tool); FIFOs and devices are refused before anything is opened.
+  const SceneLocation location = locate_scene(path);
   LoadedScene s;
-  s.path = ply_path;
-  const auto status = std::filesystem::status(ply_path);
-  if (std::filesystem::is_directory(status)) {
-    // A folder is accepted when it holds point_cloud.ply (the layout of the shared scenes).
-    const auto inner = std::filesystem::path(ply_path) / "point_cloud.ply";
-    if (!std::filesystem::exists(inner)) throw Error(ply_path + ": a folder without point_cloud.ply");
-    return load_scene(inner.string(), cameras_path);
-  }
-  // Checked before opening: opening a FIFO (or a device) blocks until a writer appears.
-  if (const std::string problem = file_type_problem(status); !problem.empty()) throw Error(ply_path + ": " + problem);
-  s.scene = std::make_shared<const Scene>(load_ply(ply_path, &s.report));
-  if (s.scene->size() == 0) throw Error(ply_path + ": the file holds no usable Gaussians");
-  const std::string cameras = cameras_path.empty()
-                                  ? (std::filesystem::path(ply_path).parent_path() / "cameras.json").string()
-                                  : cameras_path;
-  const auto cameras_status = std::filesystem::status(cameras);
-  if (!std::filesystem::exists(cameras_status)) {
+  s.path = location.ply;
+  s.scene = std::make_shared<const Scene>(load_ply(location.ply, &s.report));
+  if (s.scene->size() == 0) throw Error(location.ply + ": the file holds no usable Gaussians");
+  const std::string cameras = cameras_path.empty() ? location.cameras : cameras_path;
+  if (!std::filesystem::exists(std::filesystem::symlink_status(cameras))) {
     s.cameras_note = cameras + ": not found (free navigation only)";
-  } else if (const std::string problem = file_type_problem(cameras_status); !problem.empty()) {
-    s.cameras_note = cameras + ": " + problem + " (free navigation only)";
   } else {
     try {
-      s.cameras = load_cameras(cameras);
+      s.cameras = load_cameras(cameras);  // refuses a FIFO or device without opening it
     } catch (const Error& e) {
-      s.cameras_note = e.what();
+      s.cameras_note = std::string(e.what()) + " (free navigation only)";
       s.cameras.clear();
     }
   }

@@ -1,7 +1,6 @@
 // LoadedScene: a scene with its cameras and the framing the viewer derives from them; loading never leaves a half-made scene.
 #pragma once
 
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,13 +23,12 @@ struct LoadedScene {
   glm::vec3 up{0.0f, -1.0f, 0.0f};      // guessed world up
 };
 
-// Loads `ply_path` (a regular file, or a folder holding point_cloud.ply) and the cameras.json
-// beside it (or `cameras_path`). Throws flashgs::Error naming the file and the problem, before
-// opening anything that is not a regular file (a FIFO would block); a missing, broken or
-// irregular cameras.json is not fatal (noted).
-LoadedScene load_scene(const std::string& ply_path, const std::string& cameras_path = "");
-// Empty for a regular file; else what the path is instead ("a FIFO (named pipe), not a regular file").
-std::string file_type_problem(const std::filesystem::file_status& status);
+// Loads the scene at `path` (a PLY, a folder holding point_cloud.ply or a 3DGS training
+// output: flashgs::locate_scene) and its cameras.json (or `cameras_path`). Throws
+// flashgs::Error naming the file and the problem, before opening anything that is not a
+// regular file (a FIFO would block); a missing, broken or irregular cameras.json is not fatal
+// (noted).
+LoadedScene load_scene(const std::string& path, const std::string& cameras_path = "");
 // The procedural demo scene (`count` Gaussians) with orbit cameras, for runs where no file can travel.
 LoadedScene generate_demo_scene(std::size_t count);
 // `copies` copies of a loaded scene on a grid (large-scene benchmarks); cameras kept.
