@@ -53,7 +53,8 @@ std::string scratch_dir(const std::string& name) {
 // Runs `flashgs <arguments>` through the shell, with the address space limited to
 // `address_space_bytes` when non-zero (setrlimit in the child, as `prlimit --as` would).
 CliResult run_cli(const std::string& arguments, std::size_t address_space_bytes = 0) {
-  const std::string log = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/cli/last_run.log";
+  // One log per test process: ctest runs the tests of this suite in parallel.
+  const std::string log = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/cli/run_" + std::to_string(getpid()) + ".log";
   fs::create_directories(fs::path(log).parent_path());
   const std::string command = std::string(FLASHGS_CLI) + " " + arguments;
   const pid_t child = fork();
