@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/demo_scene.h"
 #include "flashgs/io.h"
 #include "ply_builder.h"
 #include "test_support.h"
@@ -158,7 +159,7 @@ TEST(CliOptions, OutputPathIsCheckedBeforeRendering) {
 
 TEST(CliOptions, CameraListsAreCheckedAgainstTheFile) {
   const std::string dir = scratch_dir("camera_list");
-  const std::string cameras = std::string(FLASHGS_ASSET_DIR) + "/demo/cameras.json";
+  const std::string cameras = demo_cameras_path();
   const std::size_t count = load_cameras(cameras).size();
   const std::string missing = std::to_string(count + 63);
   const std::string quick = " --backend cpu -r 32x18 ";

@@ -61,11 +61,12 @@ TEST(CpuOptions, EachOptimisationAloneKeepsTheImage) {
   const Frame base = render(scene, camera, RenderOptions::baseline());
   const Frame all = render(scene, camera, RenderOptions{});
   EXPECT_LT(all.stats.kv_pairs, base.stats.kv_pairs);
-  for (int which = 0; which < 3; ++which) {
+  for (const RenderSwitch& sw : kRenderSwitches) {
+    if (!sw.changes_pairs) continue;
     RenderOptions alone;
-    alone.opacity_aware_radius = which == 0;
-    alone.tight_bbox = which == 1;
-    alone.exact_tile_test = which == 2;
+    for (const RenderSwitch& other : kRenderSwitches)
+      if (other.changes_pairs) alone.*(other.member) = false;
+    alone.*(sw.member) = true;
     const Frame f = render(scene, camera, alone);
     EXPECT_GE(compare_images(base.image, f.image).psnr_db, 50.0) << alone.label();
   }

@@ -55,23 +55,11 @@ double fraction_over(const Image& a, const Image& b, double tol) {
   return a.rgb.empty() ? 0.0 : double(over) / double(a.rgb.size());
 }
 
-std::vector<RenderOptions> all_configs() {
-  std::vector<RenderOptions> configs = {RenderOptions::baseline(), RenderOptions{}};
-  for (int k = 0; k < 8; ++k) {
-    RenderOptions o;
-    bool* switches[] = {&o.opacity_aware_radius, &o.tight_bbox,        &o.exact_tile_test, &o.warp_cooperative_emit,
-                        &o.fused_emit,           &o.minimal_sort_bits, &o.pipelined_blend, &o.exp2_alpha};
-    *switches[k] = false;
-    configs.push_back(o);
-  }
-  return configs;
-}
+std::vector<RenderOptions> all_configs() { return single_switch_configs(); }
 
-// The CPU ignores the scheduling switches: its image for a config depends on the geometry only.
-std::string cpu_key(const RenderOptions& o) {
-  if (o.is_baseline()) return "baseline";
-  return std::to_string(o.opacity_aware_radius) + std::to_string(o.tight_bbox) + std::to_string(o.exact_tile_test);
-}
+// The CPU ignores the switches it does not honour: its image for a config is that of the
+// config with those switches at their defaults.
+std::string cpu_key(const RenderOptions& o) { return o.seen_by(Backend::cpu).label(); }
 
 void expect_match(const std::string& what, const Result& cpu, const Result& gpu) {
   EXPECT_EQ(gpu.stats.kv_pairs, cpu.stats.kv_pairs) << what;

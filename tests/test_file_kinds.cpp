@@ -16,6 +16,7 @@
 #include <functional>
 #include <tuple>
 
+#include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
 #include "flashgs/io.h"
 #include "ply_builder.h"
@@ -41,7 +42,7 @@ void write_file(const fs::path& path, const std::string& bytes) { std::ofstream(
 std::string small_ply() { return test::PlyBuilder::inria(0, 10).bytes(); }
 
 std::string demo_cameras_json() {
-  std::ifstream in(std::string(FLASHGS_ASSET_DIR) + "/demo/cameras.json");
+  std::ifstream in(demo_cameras_path());
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 

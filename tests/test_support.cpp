@@ -5,8 +5,9 @@
 #include <map>
 #include <mutex>
 
-#include "flashgs/netpbm.h"
+#include "flashgs/demo_scene.h"
 #include "flashgs/io.h"
+#include "flashgs/netpbm.h"
 
 namespace flashgs::test {
 
@@ -37,12 +38,12 @@ std::vector<Camera> load_shared_cameras(const std::string& name) {
 
 std::shared_ptr<const Scene> load_demo_scene() {
   static std::shared_ptr<const Scene> scene =
-      std::make_shared<Scene>(load_ply(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply"));
+      std::make_shared<Scene>(load_ply(demo_scene_path()));
   return scene;
 }
 
 std::vector<Camera> load_demo_cameras() {
-  return load_cameras(std::string(FLASHGS_ASSET_DIR) + "/demo/cameras.json");
+  return load_cameras(demo_cameras_path());
 }
 
 void dump_images(const std::string& stem, const Image& expected, const Image& actual) {

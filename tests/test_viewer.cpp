@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "flashgs/demo_scene.h"
 #include "flashgs/image.h"
 #include "flashgs/image_io.h"
 #include "flashgs/frame_memory.h"
@@ -253,7 +254,7 @@ TEST(Viewer, DroppedFilesOpenAndABadOneKeepsTheViewerRunning) {
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   const std::string dir = out_dir();
   const std::string good = dir + "/dropped_scene.ply", bad = dir + "/dropped_missing.ply";
-  std::filesystem::copy_file(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply", good,
+  std::filesystem::copy_file(flashgs::demo_scene_path(), good,
                              std::filesystem::copy_options::overwrite_existing);
   std::filesystem::remove(bad);
   const std::string steps = "wait_for \"UI ready\" || status=10\n"

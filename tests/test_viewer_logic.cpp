@@ -14,6 +14,7 @@
 
 #include "camera_controller.h"
 #include "camera_path.h"
+#include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
@@ -239,6 +240,8 @@ TEST(ViewerStats, FrameTimeSummary) {
   const fv::FrameTimeSummary s = fv::summarize_frame_times({4.0, 2.0, 3.0, 1.0});
   EXPECT_EQ(s.frames, 4u);
   EXPECT_DOUBLE_EQ(s.mean_ms, 2.5);
+  EXPECT_DOUBLE_EQ(s.median_ms, 2.5);  // the mean of the middle two (flashgs::percentile)
+  EXPECT_DOUBLE_EQ(s.p95_ms, 3.85);    // 3 + 0.85 (4 - 3): between the two highest ranks
   EXPECT_DOUBLE_EQ(s.min_ms, 1.0);
   EXPECT_DOUBLE_EQ(s.max_ms, 4.0);
   EXPECT_DOUBLE_EQ(s.fps, 400.0);
@@ -426,7 +429,7 @@ TEST(ViewerScene, AFifoOrDeviceIsRefusedWithoutOpeningIt) {
 
 TEST(ViewerScene, AFifoAsCamerasJsonIsNotedAndTheSceneLoads) {
   const std::string dir = scratch_dir("fifo_cameras");
-  std::filesystem::copy_file(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply", dir + "/point_cloud.ply");
+  std::filesystem::copy_file(flashgs::demo_scene_path(), dir + "/point_cloud.ply");
   ASSERT_EQ(mkfifo((dir + "/cameras.json").c_str(), 0600), 0);
   auto result = std::async(std::launch::async, [&] { return fv::load_scene(dir + "/point_cloud.ply"); });
   ASSERT_EQ(result.wait_for(std::chrono::seconds(30)), std::future_status::ready) << "blocked on the FIFO";
@@ -438,7 +441,7 @@ TEST(ViewerScene, AFifoAsCamerasJsonIsNotedAndTheSceneLoads) {
 
 TEST(ViewerSceneLoader, LoadsInTheBackgroundAndReportsErrors) {
   fv::SceneLoader loader;
-  ASSERT_TRUE(loader.start(std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply"));
+  ASSERT_TRUE(loader.start(flashgs::demo_scene_path()));
   EXPECT_FALSE(loader.start("/another.ply")) << "a second load while one runs";
   fv::LoadedScene scene;
   std::string error;

@@ -15,6 +15,7 @@
 #include "flashgs/error.h"
 #include "flashgs/io.h"
 #include "flashgs/parse.h"
+#include "flashgs/percentile.h"
 #include "option_checks.h"
 #include "scene_source.h"
 
@@ -32,19 +33,17 @@ struct BenchArgs {
   std::string json_path = "bench.json";
 };
 
-// The configurations by name: baseline, flash, and flash with one switch off.
+// The configurations by name (their labels): baseline, flash, and flash with one switch off.
 std::vector<std::pair<std::string, RenderOptions>> known_configs() {
   std::vector<std::pair<std::string, RenderOptions>> out;
-  out.emplace_back("baseline", RenderOptions::baseline());
-  out.emplace_back("flash", RenderOptions{});
-  for (int k = 0; k < 8; ++k) {
-    RenderOptions o;
-    bool* switches[] = {&o.opacity_aware_radius, &o.tight_bbox,        &o.exact_tile_test, &o.warp_cooperative_emit,
-                        &o.fused_emit,           &o.minimal_sort_bits, &o.pipelined_blend, &o.exp2_alpha};
-    *switches[k] = false;
-    out.emplace_back(o.label(), o);
-  }
+  for (const RenderOptions& o : single_switch_configs()) out.emplace_back(o.label(), o);
   return out;
+}
+
+std::string known_config_names() {
+  std::string names;
+  for (const auto& c : known_configs()) names += " " + c.first;
+  return names;
 }
 
 std::vector<std::pair<std::string, RenderOptions>> select_configs(const std::vector<std::string>& wanted,
@@ -54,20 +53,14 @@ std::vector<std::pair<std::string, RenderOptions>> select_configs(const std::vec
   for (const std::string& w : wanted) {
     if (w == "all") {
       for (const auto& c : known) {
-        // The CPU ignores the scheduling switches: their rows would repeat "flash".
-        const RenderOptions& o = c.second;
-        const bool scheduling_only = !o.is_baseline() && o.opacity_aware_radius && o.tight_bbox && o.exact_tile_test &&
-                                     c.first != "flash";
-        if (!(cpu && scheduling_only)) out.push_back(c);
+        // A switch the CPU does not honour: its row would repeat "flash".
+        const bool repeats_flash = c.first != "flash" && c.second.seen_by(Backend::cpu) == RenderOptions{};
+        if (!(cpu && repeats_flash)) out.push_back(c);
       }
       continue;
     }
     auto it = std::find_if(known.begin(), known.end(), [&](const auto& c) { return c.first == w; });
-    if (it == known.end()) {
-      std::string names;
-      for (const auto& c : known) names += " " + c.first;
-      throw Error("bench: unknown config \"" + w + "\" (all" + names + ")");
-    }
+    if (it == known.end()) throw Error("bench: unknown config \"" + w + "\" (all" + known_config_names() + ")");
     out.push_back(*it);
   }
   // The baseline is rendered anyway (it is the reference image); list it first, once.
@@ -75,17 +68,6 @@ std::vector<std::pair<std::string, RenderOptions>> select_configs(const std::vec
   out.insert(out.begin(), known.front());
   return out;
 }
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = p * (v.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (v[hi] - v[lo]) * (pos - lo);
-}
-
-double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
 
 const char* kStages[] = {"project", "emit", "sort", "ranges", "blend", "total"};
 
@@ -210,7 +192,7 @@ void run(const BenchArgs& args) {
       j["config"] = r.name;
       j["label"] = r.options.label();
       for (int s = 0; s < 6; ++s)
-        j["ms"][kStages[s]] = {{"median", median(r.stage[s])}, {"p95", percentile(r.stage[s], 0.95)}};
+        j["ms"][kStages[s]] = {{"median", median(r.stage[s])}, {"p95", percentile(r.stage[s], kTailPercentile)}};
       j["kv_pairs"] = {{"median", median(r.kv)}, {"max", *std::max_element(r.kv.begin(), r.kv.end())}};
       j["visible_median"] = median(r.visible);
       j["memory_bytes"] = {{"working_max", r.memory_max}, {"peak", r.peak_max}};
@@ -224,7 +206,7 @@ void run(const BenchArgs& args) {
       std::snprintf(line, sizeof line,
                     "%-10s %-28s %7.3f %7.3f %7.3f %7.3f %7.3f %8.3f (%7.3f) %9.0f %8.1f %7s %9.2e\n",
                     resolution.c_str(), r.name.c_str(), median(r.stage[0]), median(r.stage[1]), median(r.stage[2]),
-                    median(r.stage[3]), median(r.stage[4]), median(r.stage[5]), percentile(r.stage[5], 0.95),
+                    median(r.stage[3]), median(r.stage[4]), median(r.stage[5]), percentile(r.stage[5], kTailPercentile),
                     median(r.kv), r.peak_max / 1e6,
                     std::isfinite(psnr_min) ? std::to_string(psnr_min).substr(0, 6).c_str() : "inf",
                     *std::max_element(r.max_abs.begin(), r.max_abs.end()));
@@ -248,11 +230,7 @@ void register_bench(CLI::App& app) {
   args->scene.add_to(sub);
   sub->add_option("--backend", args->backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
   sub->add_option("--resolutions,-r", args->resolutions, "WxH list (comma separated)")->delimiter(',');
-  sub->add_option("--configs", args->configs,
-                  "all, or names: baseline flash flash-no_opacity_radius flash-no_tight_bbox flash-no_exact_tile_test "
-                  "flash-no_warp_emit flash-no_fused_emit flash-no_sort_bits flash-no_pipelined_blend "
-                  "flash-no_exp2_alpha")
-      ->delimiter(',');
+  sub->add_option("--configs", args->configs, "all, or names:" + known_config_names())->delimiter(',');
   sub->add_option("--camera-list", args->cameras, "camera indices (default 0,2,...,34)")->delimiter(',');
   sub->add_option("--warmup", args->warmup, "untimed frames per camera and config")->check(CLI::NonNegativeNumber);
   sub->add_option("--repeat", args->repeat, "timed frames per camera and config")->check(CLI::PositiveNumber);

@@ -207,8 +207,10 @@ void run(const ReportArgs& args) {
   // CSV: one row per (backend, configuration).
   {
     std::ofstream csv(stem + ".csv");
-    csv << "backend,config,group,algorithm,opacity_radius,tight_bbox,exact_tile_test,warp_emit,fused_emit,sort_bits,"
-           "pipelined_blend,exp2_alpha,tau,median_ms,p95_ms,frames,kv_pairs,peak_memory_mb,psnr_vs_baseline_db,"
+    // One column per switch (its label token): 1 where it is in effect.
+    csv << "backend,config,group,algorithm,";
+    for (const RenderSwitch& s : kRenderSwitches) csv << s.label << ',';
+    csv << "tau,median_ms,p95_ms,frames,kv_pairs,peak_memory_mb,psnr_vs_baseline_db,"
            "max_abs_vs_baseline,frac_over_1_255_vs_baseline,psnr_vs_fp64_db,max_abs_vs_fp64,frac_over_1_255_vs_fp64,"
            "non_finite,pareto\n";
     for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
@@ -219,10 +221,9 @@ void run(const ReportArgs& args) {
       for (std::size_t i = 0; i < subset.size(); ++i) {
         const SweepResult& r = subset[i];
         const RenderOptions& o = r.config.options;
-        csv << r.backend << ',' << r.config.name << ',' << r.config.group << ',' << algorithm_name(o.algorithm) << ','
-            << o.uses_opacity_radius() << ',' << o.uses_tight_bbox() << ',' << o.uses_exact_tile_test() << ','
-            << o.warp_cooperative_emit << ',' << o.fused_emit << ',' << o.minimal_sort_bits << ',' << o.pipelined_blend
-            << ',' << o.exp2_alpha << ',' << fmt("%.6g", o.tau) << ',' << fmt("%.4f", r.median_ms) << ','
+        csv << r.backend << ',' << r.config.name << ',' << r.config.group << ',' << algorithm_name(o.algorithm) << ',';
+        for (const RenderSwitch& s : kRenderSwitches) csv << (!o.is_baseline() && o.*(s.member)) << ',';
+        csv << fmt("%.6g", o.tau) << ',' << fmt("%.4f", r.median_ms) << ','
             << fmt("%.4f", r.p95_ms) << ',' << r.frame_ms.size() << ',' << fmt("%.0f", r.kv_pairs) << ','
             << (r.peak_memory_mb >= 0 ? fmt("%.1f", r.peak_memory_mb) : "") << ','
             << psnr_csv(r.vs_baseline.psnr_db) << ',' << fmt("%.3e", r.vs_baseline.max_abs) << ','

@@ -7,47 +7,40 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/percentile.h"
+
 namespace flashgs::cli {
 
 std::vector<SweepConfig> sweep_configs() {
   std::vector<SweepConfig> out;
   out.push_back({"baseline", "baseline", RenderOptions::baseline(), false});
   out.push_back({"flash", "flash", RenderOptions{}, false});
-  struct Switch {
-    const char* name;
-    bool RenderOptions::*member;
-  };
+  // The switches every backend honours, and those only the GPU does (the CPU skips their rows).
+  std::vector<const RenderSwitch*> every_backend, gpu_only;
+  for (const RenderSwitch& s : kRenderSwitches) (s.honoured_by(Backend::cpu) ? every_backend : gpu_only).push_back(&s);
   // For a group of switches: each one alone (the others of the group off), then each one left
   // out (the rest of the flash defaults kept).
-  auto add_group = [&out](const std::vector<Switch>& group, const std::string& alone_prefix,
+  auto add_group = [&out](const std::vector<const RenderSwitch*>& group, const std::string& alone_prefix,
                           const std::string& alone_kind, const std::string& left_out_kind, bool gpu_only) {
-    for (const Switch& s : group) {
+    for (const RenderSwitch* s : group) {
       RenderOptions o;
-      for (const Switch& other : group) o.*(other.member) = false;
-      o.*(s.member) = true;
-      out.push_back({alone_prefix + s.name, alone_kind, o, gpu_only});
+      for (const RenderSwitch* other : group) o.*(other->member) = false;
+      o.*(s->member) = true;
+      out.push_back({alone_prefix + s->label, alone_kind, o, gpu_only});
     }
-    for (const Switch& s : group) {
+    for (const RenderSwitch* s : group) {
       RenderOptions o;
-      o.*(s.member) = false;
-      out.push_back({std::string("no-") + s.name, left_out_kind, o, gpu_only});
+      o.*(s->member) = false;
+      out.push_back({std::string("no-") + s->label, left_out_kind, o, gpu_only});
     }
   };
-  add_group({{"opacity_radius", &RenderOptions::opacity_aware_radius},
-             {"tight_bbox", &RenderOptions::tight_bbox},
-             {"exact_tile_test", &RenderOptions::exact_tile_test}},
-            "only-", "alone", "left out", false);
+  add_group(every_backend, "only-", "alone", "left out", false);
   for (int denominator : {128, 64, 32, 16}) {
     RenderOptions o;
     o.tau = 1.0f / static_cast<float>(denominator);
     out.push_back({"tau=1/" + std::to_string(denominator), "tau", o, false});
   }
-  add_group({{"warp_emit", &RenderOptions::warp_cooperative_emit},
-             {"fused_emit", &RenderOptions::fused_emit},
-             {"sort_bits", &RenderOptions::minimal_sort_bits},
-             {"pipelined_blend", &RenderOptions::pipelined_blend},
-             {"exp2_alpha", &RenderOptions::exp2_alpha}},
-            "gpu-only-", "gpu alone", "gpu left out", true);
+  add_group(gpu_only, "gpu-only-", "gpu alone", "gpu left out", true);
   return out;
 }
 
@@ -63,15 +56,6 @@ void ErrorSummary::finish() {
   const double mse = pixels_ ? sum_sq_ / (3.0 * static_cast<double>(pixels_)) : 0.0;
   psnr_db = mse > 0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
   fraction_over = pixels_ ? over_ / static_cast<double>(pixels_) : 0.0;
-}
-
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  // Nearest rank: the smallest value with at least p of the samples at or below it.
-  const double rank = std::ceil(p * static_cast<double>(values.size()));
-  const std::size_t index = static_cast<std::size_t>(std::max(1.0, rank)) - 1;
-  return values[std::min(index, values.size() - 1)];
 }
 
 SweepResult measure_config(Renderer& renderer, const std::string& backend, const SweepConfig& config,
@@ -109,8 +93,8 @@ SweepResult measure_config(Renderer& renderer, const std::string& backend, const
   }
   r.vs_baseline.finish();
   r.vs_reference.finish();
-  r.median_ms = percentile(r.frame_ms, 0.5);
-  r.p95_ms = percentile(r.frame_ms, 0.95);
+  r.median_ms = median(r.frame_ms);
+  r.p95_ms = percentile(r.frame_ms, kTailPercentile);
   r.kv_pairs = r.frame_ms.empty() ? 0 : kv_sum / static_cast<double>(r.frame_ms.size());
   if (memory_reported) r.peak_memory_mb = static_cast<double>(peak) / 1e6;
   return r;

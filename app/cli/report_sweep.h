@@ -21,8 +21,8 @@ struct SweepConfig {
   bool gpu_only = false;  // a scheduling switch the CPU backend ignores: measured on CUDA only
 };
 
-// baseline; flash (everything on, tau = 1/255); each geometry optimisation alone and each
-// left out; tau = 1/128 ... 1/16; and each GPU-only switch alone and left out.
+// baseline; flash (everything on, default tau); each switch every backend honours alone and
+// each left out; tau = 1/128 ... 1/16; and each GPU-only switch alone and left out.
 std::vector<SweepConfig> sweep_configs();
 
 // Error of a set of images against another, pooled over cameras / windows.
@@ -41,7 +41,7 @@ struct SweepResult {
   std::string backend;
   SweepConfig config;
   std::vector<double> frame_ms;  // every timed frame (FrameStats total), all cameras
-  double median_ms = 0, p95_ms = 0;
+  double median_ms = 0, p95_ms = 0;  // p95: flashgs::kTailPercentile
   double kv_pairs = 0;           // mean per frame
   double peak_memory_mb = -1;    // backend working memory above the scene; -1: not reported
   ErrorSummary vs_baseline;      // whole images, same backend, same cameras
@@ -59,7 +59,5 @@ struct SweepFrames {
 // Renders `config` for every camera: one untimed warm-up, then `repeat` timed frames each.
 SweepResult measure_config(Renderer& renderer, const std::string& backend, const SweepConfig& config,
                            SweepFrames& frames, int repeat);
-
-double percentile(std::vector<double> values, double p);
 
 }  // namespace flashgs::cli

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 
+#include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
@@ -10,11 +11,6 @@
 #include "option_checks.h"
 
 namespace flashgs::cli {
-
-std::string demo_scene_path() {
-  // Installed next to the binary's source tree; FLASHGS_ASSET_DIR is set by CMake.
-  return std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply";
-}
 
 void SceneArgs::add_to(CLI::App* command) {
   m_scene_option = command->add_option("scene", scene_path,
@@ -50,14 +46,7 @@ std::shared_ptr<const Scene> load_scene_verbose(const std::string& path) {
 
 void RenderArgs::add_to(CLI::App* command) {
   command->add_option("--algorithm,-a", algorithm, "flash or baseline")->check(CLI::IsMember({"flash", "baseline"}));
-  command->add_flag("--no-opacity-radius", no_opacity_radius, "flash: 3-sigma extent instead of sqrt(2 ln(o/tau))");
-  command->add_flag("--no-tight-bbox", no_tight_bbox, "flash: square box instead of the per-axis box");
-  command->add_flag("--no-exact-tile-test", no_exact_tile_test, "flash: every tile of the box gets a key");
-  command->add_flag("--no-warp-emit", no_warp_emit, "CUDA flash: one thread per Gaussian for all sizes");
-  command->add_flag("--no-fused-emit", no_fused_emit, "CUDA flash: emit keys in a separate pass");
-  command->add_flag("--no-sort-bits", no_sort_bits, "CUDA flash: sort all 64 key bits");
-  command->add_flag("--no-pipelined-blend", no_pipelined_blend, "CUDA flash: no prefetch in the render loop");
-  command->add_flag("--no-exp2-alpha", no_exp2_alpha, "CUDA flash: expf instead of exp2 of a pre-scaled form");
+  switches.add_to(command);
   command->add_option("--tau", tau, "alpha threshold of the opacity-aware extent")->check(finite_in(1e-6, 0.99));
   command->add_option("--background", background, "background colour r,g,b in [0, 1]")
       ->delimiter(',')->expected(3)->check(finite_in(0.0, 1.0));
@@ -67,16 +56,7 @@ void RenderArgs::add_to(CLI::App* command) {
 
 RenderOptions RenderArgs::options() const {
   RenderOptions o = algorithm == "baseline" ? RenderOptions::baseline() : RenderOptions{};
-  if (algorithm != "baseline") {
-    o.opacity_aware_radius = !no_opacity_radius;
-    o.tight_bbox = !no_tight_bbox;
-    o.exact_tile_test = !no_exact_tile_test;
-    o.warp_cooperative_emit = !no_warp_emit;
-    o.fused_emit = !no_fused_emit;
-    o.minimal_sort_bits = !no_sort_bits;
-    o.pipelined_blend = !no_pipelined_blend;
-    o.exp2_alpha = !no_exp2_alpha;
-  }
+  if (algorithm != "baseline") switches.apply(&o);
   o.tau = tau;
   for (int k = 0; k < 3; ++k) o.background[k] = background[k];
   o.sh_degree_cap = sh_degree;

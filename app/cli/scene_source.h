@@ -11,11 +11,9 @@
 #include "flashgs/io.h"
 #include "flashgs/options.h"
 #include "flashgs/scene.h"
+#include "switch_flags.h"
 
 namespace flashgs::cli {
-
-// The bundled demo scene (assets/demo/point_cloud.ply).
-std::string demo_scene_path();
 
 struct SceneArgs {
   std::string scene_path;    // a PLY or a scene folder; not given: the demo scene
@@ -37,10 +35,8 @@ std::shared_ptr<const Scene> load_scene_verbose(const std::string& path);
 
 struct RenderArgs {
   std::string algorithm = "flash";
-  bool no_opacity_radius = false, no_tight_bbox = false, no_exact_tile_test = false;
-  bool no_warp_emit = false, no_fused_emit = false, no_sort_bits = false;
-  bool no_pipelined_blend = false, no_exp2_alpha = false;
-  float tau = 1.0f / 255.0f;
+  SwitchFlags switches;
+  float tau = kDefaultTau;
   std::vector<float> background = {0, 0, 0};
   int sh_degree = 3;
   std::string backend = "auto";

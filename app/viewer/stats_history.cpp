@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "flashgs/percentile.h"
+
 namespace flashgs::viewer {
 
 void StatsHistory::push(double frame_ms, const FrameStats& stats) {
@@ -45,8 +47,8 @@ FrameTimeSummary summarize_frame_times(std::vector<double> ms) {
   if (ms.empty()) return r;
   std::sort(ms.begin(), ms.end());
   r.mean_ms = std::accumulate(ms.begin(), ms.end(), 0.0) / ms.size();
-  r.median_ms = ms[ms.size() / 2];
-  r.p95_ms = ms[std::min(ms.size() - 1, ms.size() * 95 / 100)];
+  r.median_ms = median(ms);
+  r.p95_ms = percentile(ms, kTailPercentile);
   r.min_ms = ms.front();
   r.max_ms = ms.back();
   r.fps = r.mean_ms > 0 ? 1000.0 / r.mean_ms : 0;

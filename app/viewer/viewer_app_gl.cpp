@@ -11,6 +11,7 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
+#include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
 #include "flashgs/image_io.h"
 #include "flashgs/renderer.h"
@@ -34,23 +35,12 @@ bool same_camera(const Camera& a, const Camera& b) {
   return std::equal(a.rotation, a.rotation + 9, b.rotation) && std::equal(a.position, a.position + 3, b.position);
 }
 
-bool same_options(const RenderOptions& a, const RenderOptions& b) {
-  return a.algorithm == b.algorithm && a.opacity_aware_radius == b.opacity_aware_radius &&
-         a.tight_bbox == b.tight_bbox && a.exact_tile_test == b.exact_tile_test &&
-         a.warp_cooperative_emit == b.warp_cooperative_emit && a.fused_emit == b.fused_emit &&
-         a.minimal_sort_bits == b.minimal_sort_bits && a.pipelined_blend == b.pipelined_blend &&
-         a.exp2_alpha == b.exp2_alpha && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
-         a.collect_tile_counts == b.collect_tile_counts && std::equal(a.background, a.background + 3, b.background);
-}
-
 glm::vec3 axis_from_text(const std::string& t) {
   glm::vec3 v(0.0f);
   const int axis = t[1] == 'x' ? 0 : (t[1] == 'y' ? 1 : 2);
   v[axis] = t[0] == '-' ? -1.0f : 1.0f;
   return v;
 }
-
-std::string demo_scene_path() { return std::string(FLASHGS_ASSET_DIR) + "/demo/point_cloud.ply"; }
 
 // An exception's text for a message: a bare std::bad_alloc says only "std::bad_alloc".
 std::string reason(const std::exception& e) {
@@ -664,6 +654,7 @@ int ViewerApp::run() {
       m_ui->begin_frame();
       model.frame_path = m_path->name();
       model.frame_path_note = m_path_note;
+      model.backend = m_path_is_cpu ? Backend::cpu : Backend::cuda;
       model.scene_path = m_scene.path;
       model.gaussians = m_scene.scene ? m_scene.scene->size() : 0;
       model.sh_degree = m_scene.scene ? m_scene.scene->sh_degree : 0;
@@ -726,7 +717,7 @@ int ViewerApp::run() {
     const Camera camera = m_controller.render_camera(rw, rh, m_settings.fov_x_degrees);
     RenderOptions wanted = m_settings.options;
     wanted.collect_tile_counts = m_settings.heatmap;
-    const bool changed = !m_have_frame || !same_camera(camera, m_last_camera) || !same_options(wanted, m_last_options);
+    const bool changed = !m_have_frame || !same_camera(camera, m_last_camera) || wanted != m_last_options;
     bool rendered = false;
     double render_call_ms = 0;
     const double before_render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_loop).count();

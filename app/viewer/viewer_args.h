@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/options.h"
+
 namespace flashgs::viewer {
 
 struct ViewerArgs {
@@ -20,7 +22,7 @@ struct ViewerArgs {
   int camera = -1;               // snap to this camera at start
   float fov = 0;                 // > 0: horizontal field of view in degrees
   std::string algorithm = "flash";
-  float tau = 1.0f / 255.0f;
+  float tau = kDefaultTau;
   int sh_degree = 3;
   std::vector<float> background = {0, 0, 0};
   bool heatmap = false;

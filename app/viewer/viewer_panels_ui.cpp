@@ -89,7 +89,22 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   ImGui::TextDisabled("pos (%.2f, %.2f, %.2f)", m.position[0], m.position[1], m.position[2]);
 }
 
-void render_panel(ViewerSettings& s) {
+// One optimisation switch: a checkbox greyed out where the backend does not honour it, and a
+// tooltip saying what it removes, where the paper has it, its CLI flag and why it is grey.
+void switch_checkbox(const RenderSwitch& sw, RenderOptions& o, Backend backend) {
+  const bool honoured = sw.honoured_by(backend);
+  ImGui::BeginDisabled(!honoured);
+  ImGui::Checkbox(sw.ui_name, &(o.*(sw.member)));
+  ImGui::EndDisabled();
+  if (!ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) return;
+  std::string tip = std::string(sw.help) + "\nFlashGS paper: " + sw.paper + "\nCLI: --no-" + sw.cli_name;
+  if (!honoured) tip += std::string("\nGreyed out: the ") + backend_name(backend) + " backend ignores it (" +
+                        sw.why_ignored + ")";
+  else if (o.is_baseline()) tip += "\nGreyed out: the baseline uses none of the optimisations";
+  ImGui::SetTooltip("%s", tip.c_str());
+}
+
+void render_panel(const UiModel& m, ViewerSettings& s) {
   if (!ImGui::CollapsingHeader("Rendering", ImGuiTreeNodeFlags_DefaultOpen)) return;
   RenderOptions& o = s.options;
   int algo = o.is_baseline() ? 0 : 1;
@@ -100,20 +115,15 @@ void render_panel(ViewerSettings& s) {
   ImGui::TextDisabled("(B)");
   o.algorithm = algo == 0 ? Algorithm::baseline : Algorithm::flash;
   ImGui::BeginDisabled(o.is_baseline());
-  // Two columns: the geometry switches (every backend) and the GPU kernel switches (CUDA only).
+  // Two columns: the switches that change the Gaussian-tile pairs (geometry) and those that
+  // only change how fast the kernels make and blend them.
   if (ImGui::BeginTable("opts", 2, ImGuiTableFlags_SizingStretchSame)) {
-    ImGui::TableNextColumn();
-    ImGui::TextDisabled("geometry");
-    ImGui::Checkbox("Opacity radius", &o.opacity_aware_radius);
-    ImGui::Checkbox("Tight box", &o.tight_bbox);
-    ImGui::Checkbox("Exact tile test", &o.exact_tile_test);
-    ImGui::TableNextColumn();
-    ImGui::TextDisabled("GPU kernels");
-    ImGui::Checkbox("Warp emit", &o.warp_cooperative_emit);
-    ImGui::Checkbox("Fused emit", &o.fused_emit);
-    ImGui::Checkbox("Sort bits", &o.minimal_sort_bits);
-    ImGui::Checkbox("Pipelined blend", &o.pipelined_blend);
-    ImGui::Checkbox("exp2 alpha", &o.exp2_alpha);
+    for (const bool geometry : {true, false}) {
+      ImGui::TableNextColumn();
+      ImGui::TextDisabled(geometry ? "geometry" : "GPU kernels");
+      for (const RenderSwitch& sw : kRenderSwitches)
+        if (sw.changes_pairs == geometry) switch_checkbox(sw, o, m.backend);
+    }
     ImGui::EndTable();
   }
   ImGui::EndDisabled();
@@ -252,7 +262,7 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels
   scene_panel(m, a, path_buffer);
   view_panel(m, s, a);
-  render_panel(s);
+  render_panel(m, s);
   compare_panel(m, a);
   overlay_panel(m, s, a, shot);
   if (ImGui::CollapsingHeader("Keys")) {

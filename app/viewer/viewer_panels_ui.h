@@ -13,6 +13,7 @@ namespace flashgs::viewer {
 struct UiModel {
   std::string frame_path;         // the active presentation path
   std::string frame_path_note;    // why a faster path is not used, if so
+  Backend backend = Backend::cpu;  // the renderer behind the frame path (greys the switches it ignores)
   std::string scene_path;
   std::size_t gaussians = 0;
   int sh_degree = 0;

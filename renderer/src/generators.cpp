@@ -6,6 +6,7 @@
 #include <random>
 
 #include "flashgs/error.h"
+#include "flashgs/gaussian_math.h"
 
 namespace flashgs {
 namespace {
@@ -16,7 +17,7 @@ void push_gaussian(Scene& s, const float p[3], const float scale[3], const float
   for (int k = 0; k < 3; ++k) {
     s.positions.push_back(p[k]);
     s.scales.push_back(scale[k]);
-    s.sh_dc.push_back((rgb[k] - 0.5f) / 0.28209479177387814f);  // colour -> degree-0 coefficient
+    s.sh_dc.push_back((rgb[k] - 0.5f) / gm::kShC0);  // colour -> degree-0 coefficient
   }
   for (int k = 0; k < 4; ++k) s.rotations.push_back(static_cast<float>(q[k] / norm));
   s.opacities.push_back(opacity);

@@ -1,30 +1,56 @@
-// RenderOptions presets and labels.
+// RenderOptions presets, labels and comparisons, all walked from kRenderSwitches.
 #include "flashgs/options.h"
 
+#include <algorithm>
+
+#include "flashgs/gaussian_math.h"
+
 namespace flashgs {
+
+static_assert(kDefaultTau == gm::kAlphaMin, "the default tau is the blend's alpha cut (see options.h)");
 
 RenderOptions RenderOptions::baseline() {
   RenderOptions options;
   options.algorithm = Algorithm::baseline;
-  options.opacity_aware_radius = options.tight_bbox = options.exact_tile_test = false;
-  options.warp_cooperative_emit = options.fused_emit = options.minimal_sort_bits = false;
-  options.pipelined_blend = options.exp2_alpha = false;
+  for (const RenderSwitch& s : kRenderSwitches) options.*(s.member) = false;
   return options;
 }
 
 std::string RenderOptions::label() const {
   if (is_baseline()) return "baseline";
   std::string label = "flash";
-  const std::pair<bool, const char*> switches[] = {
-      {opacity_aware_radius, "opacity_radius"}, {tight_bbox, "tight_bbox"},
-      {exact_tile_test, "exact_tile_test"},     {warp_cooperative_emit, "warp_emit"},
-      {fused_emit, "fused_emit"},               {minimal_sort_bits, "sort_bits"},
-      {pipelined_blend, "pipelined_blend"},     {exp2_alpha, "exp2_alpha"}};
-  for (const auto& [on, name] : switches)
-    if (!on) label += std::string("-no_") + name;
+  for (const RenderSwitch& s : kRenderSwitches)
+    if (!(this->*(s.member))) label += std::string("-no_") + s.label;
   return label;
 }
 
+RenderOptions RenderOptions::seen_by(Backend backend) const {
+  RenderOptions seen = *this;
+  const RenderOptions defaults = is_baseline() ? RenderOptions::baseline() : RenderOptions{};
+  for (const RenderSwitch& s : kRenderSwitches)
+    if (!s.honoured_by(backend)) seen.*(s.member) = defaults.*(s.member);
+  return seen;
+}
+
+bool operator==(const RenderOptions& a, const RenderOptions& b) {
+  for (const RenderSwitch& s : kRenderSwitches)
+    if (a.*(s.member) != b.*(s.member)) return false;
+  return a.algorithm == b.algorithm && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
+         a.collect_tile_counts == b.collect_tile_counts && std::equal(a.background, a.background + 3, b.background);
+}
+
+std::vector<RenderOptions> single_switch_configs() {
+  std::vector<RenderOptions> out = {RenderOptions::baseline(), RenderOptions{}};
+  for (const RenderSwitch& s : kRenderSwitches) {
+    RenderOptions o;
+    o.*(s.member) = false;
+    out.push_back(o);
+  }
+  return out;
+}
+
 const char* algorithm_name(Algorithm a) { return a == Algorithm::baseline ? "baseline" : "flash"; }
+
+const char* backend_name(Backend b) { return b == Backend::cpu ? "CPU" : "CUDA"; }
 
 }  // namespace flashgs

@@ -54,27 +54,27 @@ void box_3dgs(const Camera& camera, double mean_x, double mean_y, double a, doub
 // Real SH in double, same basis as gaussian_math.h.
 void sh_rgb_double(const Scene& scene, std::size_t i, int degree, const double dir[3], double rgb[3]) {
   const double x = dir[0], y = dir[1], z = dir[2];
-  double basis[16] = {0.28209479177387814};
+  double basis[16] = {model::kShC0};
   if (degree > 0) {
-    basis[1] = -0.4886025119029199 * y;
-    basis[2] = 0.4886025119029199 * z;
-    basis[3] = -0.4886025119029199 * x;
+    basis[1] = -model::kShC1 * y;
+    basis[2] = model::kShC1 * z;
+    basis[3] = -model::kShC1 * x;
   }
   if (degree > 1) {
     const double xx = x * x, yy = y * y, zz = z * z;
-    basis[4] = 1.0925484305920792 * x * y;
-    basis[5] = -1.0925484305920792 * y * z;
-    basis[6] = 0.31539156525252005 * (2 * zz - xx - yy);
-    basis[7] = -1.0925484305920792 * x * z;
-    basis[8] = 0.5462742152960396 * (xx - yy);
+    basis[4] = model::kShC2_0 * x * y;
+    basis[5] = model::kShC2_1 * y * z;
+    basis[6] = model::kShC2_2 * (2 * zz - xx - yy);
+    basis[7] = model::kShC2_3 * x * z;
+    basis[8] = model::kShC2_4 * (xx - yy);
     if (degree > 2) {
-      basis[9] = -0.5900435899266435 * y * (3 * xx - yy);
-      basis[10] = 2.890611442640554 * x * y * z;
-      basis[11] = -0.4570457994644658 * y * (4 * zz - xx - yy);
-      basis[12] = 0.3731763325901154 * z * (2 * zz - 3 * xx - 3 * yy);
-      basis[13] = -0.4570457994644658 * x * (4 * zz - xx - yy);
-      basis[14] = 1.445305721320277 * z * (xx - yy);
-      basis[15] = -0.5900435899266435 * x * (xx - 3 * yy);
+      basis[9] = model::kShC3_0 * y * (3 * xx - yy);
+      basis[10] = model::kShC3_1 * x * y * z;
+      basis[11] = model::kShC3_2 * y * (4 * zz - xx - yy);
+      basis[12] = model::kShC3_3 * z * (2 * zz - 3 * xx - 3 * yy);
+      basis[13] = model::kShC3_4 * x * (4 * zz - xx - yy);
+      basis[14] = model::kShC3_5 * z * (xx - yy);
+      basis[15] = model::kShC3_6 * x * (xx - 3 * yy);
     }
   }
   const int rest_n = scene.sh_rest_per_gaussian();
@@ -132,10 +132,10 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
     const double fx = camera.fx, fy = camera.fy, z = v[2];
     // The Jacobian at the direction clamped to the widened frustum (gm::frustum_clamped_direction).
     const double width = camera.width, height = camera.height;
-    const double tx = std::clamp(v[0] / z, -(camera.cx + 0.5 + 0.15 * width) / fx,
-                                 (width - 0.5 - camera.cx + 0.15 * width) / fx);
-    const double ty = std::clamp(v[1] / z, -(camera.cy + 0.5 + 0.15 * height) / fy,
-                                 (height - 0.5 - camera.cy + 0.15 * height) / fy);
+    const double tx = std::clamp(v[0] / z, -(camera.cx + 0.5 + model::kFrustumMargin * width) / fx,
+                                 (width - 0.5 - camera.cx + model::kFrustumMargin * width) / fx);
+    const double ty = std::clamp(v[1] / z, -(camera.cy + 0.5 + model::kFrustumMargin * height) / fy,
+                                 (height - 0.5 - camera.cy + model::kFrustumMargin * height) / fy);
     const double j00 = fx / z, j02 = -fx * tx / z, j11 = fy / z, j12 = -fy * ty / z;
     double t0[3], t1[3];
     for (int k = 0; k < 3; ++k) {

@@ -15,12 +15,12 @@
 #include <unistd.h>
 
 #include "flashgs/error.h"
+#include "flashgs/gaussian_math.h"
 #include "flashgs/io.h"
+#include "flashgs/options.h"
 
 namespace flashgs {
 namespace {
-
-constexpr float kC0 = 0.28209479177387814f;
 
 // A small portable generator (xorshift64*), so that a case is the same on every platform
 // (std:: distributions are implementation-defined).
@@ -76,7 +76,7 @@ void add(Scene& s, float x, float y, float z, float sx, float sy, float sz, cons
   for (int k = 0; k < 3; ++k) {
     s.positions.push_back(p[k]);
     s.scales.push_back(sc[k]);
-    s.sh_dc.push_back((rgb[k] - 0.5f) / kC0);
+    s.sh_dc.push_back((rgb[k] - 0.5f) / gm::kShC0);
   }
   for (int k = 0; k < 4; ++k) s.rotations.push_back(q[k]);
   s.opacities.push_back(opacity);
@@ -385,7 +385,7 @@ StressCase opacity_edges_case() {
   c.description = "opacity 1 (alpha clamped to 0.99), two and three opaque layers (T reaches the 1e-4 stop), "
                   "opacity exactly 1/255, one ulp above and below, 0 and 1e-30";
   Scene& s = c.scene;
-  const float tau = 1.0f / 255.0f;
+  const float tau = kDefaultTau;  // also the blend's alpha cut
   const float opacities[] = {1.0f, 0.99f, tau, std::nextafter(tau, 1.0f), std::nextafter(tau, 0.0f), 0.0f, 1e-30f,
                              2.0f * tau};
   // 64 x 64, f = 32 at z = 2: one world unit is 16 px; centres on pixel centres.

@@ -12,6 +12,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "flashgs/model_constants.h"
+
 #if defined(__CUDACC__)
 #define FLASHGS_HD __host__ __device__ __forceinline__
 #else
@@ -148,8 +150,8 @@ FLASHGS_HD void to_view(const CameraParams& cam, const float p[3], float v[3]) {
 // principal point is the image centre; the image spans pixel edges -0.5 .. width - 0.5).
 FLASHGS_HD void frustum_clamped_direction(const CameraParams& cam, float x_over_z, float y_over_z,
                                           float& tx, float& ty) {
-  const float margin_x = 0.15f * static_cast<float>(cam.width);
-  const float margin_y = 0.15f * static_cast<float>(cam.height);
+  const float margin_x = static_cast<float>(model::kFrustumMargin) * static_cast<float>(cam.width);
+  const float margin_y = static_cast<float>(model::kFrustumMargin) * static_cast<float>(cam.height);
   const float x_lo = -(cam.cx + 0.5f + margin_x) / cam.fx;
   const float x_hi = (static_cast<float>(cam.width) - 0.5f - cam.cx + margin_x) / cam.fx;
   const float y_lo = -(cam.cy + 0.5f + margin_y) / cam.fy;
@@ -369,22 +371,22 @@ FLASHGS_HD bool footprint_touches_tile(const Footprint& f, int tx, int ty, int w
                               width, height);
 }
 
-// Real spherical harmonics constants (degree 0..3) of the 3DGS colour model.
-constexpr float kShC0 = 0.28209479177387814f;
-constexpr float kShC1 = 0.4886025119029199f;
+// Real spherical harmonics constants (degree 0..3) of the 3DGS colour model, in float.
+constexpr float kShC0 = static_cast<float>(model::kShC0);
+constexpr float kShC1 = static_cast<float>(model::kShC1);
 // Scalars, not arrays: a namespace-scope constexpr array cannot be read in CUDA device code.
-constexpr float kShC2_0 = 1.0925484305920792f;
-constexpr float kShC2_1 = -1.0925484305920792f;
-constexpr float kShC2_2 = 0.31539156525252005f;
-constexpr float kShC2_3 = -1.0925484305920792f;
-constexpr float kShC2_4 = 0.5462742152960396f;
-constexpr float kShC3_0 = -0.5900435899266435f;
-constexpr float kShC3_1 = 2.890611442640554f;
-constexpr float kShC3_2 = -0.4570457994644658f;
-constexpr float kShC3_3 = 0.3731763325901154f;
-constexpr float kShC3_4 = -0.4570457994644658f;
-constexpr float kShC3_5 = 1.445305721320277f;
-constexpr float kShC3_6 = -0.5900435899266435f;
+constexpr float kShC2_0 = static_cast<float>(model::kShC2_0);
+constexpr float kShC2_1 = static_cast<float>(model::kShC2_1);
+constexpr float kShC2_2 = static_cast<float>(model::kShC2_2);
+constexpr float kShC2_3 = static_cast<float>(model::kShC2_3);
+constexpr float kShC2_4 = static_cast<float>(model::kShC2_4);
+constexpr float kShC3_0 = static_cast<float>(model::kShC3_0);
+constexpr float kShC3_1 = static_cast<float>(model::kShC3_1);
+constexpr float kShC3_2 = static_cast<float>(model::kShC3_2);
+constexpr float kShC3_3 = static_cast<float>(model::kShC3_3);
+constexpr float kShC3_4 = static_cast<float>(model::kShC3_4);
+constexpr float kShC3_5 = static_cast<float>(model::kShC3_5);
+constexpr float kShC3_6 = static_cast<float>(model::kShC3_6);
 
 // SH basis values for a unit direction, for bands 0..degree (DEGREE is a template argument so
 // that a degree-0 scene compiles to no SH work at all).

@@ -1,0 +1,20 @@
+// The CLI's --no-<switch> flags, one per row of kRenderSwitches (options.h).
+#pragma once
+
+#include <array>
+#include <iterator>
+
+#include <CLI/CLI.hpp>
+
+#include "flashgs/options.h"
+
+namespace flashgs::cli {
+
+struct SwitchFlags {
+  std::array<bool, std::size(kRenderSwitches)> off{};  // per table row: its --no- flag was given
+  void add_to(CLI::App* command);
+  // Turns off every switch whose flag was given.
+  void apply(RenderOptions* options) const;
+};
+
+}  // namespace flashgs::cli
