@@ -2,7 +2,7 @@
 # GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench
-#                                       bench-regions bench-large bench-prev bench-cpu profile
+#                                       bench-regions bench-large bench-prev bench-cpu report profile
 #                                       profile-blend profile-sass
 #                                       build-bg wait-build
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
@@ -119,6 +119,15 @@ bench_cpu() {
   bench_scene "$SCENES/pc_playbot" bench_playbot_cpu --backend cpu -r 1920x1080 --warmup 1 --repeat 3
 }
 
+report() {  # the error-vs-time report of pc_playbot on each backend (docs/report_pc_playbot)
+  for backend in cuda cpu; do
+    log "report pc_playbot $backend"
+    "$FLASHGS" report "$SCENES/pc_playbot/point_cloud.ply" --backend $backend --title pc_playbot \
+      -o "$OUT/report_$backend" > "$OUT/report_$backend.txt" 2>&1
+    log "report $backend rc=$?"
+  done
+}
+
 profile() {  # PROFILE_SCENE (pc_playbot), PROFILE_RES (3840x2160)
   log "ncu ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-3840x2160}"
   timeout 240 ncu --set basic -k regex:'preprocess|emit|blend|ranges|duplicate|Onesweep' --launch-skip 20 \
@@ -168,6 +177,7 @@ for step in "$@"; do
     bench-large) bench_large ;;
     bench-prev) (FLASHGS=$BIN/flashgs_prev TAG=prev_ bench_regions) ;;  # a carried earlier build, to compare
     bench-cpu) bench_cpu ;;
+    report) report ;;
     profile) profile ;;
     profile-blend) profile_blend ;;
     profile-sass) profile_sass ;;
