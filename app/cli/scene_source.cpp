@@ -7,6 +7,7 @@
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
+#include "flashgs/scene_formats.h"
 #include "flashgs/parse.h"
 #include "option_checks.h"
 
@@ -35,7 +36,7 @@ SceneLocation SceneArgs::locate() const {
 
 std::shared_ptr<const Scene> load_scene_verbose(const std::string& path) {
   LoadReport report;
-  auto scene = std::make_shared<Scene>(load_ply(path, &report));
+  auto scene = std::make_shared<Scene>(load_scene_file(path, &report));
   if (report.dropped_non_finite)
     std::fprintf(stderr, "%s: dropped %zu Gaussians with NaN/Inf attributes (or exp(scale) overflow)\n",
                  path.c_str(), report.dropped_non_finite);

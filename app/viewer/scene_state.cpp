@@ -8,6 +8,7 @@
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
+#include "flashgs/scene_formats.h"
 
 namespace flashgs::viewer {
 namespace {
@@ -59,7 +60,7 @@ LoadedScene load_scene(const std::string& path, const std::string& cameras_path)
   const SceneLocation location = locate_scene(path);
   LoadedScene s;
   s.path = location.ply;
-  s.scene = std::make_shared<const Scene>(load_ply(location.ply, &s.report));
+  s.scene = std::make_shared<const Scene>(load_scene_file(location.ply, &s.report));
   if (s.scene->size() == 0) throw Error(location.ply + ": the file holds no usable Gaussians");
   const std::string cameras = cameras_path.empty() ? location.cameras : cameras_path;
   if (!std::filesystem::exists(std::filesystem::symlink_status(cameras))) {

@@ -13,6 +13,12 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
+// Thrown by a loader that saw LoadProgress::cancel_requested: the user stopped it, nothing is wrong.
+class LoadCancelled : public Error {
+ public:
+  explicit LoadCancelled(const std::string& path) : Error(path + ": loading cancelled") {}
+};
+
 // Text taken from a file (a header line, a token, an img_name), made safe to put in a message:
 // control bytes and invalid UTF-8 become \xNN, and text longer than `max_bytes` is cut with
 // "..." and its full length, so a message stays one short line whatever the file holds.
