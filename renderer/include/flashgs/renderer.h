@@ -1,6 +1,7 @@
 // Renderer: the interface every backend (CPU, CUDA) implements, and the CPU factory.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <string>
 
@@ -23,6 +24,20 @@ class Renderer {
   // Renders one frame. `stats` may be null.
   virtual void render(const Camera& camera, const RenderOptions& options, Image& out,
                       FrameStats* stats) = 0;
+
+  // A flag another thread sets to stop the render in flight (the viewer's progressive CPU
+  // path): render() then returns at its next check with FrameStats::cancelled set and an
+  // incomplete image. The caller clears the flag before each render; null = never cancelled.
+  // A backend that cannot stop early finishes the frame.
+  void set_cancel_flag(const std::atomic<bool>* flag) { m_cancel_flag = flag; }
+
+ protected:
+  bool cancel_requested() const {
+    return m_cancel_flag != nullptr && m_cancel_flag->load(std::memory_order_relaxed);
+  }
+
+ private:
+  const std::atomic<bool>* m_cancel_flag = nullptr;
 };
 
 // The multi-threaded CPU backend; `threads` = 0 uses every core.

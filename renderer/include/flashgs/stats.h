@@ -34,6 +34,8 @@ struct FrameStats {
   StageTimes times;
   std::uint64_t device_memory_bytes = 0;  // backend working memory now (GPU; 0 on CPU)
   std::uint64_t device_peak_bytes = 0;    // high-water mark of the above
+  // The render stopped early on Renderer::set_cancel_flag's flag: the image is incomplete.
+  bool cancelled = false;
 };
 
 }  // namespace flashgs
