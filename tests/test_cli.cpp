@@ -201,6 +201,23 @@ TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
   EXPECT_EQ(r.exit_code, 2);
 }
 
+// `bench --tile N` renders N copies of the scene (scale runs), reports the upload and the
+// first frame apart, and refuses copies that cannot fit in memory before making any.
+TEST(CliBench, TiledSceneIsBenchedAndTooManyCopiesAreRefused) {
+  const std::string dir = scratch_dir("bench_tile");
+  const std::size_t demo = load_ply(demo_scene_path()).size();
+  const std::string quick = " --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 --json ";
+  const CliResult r = run_cli("bench --tile 3" + quick + dir + "/b.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(": " + std::to_string(3 * demo) + " Gaussians"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("flash                        scene upload"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("first frame"), std::string::npos) << r.output;
+
+  const CliResult huge = run_cli("bench --tile 4096" + quick + dir + "/c.json", std::size_t{1} << 30);
+  expect_one_line_error(huge, "--tile: 4096 copies need", "4096 copies");
+  EXPECT_FALSE(fs::exists(dir + "/c.json"));
+}
+
 TEST(CliGenerate, RefusesToOverwriteAScene) {
   const std::string dir = scratch_dir("overwrite");
   ASSERT_EQ(run_cli("generate demo --count 300 -o " + dir).exit_code, 0);

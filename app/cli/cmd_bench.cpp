@@ -1,6 +1,7 @@
 // `flashgs bench`: per-stage timings, pairs, memory and image error of every configuration
 // over a camera set and resolutions; prints a table and writes JSON.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -13,6 +14,8 @@
 #include "backend_factory.h"
 #include "commands.h"
 #include "flashgs/error.h"
+#include "flashgs/frame_memory.h"
+#include "flashgs/generators.h"
 #include "flashgs/io.h"
 #include "flashgs/parse.h"
 #include "flashgs/percentile.h"
@@ -30,8 +33,13 @@ struct BenchArgs {
   std::vector<int> cameras;  // empty: 0, 2, ..., 34 (the 18 views of ANCHORS.md)
   int warmup = 3;
   int repeat = 10;
+  int copies = 1;  // --tile: the scene copied on a grid in memory (scale benchmarks)
   std::string json_path = "bench.json";
 };
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
 
 // The configurations by name (their labels): baseline, flash, and flash with one switch off.
 std::vector<std::pair<std::string, RenderOptions>> known_configs() {
@@ -90,6 +98,7 @@ struct ConfigRun {
   std::vector<double> stage[6];  // per camera
   std::vector<double> kv, visible, psnr, max_abs;
   std::uint64_t memory_max = 0, peak_max = 0;
+  double upload_ms = 0, first_frame_ms = -1;  // wall clock: set_scene, and the first render
   nlohmann::json per_camera = nlohmann::json::array();
 };
 
@@ -101,7 +110,16 @@ void run(const BenchArgs& args) {
   std::vector<Resolution> resolutions;
   for (const std::string& text : args.resolutions) resolutions.push_back(parse_resolution(text));
   const std::string scene_path = args.scene.resolved_scene();
-  auto scene = load_scene_verbose(scene_path);
+  std::shared_ptr<const Scene> scene = load_scene_verbose(scene_path);
+  if (args.copies > 1) {
+    const std::uint64_t wanted = static_cast<std::uint64_t>(scene->byte_size()) * args.copies;
+    const AvailableMemory available = available_host_memory();
+    if (available.bytes > 0 && wanted > available.bytes)
+      throw Error("--tile: " + std::to_string(args.copies) + " copies need " + format_bytes(wanted) +
+                  " of host memory, " + format_bytes(available.bytes) + " is available (" + available.limited_by +
+                  ")");
+    scene = std::make_shared<const Scene>(tile_scene(*scene, args.copies));
+  }
   const std::string cameras_path = args.scene.resolved_cameras();
   const std::vector<Camera> all_cameras = load_cameras(cameras_path);
   std::vector<int> camera_ids = args.cameras;
@@ -120,6 +138,7 @@ void run(const BenchArgs& args) {
 
   nlohmann::json out;
   out["scene"] = scene_path;
+  out["copies"] = args.copies;
   out["gaussians"] = scene->size();
   out["sh_degree"] = scene->sh_degree;
   out["scene_bytes_host_layout"] = scene->byte_size();
@@ -136,7 +155,7 @@ void run(const BenchArgs& args) {
   std::printf("; %d warm-up + %d timed frames each; per-camera medians, then median (p95) over cameras\n",
               args.warmup, args.repeat);
 
-  std::string table;
+  std::string table, uploads;
   for (std::size_t k = 0; k < resolutions.size(); ++k) {
     const std::string& resolution = args.resolutions[k];
     const int width = resolutions[k].width, height = resolutions[k].height;
@@ -147,7 +166,9 @@ void run(const BenchArgs& args) {
       r.name = name;
       r.options = options;
       r.renderer = create_backend(args.backend);
+      const auto upload_start = std::chrono::steady_clock::now();
       r.renderer->set_scene(scene);
+      r.upload_ms = ms_since(upload_start);
       runs.push_back(std::move(r));
     }
     for (int id : camera_ids) {
@@ -156,6 +177,11 @@ void run(const BenchArgs& args) {
       for (ConfigRun& r : runs) {
         Image image;
         FrameStats stats;
+        if (r.first_frame_ms < 0) {  // the first frame allocates its buffers: timed apart, wall clock
+          const auto first_start = std::chrono::steady_clock::now();
+          r.renderer->render(camera, r.options, image, &stats);
+          r.first_frame_ms = ms_since(first_start);
+        }
         for (int w = 0; w < args.warmup; ++w) r.renderer->render(camera, r.options, image, &stats);
         std::vector<double> samples[6];
         for (int k = 0; k < std::max(1, args.repeat); ++k) {
@@ -196,6 +222,12 @@ void run(const BenchArgs& args) {
       j["kv_pairs"] = {{"median", median(r.kv)}, {"max", *std::max_element(r.kv.begin(), r.kv.end())}};
       j["visible_median"] = median(r.visible);
       j["memory_bytes"] = {{"working_max", r.memory_max}, {"peak", r.peak_max}};
+      j["upload_ms"] = r.upload_ms;
+      j["first_frame_ms"] = r.first_frame_ms;
+      char upload_line[256];
+      std::snprintf(upload_line, sizeof upload_line, "%-10s %-28s scene upload %.1f ms, first frame %.1f ms (wall clock)\n",
+                    resolution.c_str(), r.name.c_str(), r.upload_ms, r.first_frame_ms);
+      uploads += upload_line;
       const double psnr_min = *std::min_element(r.psnr.begin(), r.psnr.end());
       j["psnr_db_vs_baseline"] = {{"min", finite_or_null(psnr_min)}, {"median", finite_or_null(median(r.psnr))}};
       j["max_abs_vs_baseline"] = *std::max_element(r.max_abs.begin(), r.max_abs.end());
@@ -216,6 +248,7 @@ void run(const BenchArgs& args) {
   std::printf("%-10s %-28s %7s %7s %7s %7s %7s %8s %9s %9s %8s %7s %9s\n", "resolution", "config", "project", "emit",
               "sort", "ranges", "blend", "total", "(p95)", "kv", "peak MB", "PSNRmin", "max abs");
   std::printf("%s", table.c_str());
+  std::printf("%s", uploads.c_str());
   std::ofstream file(args.json_path);
   if (!file) throw Error("bench: cannot write " + args.json_path);
   file << out.dump(2) << "\n";
@@ -234,6 +267,8 @@ void register_bench(CLI::App& app) {
   sub->add_option("--camera-list", args->cameras, "camera indices (default 0,2,...,34)")->delimiter(',');
   sub->add_option("--warmup", args->warmup, "untimed frames per camera and config")->check(CLI::NonNegativeNumber);
   sub->add_option("--repeat", args->repeat, "timed frames per camera and config")->check(CLI::PositiveNumber);
+  sub->add_option("--tile", args->copies, "render this many copies of the scene on a grid (scale runs)")
+      ->check(CLI::Range(1, 4096));
   sub->add_option("--json,-o", args->json_path, "JSON output file");
   sub->callback([args] { run(*args); });
 }

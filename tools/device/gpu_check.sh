@@ -2,7 +2,7 @@
 # GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench
-#                                       bench-regions bench-large bench-prev bench-cpu report profile
+#                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
 #                                       profile-blend profile-sass
 #                                       build-bg wait-build
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
@@ -114,9 +114,23 @@ bench() {
   bench_scene /tmp/tile7 bench_tile7 --backend cuda -r 1920x1080,3840x2160 --configs baseline,flash --warmup 2 --repeat 5
 }
 
-bench_cpu() {
-  log "bench cpu pc_playbot 1080p"
-  bench_scene "$SCENES/pc_playbot" bench_playbot_cpu --backend cpu -r 1920x1080 --warmup 1 --repeat 3
+bench_cpu() {  # the CPU backend on 1, 2 and every host thread (CPU_THREADS)
+  for threads in ${CPU_THREADS:-1 2 $(nproc)}; do
+    log "bench cpu pc_playbot 1080p, $threads threads"
+    OMP_NUM_THREADS=$threads bench_scene "$SCENES/pc_playbot" bench_playbot_cpu_t$threads --backend cpu -r 1920x1080 \
+      --configs baseline,flash --camera-list 0,10,20 --warmup 1 --repeat 3 | grep -E "^[0-9]+x"
+    log "bench cpu pc_biker 1280x800, $threads threads"
+    OMP_NUM_THREADS=$threads bench_scene "$SCENES/pc_biker" bench_biker_cpu_t$threads --backend cpu -r 1280x800 \
+      --configs baseline,flash --camera-list 0,10,20 --warmup 1 --repeat 3 | grep -E "^[0-9]+x"
+  done
+}
+
+bench_scale() {  # pc_playbot copied SCALE_COPIES times in memory (default 20 60 200: 10M, 30M, 100M)
+  for copies in ${SCALE_COPIES:-20 60 200}; do
+    log "bench scale: $copies x pc_playbot"
+    bench_scene "$SCENES/pc_playbot" bench_scale_$copies --backend cuda --tile $copies -r 1920x1080,3840x2160 \
+      --configs flash --camera-list 0,10,20 --warmup 1 --repeat 3 | grep -E "^[0-9]+x|Gaussians|error"
+  done
 }
 
 report() {  # the error-vs-time report of pc_playbot on each backend (docs/report_pc_playbot)
@@ -177,6 +191,7 @@ for step in "$@"; do
     bench-large) bench_large ;;
     bench-prev) (FLASHGS=$BIN/flashgs_prev TAG=prev_ bench_regions) ;;  # a carried earlier build, to compare
     bench-cpu) bench_cpu ;;
+    bench-scale) bench_scale ;;
     report) report ;;
     profile) profile ;;
     profile-blend) profile_blend ;;
