@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <numeric>
 
@@ -128,6 +129,57 @@ Camera inside_camera(const Scene& scene, int width, int height) {
   Camera c = Camera::from_pose(width, height, 0.6f * width, 0.6f * width, identity, centre);
   c.name = "inside";
   return c;
+}
+
+// The demo scene copied 9 times on a grid: seen from the demo cameras, most chunks of
+// 256 Gaussians lie wholly outside the view (or behind the camera).
+std::shared_ptr<const Scene> tiled_demo_scene() {
+  static const auto scene = std::make_shared<const Scene>(tile_scene(*test::load_demo_scene(), 9));
+  return scene;
+}
+
+std::vector<Camera> chunk_cull_cameras(const Scene& scene) {
+  const auto cameras = test::load_demo_cameras();
+  return {cameras[0].resized(1001, 563), cameras[7].resized(640, 360), inside_camera(scene, 803, 451)};
+}
+
+// The chunk cull only skips work: with it off (FLASHGS_CHUNK_CULL=0) every image byte and
+// every count is the same, and with it on chunks are actually culled.
+TEST(CudaChunkCull, ChangesNothingButTheWork) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = tiled_demo_scene();
+  setenv("FLASHGS_CHUNK_CULL", "0", 1);
+  auto plain = make_cuda_renderer();
+  unsetenv("FLASHGS_CHUNK_CULL");
+  auto culling = make_cuda_renderer();
+  plain->set_scene(scene);
+  culling->set_scene(scene);
+  std::uint64_t culled = 0;
+  for (const Camera& camera : chunk_cull_cameras(*scene))
+    for (const RenderOptions& o : all_configs()) {
+      const std::string what = camera.name + " " + o.label();
+      const Result a = render(*plain, camera, o);
+      const Result b = render(*culling, camera, o);
+      EXPECT_TRUE(a.image.rgb == b.image.rgb) << what;
+      EXPECT_EQ(a.stats.kv_pairs, b.stats.kv_pairs) << what;
+      EXPECT_EQ(a.stats.visible, b.stats.visible) << what;
+      EXPECT_EQ(a.stats.culled_near, b.stats.culled_near) << what;
+      EXPECT_EQ(a.stats.culled_offscreen, b.stats.culled_offscreen) << what;
+      EXPECT_EQ(a.stats.culled_low_opacity, b.stats.culled_low_opacity) << what;
+      EXPECT_EQ(a.stats.culled_degenerate, b.stats.culled_degenerate) << what;
+      EXPECT_EQ(a.stats.culled_by_chunk, 0u) << what;
+      if (o.is_baseline()) {
+        EXPECT_EQ(b.stats.culled_by_chunk, 0u) << what << ": the baseline culls per Gaussian";
+      }
+      culled += b.stats.culled_by_chunk;
+    }
+  EXPECT_GT(culled, 0u) << "no chunk was culled: the test does not exercise the cull";
+}
+
+TEST(CudaVsCpu, TiledSceneWithChunkCull) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = tiled_demo_scene();
+  compare_scene("tiled demo", scene, chunk_cull_cameras(*scene));
 }
 
 // The frames the sanitizer run uses (tools/device/gpu_check.sh runs this test under

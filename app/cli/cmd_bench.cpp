@@ -201,6 +201,11 @@ void run(const BenchArgs& args) {
         r.peak_max = std::max<std::uint64_t>(r.peak_max, stats.device_peak_bytes);
         cam["kv_pairs"] = stats.kv_pairs;
         cam["visible"] = stats.visible;
+        cam["culled"] = {{"near", stats.culled_near},
+                         {"offscreen", stats.culled_offscreen},
+                         {"low_opacity", stats.culled_low_opacity},
+                         {"degenerate", stats.culled_degenerate},
+                         {"by_chunk", stats.culled_by_chunk}};
         if (r.name == "baseline") reference = image;
         const ImageDifference d = compare_images(reference, image);
         r.psnr.push_back(d.psnr_db);

@@ -13,6 +13,7 @@
 #include "flashgs/error.h"
 #include "flashgs/frame_params.h"
 #include "pipeline.h"
+#include "scene_upload.h"
 
 namespace flashgs {
 
@@ -183,6 +184,8 @@ class CudaRendererImpl final : public CudaRenderer {
     // And the box size (in tiles) above which a warp emits a Gaussian's pairs.
     if (const char* tiles = std::getenv("FLASHGS_LARGE_BOX_TILES"))
       large_box_tiles_ = std::max(1, std::min(cuda::kHugeBoxTiles, std::atoi(tiles)));
+    // FLASHGS_CHUNK_CULL=0 projects every Gaussian (to measure what the chunk cull saves).
+    if (const char* cull = std::getenv("FLASHGS_CHUNK_CULL")) chunk_cull_ = std::atoi(cull) != 0;
     for (int set = 0; set < 2; ++set)
       for (int e = 0; e < kEventCount; ++e) {
         check_cuda(cudaEventCreate(event_handles_[set][e].out()), "event creation");
@@ -211,59 +214,63 @@ class CudaRendererImpl final : public CudaRenderer {
     const int rest_floats = scene->sh_rest_per_gaussian();
     const int stride_vec4 = (rest_floats + 3) / 4;
 
-    // Host staging in the device layout.
-    std::vector<float4> position_opacity(n), rotation(n), scale_dc_r(n), rest(n * stride_vec4);
-    std::vector<float2> dc_gb(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const float* p = &scene->positions[i * 3];
-      const float* s = &scene->scales[i * 3];
-      const float* q = &scene->rotations[i * 4];
-      const float* dc = &scene->sh_dc[i * 3];
-      position_opacity[i] = make_float4(p[0], p[1], p[2], scene->opacities[i]);
-      rotation[i] = make_float4(q[0], q[1], q[2], q[3]);
-      scale_dc_r[i] = make_float4(s[0], s[1], s[2], dc[0]);
-      dc_gb[i] = make_float2(dc[1], dc[2]);
-      if (stride_vec4 > 0) {
-        float* dst = reinterpret_cast<float*>(&rest[i * stride_vec4]);
-        std::memset(dst, 0, sizeof(float4) * stride_vec4);
-        std::memcpy(dst, &scene->sh_rest[i * rest_floats], sizeof(float) * rest_floats);
-      }
-    }
-
     // Allocate the new scene next to the old one; on failure the old one stays.
-    DeviceBuffer new_pos, new_rot, new_scale, new_dc, new_rest;
+    DeviceBuffer new_pos, new_rot, new_scale, new_dc, new_rest, new_chunks;
     const std::size_t m = std::max<std::size_t>(n, 1);
+    const std::size_t chunks = (n + cuda::kChunkSize - 1) / cuda::kChunkSize;
     new_pos.reserve(m * sizeof(float4), "scene positions");
     new_rot.reserve(m * sizeof(float4), "scene rotations");
     new_scale.reserve(m * sizeof(float4), "scene scales");
     new_dc.reserve(m * sizeof(float2), "scene colours");
     if (stride_vec4 > 0) new_rest.reserve(n * stride_vec4 * sizeof(float4), "scene SH bands");
+    new_chunks.reserve(std::max<std::size_t>(chunks, 1) * sizeof(cuda::ChunkBound), "scene chunk bounds");
     // Per-Gaussian frame buffers of the fused path; the separate path's grow on first use.
     blend_.reserve(m * sizeof(cuda::BlendGaussian), "per-Gaussian blend data");
 
+    // Packed into the device layout chunk by chunk (no host copy of the whole scene).
     check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation");
-    auto upload = [](DeviceBuffer& dst, const void* src, std::size_t bytes) {
-      if (bytes) check_cuda(cudaMemcpy(dst.as<void>(), src, bytes, cudaMemcpyHostToDevice), "scene upload");
-    };
-    upload(new_pos, position_opacity.data(), n * sizeof(float4));
-    upload(new_rot, rotation.data(), n * sizeof(float4));
-    upload(new_scale, scale_dc_r.data(), n * sizeof(float4));
-    upload(new_dc, dc_gb.data(), n * sizeof(float2));
-    upload(new_rest, rest.data(), rest.size() * sizeof(float4));
+    const Scene& sc = *scene;
+    cuda::SceneUploader uploader(stream_);
+    uploader.upload(new_pos.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
+      const float* p = &sc.positions[i * 3];
+      *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], sc.opacities[i]);
+    });
+    uploader.upload(new_rot.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
+      const float* q = &sc.rotations[i * 4];
+      *static_cast<float4*>(dst) = make_float4(q[0], q[1], q[2], q[3]);
+    });
+    uploader.upload(new_scale.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
+      const float* sv = &sc.scales[i * 3];
+      *static_cast<float4*>(dst) = make_float4(sv[0], sv[1], sv[2], sc.sh_dc[i * 3]);
+    });
+    uploader.upload(new_dc.as<void>(), sizeof(float2), n, [&](std::size_t i, void* dst) {
+      *static_cast<float2*>(dst) = make_float2(sc.sh_dc[i * 3 + 1], sc.sh_dc[i * 3 + 2]);
+    });
+    if (stride_vec4 > 0)
+      uploader.upload(new_rest.as<void>(), stride_vec4 * sizeof(float4), n, [&](std::size_t i, void* dst) {
+        std::memset(dst, 0, sizeof(float4) * stride_vec4);
+        std::memcpy(dst, &sc.sh_rest[i * rest_floats], sizeof(float) * rest_floats);
+      });
+    cuda::DeviceScene next;
+    next.count = n;
+    next.sh_degree = degree;
+    next.rest_stride_vec4 = stride_vec4;
+    next.position_opacity = new_pos.as<float4>();
+    next.rotation = new_rot.as<float4>();
+    next.scale_dc_r = new_scale.as<float4>();
+    next.dc_gb = new_dc.as<float2>();
+    next.sh_rest = new_rest.as<float4>();
+    next.chunks = new_chunks.as<cuda::ChunkBound>();
+    cuda::launch_chunk_bounds(next, next.chunks, stream_);
+    uploader.finish();
+    // The buffers change owners, not addresses: `next` stays valid.
     scene_pos_.swap(new_pos);
     scene_rot_.swap(new_rot);
     scene_scale_.swap(new_scale);
     scene_dc_.swap(new_dc);
     scene_rest_.swap(new_rest);
-
-    device_scene_.count = n;
-    device_scene_.sh_degree = degree;
-    device_scene_.rest_stride_vec4 = stride_vec4;
-    device_scene_.position_opacity = scene_pos_.as<float4>();
-    device_scene_.rotation = scene_rot_.as<float4>();
-    device_scene_.scale_dc_r = scene_scale_.as<float4>();
-    device_scene_.dc_gb = scene_dc_.as<float2>();
-    device_scene_.sh_rest = scene_rest_.as<float4>();
+    scene_chunks_.swap(new_chunks);
+    device_scene_ = next;
     compute_bounds(*scene);
     scene_ = std::move(scene);
     last_tiles_ = 0;
@@ -479,6 +486,7 @@ class CudaRendererImpl final : public CudaRenderer {
     args.exp2_alpha = !baseline && options.exp2_alpha;
     args.sh_degree = std::max(0, std::min(device_scene_.sh_degree, options.sh_degree_cap));
     args.large_box_tiles = large_box_tiles_;
+    args.chunk_cull = !baseline && chunk_cull_;
 
     // project (+ fused emit), then the frame's one read back: the pair count. Fused emission
     // that overflowed wrote nothing past the capacity; grow and run it again.
@@ -574,6 +582,7 @@ class CudaRendererImpl final : public CudaRenderer {
     stats.culled_offscreen = c.by_reason[gm::kCulledOffscreen];
     stats.culled_low_opacity = c.by_reason[gm::kCulledLowOpacity];
     stats.culled_degenerate = c.by_reason[gm::kCulledDegenerate];
+    stats.culled_by_chunk = c.chunk_culled;
     // GPU time of each stage between events; host gaps (the pair-count wait) are not counted.
     // A surface frame is not waited for (the caller presents it while the GPU finishes): it
     // reports the previous frame's times, complete since this frame's pair-count wait.
@@ -611,11 +620,12 @@ class CudaRendererImpl final : public CudaRenderer {
   std::size_t cub_sized_for_gaussians_ = ~std::size_t{0};  // sizes cub_temp_ was last checked for
   std::uint64_t cub_sized_for_pairs_ = 0;
   int large_box_tiles_ = cuda::kLargeBoxTiles;
+  bool chunk_cull_ = true;
   cuda::KeyFormat key_format_;           // this frame's
   double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
   double bounds_radius_ = 0;
   // Scene (not counted as working memory).
-  DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_;
+  DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
   DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, image_,
       cub_temp_, large_footprints_, large_ids_, huge_footprints_, huge_ids_;

@@ -22,6 +22,22 @@ constexpr int kLargeBoxTiles = 32;
 // block per Gaussian: one warp looping over 10^4 tiles would set the preprocess kernel's length.
 constexpr int kHugeBoxTiles = 1024;
 
+// Preprocess takes the Gaussians in chunks of this many (one block each) and skips the
+// projection of a chunk whose bounds lie outside the view (chunk_cull.cuh).
+constexpr int kChunkSize = 256;
+
+// The bounds of one chunk (kChunkSize consecutive Gaussians). Every view-space centre of the chunk lies within `radius` of the view of (cx, cy, cz)
+// (a rotation keeps distances). cullable = 0 when a Gaussian could not be bounded: a
+// non-finite or astronomically large value, or a quaternion that is not a unit one (its
+// matrix would not be a rotation, and the footprint bound assumes one).
+struct ChunkBound {
+  float cx, cy, cz, radius;
+  float max_scale;    // largest |scale| of the chunk
+  float max_opacity;  // largest opacity (sets the flash extent in sigmas)
+  unsigned cullable;
+  unsigned pad;
+};
+
 // The scene on the device, in a compact layout sized to its SH degree (56 bytes per Gaussian
 // for degree 0, plus 48/96/192 bytes of higher bands for degree 1/2/3).
 struct DeviceScene {
@@ -33,6 +49,7 @@ struct DeviceScene {
   float4* scale_dc_r = nullptr;        // [count] linear scale x, y, z; SH DC red
   float2* dc_gb = nullptr;             // [count] SH DC green, blue
   float4* sh_rest = nullptr;           // [count][rest_stride_vec4] bands 1.., [k][channel], zero padded
+  ChunkBound* chunks = nullptr;        // [ceil(count / kChunkSize)]
 };
 
 // What the blend stage reads per Gaussian (48 bytes, three 16-byte loads): the whitened
@@ -68,6 +85,7 @@ struct FrameCounters {
   unsigned int max_tile_pairs;     // pairs of the fullest tile (set after the ranges pass)
   unsigned int large;             // Gaussians deferred to the large-emission kernel
   unsigned int huge;              // Gaussians deferred to the huge-emission kernel
+  unsigned long long chunk_culled; // Gaussians of chunks outside the view (classified, not projected)
 };
 
 // Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
@@ -114,7 +132,11 @@ struct PreprocessArgs {
   bool exp2_alpha;
   int sh_degree;        // bands evaluated (the scene's, capped)
   int large_box_tiles;  // boxes of more tiles go to the warp-cooperative path
+  bool chunk_cull;      // skip chunks outside the view (flash geometry only)
 };
+
+// Fills the scene's chunk bounds (once per scene).
+void launch_chunk_bounds(const DeviceScene& scene, ChunkBound* bounds, cudaStream_t stream);
 
 // project (+ fused key emission when `fused`).
 void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,

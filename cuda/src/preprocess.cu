@@ -4,6 +4,7 @@
 
 #include <cub/block/block_scan.cuh>
 
+#include "chunk_cull.cuh"
 #include "device_common.cuh"
 #include "flashgs/gaussian_math.h"
 #include "pipeline.h"
@@ -255,14 +256,46 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
 template <int DEGREE, bool FUSED>
 __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, FrameBuffers buf,
                                                             PreprocessArgs args) {
+  static_assert(kBlock == kChunkSize, "a block is one chunk");
   __shared__ unsigned block_counts[gm::kCullReasonCount];  // by gm::CullReason
+  __shared__ bool chunk_outside;
   if (threadIdx.x < gm::kCullReasonCount) block_counts[threadIdx.x] = 0;
+  if (threadIdx.x == 0)
+    chunk_outside = args.chunk_cull && chunk_outside_view(scene.chunks[blockIdx.x], args.camera, args.geometry);
   __syncthreads();
 
   const unsigned i = blockIdx.x * kBlock + threadIdx.x;
   const unsigned lane = lane_id();
   const bool valid = i < scene.count;
   const gm::CameraParams& cam = args.camera;
+
+  if (chunk_outside) {  // the whole block: only the centre and opacity are read
+    int reason = gm::kCulledOffscreen;
+    if (valid) {
+      const float4 po = __ldg(scene.position_opacity + i);
+      const float pos[3] = {po.x, po.y, po.z};
+      float view[3];
+      gm::to_view(cam, pos, view);
+      const gm::CullReason by_centre = gm::cull_by_centre(args.geometry, view, po.w);
+      reason = by_centre == gm::kVisible ? gm::kCulledOffscreen : by_centre;
+      if constexpr (!FUSED) buf.pair_counts[i] = 0;
+    }
+    // One shared atomic per reason and warp: a chunk's lanes mostly share one reason, and
+    // same-address atomics from a warp serialise.
+    for (int r = gm::kCulledNear; r < gm::kCullReasonCount; ++r) {
+      const unsigned votes = __ballot_sync(kFullMask, valid && reason == r);
+      if (lane == 0 && votes) atomicAdd(&block_counts[r], static_cast<unsigned>(__popc(votes)));
+    }
+    __syncthreads();
+    if (threadIdx.x < gm::kCullReasonCount && block_counts[threadIdx.x] > 0)
+      atomicAdd(&buf.counters->by_reason[threadIdx.x], block_counts[threadIdx.x]);
+    if (threadIdx.x == 0) {
+      const std::size_t first = static_cast<std::size_t>(blockIdx.x) * kBlock;
+      const std::size_t members = scene.count - first < kBlock ? scene.count - first : kBlock;
+      atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(members));
+    }
+    return;
+  }
 
   gm::Footprint f{};
   int reason = gm::kCulledDegenerate;

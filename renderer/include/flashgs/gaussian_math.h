@@ -160,6 +160,18 @@ FLASHGS_HD void frustum_clamped_direction(const CameraParams& cam, float x_over_
   ty = clampf(y_over_z, y_lo, y_hi);
 }
 
+// The culls that need only the view-space centre and the opacity, in project()'s order
+// (kVisible: neither applies). The CUDA chunk cull classifies the Gaussians of a chunk that
+// lies wholly outside the view with it, so its reasons are exactly project()'s.
+FLASHGS_HD CullReason cull_by_centre(const GeometryParams& geo, const float view[3], float opacity) {
+  if (!(view[2] > kNearZ)) return is_finite(view[2]) ? kCulledNear : kCulledDegenerate;
+  // alpha = o exp(-q / 2) >= tau  <=>  q <= 2 ln(o / tau). Culled only when o < tau: the
+  // blend keeps alpha == 1/255 (it skips alpha < 1/255), so o == tau still draws its centre
+  // pixel (threshold 0); culling it too dropped 1/255 of colour there (stress opacity_edges).
+  if (geo.opacity_radius && !(opacity >= geo.tau)) return kCulledLowOpacity;
+  return kVisible;
+}
+
 // Projects one Gaussian. The 2D covariance is M M^T with M = J W R S (2x3). Its determinant
 // comes from Cauchy-Binet as a sum of squared 2x2 minors of M, never as a*c - b*b: for a
 // needle or pancake (scale ratios of 1e6 and more) a*c and b*b agree in every float digit
@@ -171,16 +183,11 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
                               const float quaternion[4], float opacity, Footprint& out) {
   float v[3];
   to_view(cam, position, v);
-  if (!(v[2] > kNearZ)) return is_finite(v[2]) ? kCulledNear : kCulledDegenerate;
+  const CullReason by_centre = cull_by_centre(geo, v, opacity);
+  if (by_centre != kVisible) return by_centre;
 
   float threshold = kBaselineSigmas * kBaselineSigmas;
-  if (geo.opacity_radius) {
-    // alpha = o exp(-q / 2) >= tau  <=>  q <= 2 ln(o / tau). Culled only when o < tau: the
-    // blend keeps alpha == 1/255 (it skips alpha < 1/255), so o == tau still draws its centre
-    // pixel (threshold 0); culling it too dropped 1/255 of colour there (stress opacity_edges).
-    if (!(opacity >= geo.tau)) return kCulledLowOpacity;
-    threshold = 2.0f * portable_log(opacity / geo.tau);
-  }
+  if (geo.opacity_radius) threshold = 2.0f * portable_log(opacity / geo.tau);
 
   const float inv_z = 1.0f / v[2];
   const float mean_x = cam.fx * v[0] * inv_z + cam.cx;

@@ -30,6 +30,9 @@ struct FrameStats {
   std::uint64_t culled_offscreen = 0;   // box misses the image
   std::uint64_t culled_low_opacity = 0; // opacity below tau (flash opacity-aware radius only)
   std::uint64_t culled_degenerate = 0;  // non-finite projection or empty covariance
+  // CUDA flash: Gaussians of 256-Gaussian chunks that lay wholly outside the view, classified
+  // from their centres without being projected (also counted in the culled_* above).
+  std::uint64_t culled_by_chunk = 0;
 
   StageTimes times;
   std::uint64_t device_memory_bytes = 0;  // backend working memory now (GPU; 0 on CPU)

@@ -1,0 +1,99 @@
+// The bounds of every chunk of 256 consecutive Gaussians, computed once per scene on the device.
+#include <math.h>
+
+#include <cub/block/block_reduce.cuh>
+
+#include "device_common.cuh"
+#include "pipeline.h"
+
+namespace flashgs {
+namespace cuda {
+namespace {
+
+// Beyond this a float view transform or projection could lose the chunk test's margins.
+constexpr float kMaxBoundedValue = 1e18f;
+
+__device__ bool bounded(float v) { return fabsf(v) <= kMaxBoundedValue; }  // false for NaN, Inf
+
+struct Smaller {
+  __device__ float operator()(float a, float b) const { return fminf(a, b); }
+};
+struct Larger {
+  __device__ float operator()(float a, float b) const { return fmaxf(a, b); }
+};
+
+__global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene scene, ChunkBound* bounds) {
+  using Reduce = cub::BlockReduce<float, kChunkSize>;
+  __shared__ typename Reduce::TempStorage storage;
+  __shared__ float centre[3];
+  __shared__ float shared_radius, shared_scale, shared_opacity;
+  __shared__ int all_bounded;
+  const std::size_t i = static_cast<std::size_t>(blockIdx.x) * kChunkSize + threadIdx.x;
+  const bool valid = i < scene.count;
+  float4 po = make_float4(0, 0, 0, 0), q = make_float4(1, 0, 0, 0), sd = make_float4(0, 0, 0, 0);
+  if (valid) {
+    po = scene.position_opacity[i];
+    q = scene.rotation[i];
+    sd = scene.scale_dc_r[i];
+  }
+  const float q_norm2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+  const bool ok = !valid || (bounded(po.x) && bounded(po.y) && bounded(po.z) && bounded(po.w) && bounded(sd.x) &&
+                             bounded(sd.y) && bounded(sd.z) && fabsf(q_norm2 - 1.0f) <= 1e-3f);
+  if (threadIdx.x == 0) all_bounded = 1;
+  __syncthreads();
+  if (!ok) all_bounded = 0;
+
+  // The box of the centres (an invalid thread repeats the chunk's first Gaussian).
+  const float4 first = scene.position_opacity[static_cast<std::size_t>(blockIdx.x) * kChunkSize];
+  const float p[3] = {valid ? po.x : first.x, valid ? po.y : first.y, valid ? po.z : first.z};
+  for (int a = 0; a < 3; ++a) {
+    const float lo = Reduce(storage).Reduce(p[a], Smaller());
+    __syncthreads();
+    const float hi = Reduce(storage).Reduce(p[a], Larger());
+    __syncthreads();
+    if (threadIdx.x == 0) centre[a] = 0.5f * lo + 0.5f * hi;
+  }
+  __syncthreads();
+  double d2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double d = double(p[a]) - centre[a];
+    d2 += d * d;
+  }
+  const float radius = Reduce(storage).Reduce(static_cast<float>(sqrt(d2)), Larger());
+  __syncthreads();
+  const float scale = fmaxf(fabsf(sd.x), fmaxf(fabsf(sd.y), fabsf(sd.z)));
+  const float max_scale = Reduce(storage).Reduce(valid ? scale : 0.0f, Larger());
+  __syncthreads();
+  const float max_opacity = Reduce(storage).Reduce(valid ? po.w : 0.0f, Larger());
+  if (threadIdx.x == 0) {
+    shared_radius = radius;
+    shared_scale = max_scale;
+    shared_opacity = max_opacity;
+  }
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    ChunkBound b;
+    b.cx = centre[0];
+    b.cy = centre[1];
+    b.cz = centre[2];
+    // Rounded up: the float of a distance may be below the distance.
+    b.radius = shared_radius * (1.0f + 1e-6f) + 1e-30f;
+    b.max_scale = shared_scale;
+    b.max_opacity = shared_opacity;
+    b.cullable = all_bounded != 0 && bounded(b.radius) ? 1u : 0u;
+    b.pad = 0;
+    bounds[blockIdx.x] = b;
+  }
+}
+
+}  // namespace
+
+void launch_chunk_bounds(const DeviceScene& scene, ChunkBound* bounds, cudaStream_t stream) {
+  if (scene.count == 0) return;
+  const unsigned chunks = static_cast<unsigned>((scene.count + kChunkSize - 1) / kChunkSize);
+  chunk_bounds_kernel<<<chunks, kChunkSize, 0, stream>>>(scene, bounds);
+  check_cuda(cudaGetLastError(), "chunk bounds kernel launch");
+}
+
+}  // namespace cuda
+}  // namespace flashgs
