@@ -1,9 +1,14 @@
-// The bounds of every chunk of 256 consecutive Gaussians, computed once per scene on the device.
+// Chunk culling: the bounds of every chunk of 256 consecutive Gaussians (once per scene, on
+// the device) and the per-frame constants of the test in chunk_cull.cuh.
 #include <math.h>
 
 #include <cub/block/block_reduce.cuh>
 
+#include <algorithm>
+#include <cmath>
+
 #include "device_common.cuh"
+#include "flashgs/model_constants.h"
 #include "pipeline.h"
 
 namespace flashgs {
@@ -26,7 +31,7 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
   using Reduce = cub::BlockReduce<float, kChunkSize>;
   __shared__ typename Reduce::TempStorage storage;
   __shared__ float centre[3];
-  __shared__ float shared_radius, shared_scale, shared_opacity;
+  __shared__ float shared_radius, shared_scale;
   __shared__ int all_bounded;
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * kChunkSize + threadIdx.x;
   const bool valid = i < scene.count;
@@ -63,12 +68,9 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
   __syncthreads();
   const float scale = fmaxf(fabsf(sd.x), fmaxf(fabsf(sd.y), fabsf(sd.z)));
   const float max_scale = Reduce(storage).Reduce(valid ? scale : 0.0f, Larger());
-  __syncthreads();
-  const float max_opacity = Reduce(storage).Reduce(valid ? po.w : 0.0f, Larger());
   if (threadIdx.x == 0) {
     shared_radius = radius;
     shared_scale = max_scale;
-    shared_opacity = max_opacity;
   }
   __syncthreads();
   if (threadIdx.x == 0) {
@@ -79,14 +81,41 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
     // Rounded up: the float of a distance may be below the distance.
     b.radius = shared_radius * (1.0f + 1e-6f) + 1e-30f;
     b.max_scale = shared_scale;
-    b.max_opacity = shared_opacity;
     b.cullable = all_bounded != 0 && bounded(b.radius) ? 1u : 0u;
-    b.pad = 0;
     bounds[blockIdx.x] = b;
   }
 }
 
 }  // namespace
+
+ChunkCullFrame chunk_cull_frame(const gm::CameraParams& cam, const gm::GeometryParams& geo, float max_opacity) {
+  const double tau = geo.tau > 0.0f ? geo.tau : 1.0;
+  const double s = std::sqrt(std::max(9.0, 2.0 * std::log(std::max(1.0, double(max_opacity)) / tau)));
+  // The Jacobian's directions are clamped to the frustum widened by kFrustumMargin.
+  const double margin_x = model::kFrustumMargin * cam.width, margin_y = model::kFrustumMargin * cam.height;
+  const double tx = std::max(std::abs(cam.cx + 0.5 + margin_x), std::abs(cam.width - 0.5 - cam.cx + margin_x)) / cam.fx;
+  const double ty = std::max(std::abs(cam.cy + 0.5 + margin_y), std::abs(cam.height - 0.5 - cam.cy + margin_y)) / cam.fy;
+  const double k = 1.01 * std::sqrt(double(cam.fx) * cam.fx * (1.0 + tx * tx) + double(cam.fy) * cam.fy * (1.0 + ty * ty));
+  const double pad = 3.0 + 0.79 * s;  // pixels: ceil (1), dilation and floor (0.79 s), rounding (2)
+  const double right = double(gm::kTileSize) * cam.tiles_x + pad - cam.cx;
+  const double bottom = double(gm::kTileSize) * cam.tiles_y + pad - cam.cy;
+  const double normals[4][3] = {{cam.fx, 0.0, -right},
+                                {-double(cam.fx), 0.0, -(cam.cx + pad)},
+                                {0.0, cam.fy, -bottom},
+                                {0.0, -double(cam.fy), -(cam.cy + pad)}};
+  ChunkCullFrame f{};
+  for (int e = 0; e < 4; ++e) {
+    double length2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      f.edge_normal[e][a] = static_cast<float>(normals[e][a]);
+      length2 += normals[e][a] * normals[e][a];
+    }
+    f.edge_normal_length[e] = static_cast<float>(std::sqrt(length2) * (1.0 + 1e-6));
+  }
+  f.reach_per_sigma = static_cast<float>(1.001 * s * k);
+  f.jacobian_bound = static_cast<float>(k);
+  return f;
+}
 
 void launch_chunk_bounds(const DeviceScene& scene, ChunkBound* bounds, cudaStream_t stream) {
   if (scene.count == 0) return;

@@ -327,6 +327,8 @@ class CudaRendererImpl final : public CudaRenderer {
       radius2 = std::max(radius2, d2);
     }
     bounds_radius_ = std::sqrt(radius2);
+    max_opacity_ = 1.0f;  // a sigmoid's; a scene built in code may hold more (NaN is never culled by chunk)
+    for (std::size_t i = 0; i < n; ++i) max_opacity_ = std::max(max_opacity_, scene.opacities[i]);
   }
 
   double distance_to_bounds_centre(const gm::CameraParams& cam) const {
@@ -487,6 +489,7 @@ class CudaRendererImpl final : public CudaRenderer {
     args.sh_degree = std::max(0, std::min(device_scene_.sh_degree, options.sh_degree_cap));
     args.large_box_tiles = large_box_tiles_;
     args.chunk_cull = !baseline && chunk_cull_;
+    if (args.chunk_cull) args.chunk_frame = cuda::chunk_cull_frame(cam, args.geometry, max_opacity_);
 
     // project (+ fused emit), then the frame's one read back: the pair count. Fused emission
     // that overflowed wrote nothing past the capacity; grow and run it again.
@@ -624,6 +627,7 @@ class CudaRendererImpl final : public CudaRenderer {
   cuda::KeyFormat key_format_;           // this frame's
   double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
   double bounds_radius_ = 0;
+  float max_opacity_ = 1.0f;             // of the scene (sets the flash extent's largest threshold)
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.

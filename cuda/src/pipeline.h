@@ -32,11 +32,27 @@ constexpr int kChunkSize = 256;
 // matrix would not be a rotation, and the footprint bound assumes one).
 struct ChunkBound {
   float cx, cy, cz, radius;
-  float max_scale;    // largest |scale| of the chunk
-  float max_opacity;  // largest opacity (sets the flash extent in sigmas)
+  float max_scale;  // largest |scale| of the chunk
   unsigned cullable;
-  unsigned pad;
 };
+
+// The per-frame constants of the chunk test (chunk_outside_view), from chunk_cull_frame().
+// Proof that a chunk passing it has no Gaussian on the image: a flash footprint's half-width
+// is at most s sqrt(lambda_max + 0.3 + 0.32) + 1 pixels (dilation, spread floor, ceil) with
+// s^2 = max(9, 2 ln(o_max / tau)) the largest threshold, and lambda_max <= (K sigma / z)^2
+// for K >= ||J||_F over the clamped frustum directions (1% more for quaternions within 1e-3
+// of unit norm). So the box misses the right edge when fx x - (16 tiles_x + pad - cx) z >
+// s K sigma (z > 0), likewise for the other edges: n.v > reach with n an edge normal below.
+// Over a ball of centres the left side is smallest at its centre minus |n| radius. The pad
+// (2 pixels more) and the slack of the device test cover float rounding in the projection.
+struct ChunkCullFrame {
+  float edge_normal[4][3];     // view space: right, left, bottom, top edges, pointing out
+  float edge_normal_length[4];
+  float reach_per_sigma;       // s K
+  float jacobian_bound;        // K
+};
+// The constants for camera `cam` and flash geometry `geo`; `max_opacity` of the scene.
+ChunkCullFrame chunk_cull_frame(const gm::CameraParams& cam, const gm::GeometryParams& geo, float max_opacity);
 
 // The scene on the device, in a compact layout sized to its SH degree (56 bytes per Gaussian
 // for degree 0, plus 48/96/192 bytes of higher bands for degree 1/2/3).
@@ -133,6 +149,7 @@ struct PreprocessArgs {
   int sh_degree;        // bands evaluated (the scene's, capped)
   int large_box_tiles;  // boxes of more tiles go to the warp-cooperative path
   bool chunk_cull;      // skip chunks outside the view (flash geometry only)
+  ChunkCullFrame chunk_frame;
 };
 
 // Fills the scene's chunk bounds (once per scene).

@@ -261,7 +261,7 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   __shared__ bool chunk_outside;
   if (threadIdx.x < gm::kCullReasonCount) block_counts[threadIdx.x] = 0;
   if (threadIdx.x == 0)
-    chunk_outside = args.chunk_cull && chunk_outside_view(scene.chunks[blockIdx.x], args.camera, args.geometry);
+    chunk_outside = args.chunk_cull && chunk_outside_view(scene.chunks[blockIdx.x], args.camera, args.chunk_frame);
   __syncthreads();
 
   const unsigned i = blockIdx.x * kBlock + threadIdx.x;
