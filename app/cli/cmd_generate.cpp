@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "atomic_write.h"
 #include "commands.h"
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
@@ -26,25 +27,6 @@ struct GenerateArgs {
 };
 
 namespace fs = std::filesystem;
-
-// Writes `path` through a temporary file beside it, renamed over it once complete: a failed
-// or interrupted write leaves the old file (for `tile`, possibly its own source) intact.
-template <class Write>
-void write_atomically(const std::string& path, Write&& write) {
-  const std::string partial = path + ".partial";
-  std::error_code ec;
-  try {
-    write(partial);
-  } catch (...) {
-    fs::remove(partial, ec);
-    throw;
-  }
-  fs::rename(partial, path, ec);
-  if (ec) {
-    fs::remove(partial, ec);
-    throw Error(path + ": cannot replace it (" + ec.message() + ")");
-  }
-}
 
 // Refuses, before any work, an output folder that already holds a scene (unless --force).
 void check_output_scene(const GenerateArgs& args) {
