@@ -75,8 +75,10 @@ std::vector<unsigned char> to_8_bit(const Image& image) {
 TEST(SceneFormats, UnknownContentGetsOneLineNamingTheFile) {
   const std::string path = scratch_file("picture.gif");
   write_file(path, "GIF89a\x01\x02 and more");
-  EXPECT_EQ(error_of([&] { load_scene_file(path); }),
+  LoadProgress progress;
+  EXPECT_EQ(error_of([&] { load_scene_file(path, nullptr, &progress); }),
             path + ": not a scene file: it starts with \"GIF89a\\x01\\x02\"; expected a PLY, .splat, .spz or SOG");
+  EXPECT_EQ(progress.bytes_total.load(), 0u) << "recognised from its first bytes, not read whole";
   const std::string empty = scratch_file("empty.bin");
   write_file(empty, "");
   EXPECT_EQ(error_of([&] { load_scene_file(empty); }),

@@ -8,6 +8,7 @@
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
+#include "flashgs/scene_formats.h"
 #include "flashgs/stress_scenes.h"
 #include "option_checks.h"
 #include "scene_source.h"
@@ -56,7 +57,7 @@ void run(const GenerateArgs& args) {
     write_scene(scene, make_orbit_cameras(target, up, 3.2f, 1.4f, 36, 1280, 720, 60.0f), args.output_dir);
   } else if (args.kind == "tile") {
     if (args.input.empty()) throw Error("generate tile: give the scene to copy with --input");
-    const Scene source = load_ply(args.input);
+    const Scene source = load_scene_file(args.input);
     const Scene scene = tile_scene(source, args.copies);
     // The source's cameras, pushed back from the grid centre so that the whole grid is in
     // view and every copy costs work (the grid is centred where the source was).

@@ -79,6 +79,24 @@ struct FileDescriptor {
   ~FileDescriptor() { ::close(fd); }
 };
 
+// Opens the regular file at `path` for reading, checked before and after opening; `st` is its status.
+int open_regular(const std::string& path, struct stat* st) {
+  check_regular(path, stat_or_fail(path).st_mode);
+  // O_NONBLOCK: should the path become a FIFO after the check, open() still returns at once.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) fail_to_open(path, errno);
+  if (::fstat(fd, st) != 0) {
+    const int error = errno;
+    ::close(fd);
+    fail_to_open(path, error);
+  }
+  if (!S_ISREG(st->st_mode)) {
+    ::close(fd);
+    check_regular(path, st->st_mode);  // throws
+  }
+  return fd;
+}
+
 }  // namespace
 
 PathKind path_kind(const std::string& path) {
@@ -90,14 +108,18 @@ PathKind path_kind(const std::string& path) {
 
 void check_regular_file(const std::string& path) { check_regular(path, stat_or_fail(path).st_mode); }
 
-std::vector<char> read_regular_file(const std::string& path, std::size_t max_bytes, LoadProgress* progress) {
-  check_regular_file(path);
-  // O_NONBLOCK: should the path become a FIFO after the check, open() still returns at once.
-  const FileDescriptor file{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)};
-  if (file.fd < 0) fail_to_open(path, errno);
+std::vector<char> read_file_start(const std::string& path, std::size_t max_bytes) {
   struct stat st {};
-  if (::fstat(file.fd, &st) != 0) fail_to_open(path, errno);
-  check_regular(path, st.st_mode);
+  const FileDescriptor file{open_regular(path, &st)};
+  // Not sized by st_size: files of /proc and the like report 0 yet have content.
+  std::vector<char> bytes(max_bytes);
+  bytes.resize(read_fully(path, file.fd, bytes.data(), bytes.size()));
+  return bytes;
+}
+
+std::vector<char> read_regular_file(const std::string& path, std::size_t max_bytes, LoadProgress* progress) {
+  struct stat st {};
+  const FileDescriptor file{open_regular(path, &st)};
   const auto size = static_cast<std::size_t>(st.st_size);
   if (size > max_bytes) fail(path, "the file is " + megabytes(size) + ", more than the " + megabytes(max_bytes) +
                                        " this kind of file may have");

@@ -18,20 +18,23 @@
 namespace flashgs {
 namespace {
 
-// What a recogniser sees: the file's name and its first bytes (all of them for small files).
+// What a recogniser sees: the file's name and its first kStartBytes (all of them for small files).
 struct FileStart {
   const std::string& name;
   std::string_view bytes;
-  std::size_t file_size;
 };
 
 using Recogniser = bool (*)(const FileStart&);
 using Parser = Scene (*)(const char*, std::size_t, const std::string&, LoadReport&, LoadProgress*);
+using PathReader = Scene (*)(const std::string&, LoadReport&, LoadProgress*);
 
+// A format parses the file's bytes, or (when its file names others beside it, as SOG's
+// meta.json does) reads from the path itself; exactly one of the two is set.
 struct FormatReader {
   SceneFormat format;
   Recogniser recognises;
   Parser parse;
+  PathReader read = nullptr;
 };
 
 // Bytes a recogniser may look at: more than any PLY header of a Gaussian scene.
@@ -78,10 +81,26 @@ const FormatReader kReaders[] = {
     {SceneFormat::splat, is_splat, parse_splat},
 };
 
+double seconds_since(std::chrono::steady_clock::time_point began) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+}
+
 // "it starts with "GIF89a"", or "it is empty".
 std::string describe_start(const FileStart& f) {
   if (f.bytes.empty()) return "it is empty";
   return "it starts with \"" + printable_file_text(f.bytes.substr(0, 8)) + "\"";
+}
+
+// The first reader that recognises the file; throws the one "not a scene file" line otherwise.
+const FormatReader& recognise(const FileStart& start) {
+  for (const FormatReader& reader : kReaders)
+    if (reader.recognises(start)) return reader;
+  throw Error(start.name + ": not a scene file: " + describe_start(start) + "; expected a PLY, .splat, .spz or SOG");
+}
+
+void note_format(LoadReport& report, SceneFormat format) {
+  report.format = format_name(format);
+  report.quantisation = format_quantisation(format);
 }
 
 }  // namespace
@@ -115,18 +134,34 @@ Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& n
                         LoadProgress* progress) {
   LoadReport local_report;
   if (!report) report = &local_report;
-  const FileStart start{name, std::string_view(data, std::min(size, kStartBytes)), size};
-  for (const FormatReader& reader : kReaders) {
-    if (!reader.recognises(start)) continue;
-    const auto began = std::chrono::steady_clock::now();
-    Scene scene = reader.parse(data, size, name, *report, progress);
-    report->decode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-    report->format = format_name(reader.format);
-    report->quantisation = format_quantisation(reader.format);
+  const FormatReader& reader = recognise({name, std::string_view(data, std::min(size, kStartBytes))});
+  if (!reader.parse)
+    throw Error(name + ": " + format_name(reader.format) + " reads the files beside this one: open it by its path");
+  const auto began = std::chrono::steady_clock::now();
+  Scene scene = reader.parse(data, size, name, *report, progress);
+  report->decode_seconds = seconds_since(began);
+  note_format(*report, reader.format);
+  return scene;
+}
+
+Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress* progress) {
+  LoadReport local_report;
+  if (!report) report = &local_report;
+  // Recognised from its start first: a file of no known format is not read whole.
+  const std::vector<char> start = read_file_start(path, kStartBytes);
+  const FormatReader& reader = recognise({path, std::string_view(start.data(), start.size())});
+  const auto began = std::chrono::steady_clock::now();
+  if (reader.read) {  // reading and decoding interleave: all of it counts as decoding
+    Scene scene = reader.read(path, *report, progress);
+    report->decode_seconds = seconds_since(began);
+    note_format(*report, reader.format);
     return scene;
   }
-  throw Error(name + ": not a scene file: " + describe_start(start) +
-              "; expected a PLY, .splat, .spz or SOG");
+  const std::vector<char> bytes = read_regular_file(path, std::numeric_limits<std::size_t>::max(), progress);
+  const double read_seconds = seconds_since(began);
+  Scene scene = parse_scene_bytes(bytes.data(), bytes.size(), path, report, progress);
+  report->read_seconds = read_seconds;
+  return scene;
 }
 
 SceneWriter scene_writer_for(const std::string& path) {
@@ -136,16 +171,5 @@ SceneWriter scene_writer_for(const std::string& path) {
 }
 
 const char* writable_scene_extensions() { return ".ply (INRIA PLY) or .splat"; }
-
-Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress* progress) {
-  LoadReport local_report;
-  if (!report) report = &local_report;
-  const auto began = std::chrono::steady_clock::now();
-  const std::vector<char> bytes = read_regular_file(path, std::numeric_limits<std::size_t>::max(), progress);
-  const double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-  Scene scene = parse_scene_bytes(bytes.data(), bytes.size(), path, report, progress);
-  report->read_seconds = read_seconds;
-  return scene;
-}
 
 }  // namespace flashgs

@@ -30,4 +30,8 @@ std::vector<char> read_regular_file(const std::string& path,
                                     std::size_t max_bytes = std::numeric_limits<std::size_t>::max(),
                                     LoadProgress* progress = nullptr);
 
+// The first `max_bytes` of the regular file at `path` (all of it when shorter), checked and
+// opened as above: what a format recogniser looks at before the whole file is read.
+std::vector<char> read_file_start(const std::string& path, std::size_t max_bytes);
+
 }  // namespace flashgs
