@@ -17,6 +17,7 @@
 
 #include "flashgs/demo_scene.h"
 #include "flashgs/io.h"
+#include "format_builders.h"
 #include "ply_builder.h"
 #include "test_support.h"
 
@@ -243,6 +244,55 @@ TEST(CliGenerate, CountMustBePositive) {
     expect_one_line_error(run_cli(std::string("generate demo --count ") + count + " -o " + dir), "--count", count);
     EXPECT_FALSE(fs::exists(dir + "/point_cloud.ply")) << count;
   }
+}
+
+TEST(CliConvert, ConvertsBetweenTheFormats) {
+  const std::string dir = scratch_dir("convert");
+  ASSERT_EQ(run_cli("generate demo --count 300 -o " + dir).exit_code, 0);
+  const std::string ply = dir + "/point_cloud.ply", splat = dir + "/scene.splat", back = dir + "/back.ply";
+  const CliResult to_splat = run_cli("convert " + ply + " " + splat);
+  ASSERT_EQ(to_splat.exit_code, 0) << to_splat.output;
+  EXPECT_NE(to_splat.output.find("(INRIA PLY, 300 Gaussians"), std::string::npos) << to_splat.output;
+  EXPECT_EQ(fs::file_size(splat), 300u * 32);
+  const CliResult to_ply = run_cli("convert " + splat + " " + back);
+  ASSERT_EQ(to_ply.exit_code, 0) << to_ply.output;
+  EXPECT_NE(to_ply.output.find("(.splat (antimatter15), 300 Gaussians"), std::string::npos) << to_ply.output;
+  // Positions are float32 in all three files.
+  EXPECT_EQ(load_ply(back).positions, load_ply(ply).positions);
+  for (const auto& entry : fs::directory_iterator(dir))
+    EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
+}
+
+TEST(CliConvert, BadOutputsAreRefusedBeforeReading) {
+  const std::string dir = scratch_dir("convert_bad");
+  ASSERT_EQ(run_cli("generate demo --count 300 -o " + dir).exit_code, 0);
+  const std::string ply = dir + "/point_cloud.ply";
+  const auto size = fs::file_size(ply);
+  expect_one_line_error(run_cli("convert " + ply + " " + dir + "/out.obj"),
+                        "OUT " + dir + "/out.obj: unknown scene format (the extension picks it: .ply (INRIA PLY) or "
+                        ".splat)", "unknown extension");
+  EXPECT_FALSE(fs::exists(dir + "/out.obj"));
+  expect_one_line_error(run_cli("convert " + ply + " " + ply), "is the input file itself", "same path");
+  expect_one_line_error(run_cli("convert " + ply + " " + dir + "/../convert_bad/point_cloud.ply --force"),
+                        "is the input file itself", "same file by another path");
+  EXPECT_EQ(fs::file_size(ply), size);
+  std::ofstream(dir + "/old.splat") << "keep";
+  expect_one_line_error(run_cli("convert " + ply + " " + dir + "/old.splat"), "already exists (give --force",
+                        "existing output");
+  EXPECT_EQ(fs::file_size(dir + "/old.splat"), 4u);
+}
+
+TEST(CliInfo, ShowsTheFormatItsQuantisationAndTheDecodeTime) {
+  const std::string dir = scratch_dir("info_format");
+  const std::string path = dir + "/scene.compressed.ply";
+  const std::string bytes = test::compressed_ply_bytes(600, 1);
+  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const CliResult r = run_cli("info " + path);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("format:          PlayCanvas compressed PLY\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("in 256-Gaussian chunks"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(", decoded in "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("gaussians:       600\n"), std::string::npos) << r.output;
 }
 
 }  // namespace

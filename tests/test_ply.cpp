@@ -378,7 +378,7 @@ TEST(PlyMalformed, CommandLineExitsNonZeroWithTheMessage) {
       {"all_nan", all_nan.bytes(), "NaN or Inf"},
       {"ascii_count_mismatch", ascii_too_many.bytes(), "declares 9 vertices but more data follows"},
       {"trailing_bytes", trailing_bytes.bytes(), "the element counts do not match the file size"},
-      {"not_ply", "GIF89a....", "not a PLY file"}};
+      {"not_ply", "GIF89a....", "not a scene file: it starts with \"GIF89a"}};
   for (const auto& [name, bytes, fragment] : cases) {
     const std::string ply = dir + "/" + name + ".ply";
     std::ofstream(ply, std::ios::binary) << bytes;

@@ -16,6 +16,11 @@ std::string shared_scene_dir(const std::string& name) {
   return std::filesystem::exists(dir / "point_cloud.ply") ? dir.string() : std::string();
 }
 
+std::string shared_format_file(const std::string& file) {
+  const std::filesystem::path path = std::filesystem::path(FLASHGS_SHARED_SCENES) / "formats" / file;
+  return std::filesystem::exists(path) ? path.string() : std::string();
+}
+
 std::vector<std::string> shared_scene_names() {
   std::vector<std::string> names;
   for (const char* name : {"pc_biker", "pc_guitar", "v3dg_donut", "kacytran_try", "pc_playbot"})

@@ -13,6 +13,9 @@ namespace flashgs::test {
 
 // ../shared/scenes/<name>; empty when the folder is absent.
 std::string shared_scene_dir(const std::string& name);
+// ../shared/scenes/formats/<file> (the compressed samples: biker.compressed.ply, biker.spz,
+// playbot_sog, ...); empty when it is absent.
+std::string shared_format_file(const std::string& file);
 // Names of the real scenes present (pc_biker, pc_guitar, ...); empty when none.
 std::vector<std::string> shared_scene_names();
 // Loads (once per process) the scene and its cameras.

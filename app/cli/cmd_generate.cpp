@@ -3,10 +3,12 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "atomic_write.h"
 #include "commands.h"
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
+#include "flashgs/scene_formats.h"
 #include "flashgs/stress_scenes.h"
 #include "option_checks.h"
 #include "scene_source.h"
@@ -26,25 +28,6 @@ struct GenerateArgs {
 };
 
 namespace fs = std::filesystem;
-
-// Writes `path` through a temporary file beside it, renamed over it once complete: a failed
-// or interrupted write leaves the old file (for `tile`, possibly its own source) intact.
-template <class Write>
-void write_atomically(const std::string& path, Write&& write) {
-  const std::string partial = path + ".partial";
-  std::error_code ec;
-  try {
-    write(partial);
-  } catch (...) {
-    fs::remove(partial, ec);
-    throw;
-  }
-  fs::rename(partial, path, ec);
-  if (ec) {
-    fs::remove(partial, ec);
-    throw Error(path + ": cannot replace it (" + ec.message() + ")");
-  }
-}
 
 // Refuses, before any work, an output folder that already holds a scene (unless --force).
 void check_output_scene(const GenerateArgs& args) {
@@ -74,7 +57,7 @@ void run(const GenerateArgs& args) {
     write_scene(scene, make_orbit_cameras(target, up, 3.2f, 1.4f, 36, 1280, 720, 60.0f), args.output_dir);
   } else if (args.kind == "tile") {
     if (args.input.empty()) throw Error("generate tile: give the scene to copy with --input");
-    const Scene source = load_ply(args.input);
+    const Scene source = load_scene_file(args.input);
     const Scene scene = tile_scene(source, args.copies);
     // The source's cameras, pushed back from the grid centre so that the whole grid is in
     // view and every copy costs work (the grid is centred where the source was).

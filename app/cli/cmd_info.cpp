@@ -2,7 +2,7 @@
 #include <cstdio>
 
 #include "commands.h"
-#include "flashgs/io.h"
+#include "flashgs/scene_formats.h"
 #include "flashgs/scene_summary.h"
 #include "scene_source.h"
 
@@ -14,7 +14,7 @@ void register_info(CLI::App& app) {
   args->add_to(sub);
   sub->callback([args] {
     LoadReport report;
-    const Scene scene = load_ply(args->resolved_scene(), &report);
+    const Scene scene = load_scene_file(args->resolved_scene(), &report);
     std::printf("%s", summarize_scene(scene, &report).c_str());
   });
 }

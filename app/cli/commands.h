@@ -7,6 +7,7 @@ namespace flashgs::cli {
 
 void register_render(CLI::App& app);
 void register_info(CLI::App& app);
+void register_convert(CLI::App& app);
 void register_generate(CLI::App& app);
 void register_bench(CLI::App& app);
 void register_check(CLI::App& app);

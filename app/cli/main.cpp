@@ -1,4 +1,4 @@
-// flashgs: render, inspect, generate, benchmark and check 3D Gaussian Splatting scenes.
+// flashgs: render, inspect, convert, generate, benchmark and check 3D Gaussian Splatting scenes.
 #include <cstdio>
 #include <new>
 
@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("error: ") + e.what() + "\n"; });
   flashgs::cli::register_render(app);
   flashgs::cli::register_info(app);
+  flashgs::cli::register_convert(app);
   flashgs::cli::register_generate(app);
   flashgs::cli::register_bench(app);
   flashgs::cli::register_check(app);

@@ -15,8 +15,9 @@ namespace flashgs::cli {
 
 void SceneArgs::add_to(CLI::App* command) {
   m_scene_option = command->add_option("scene", scene_path,
-                                       "3DGS PLY file, a folder holding point_cloud.ply, or a 3DGS training output "
-                                       "folder (default: the bundled demo scene)");
+                                       "scene file (INRIA or PlayCanvas compressed PLY, .splat), a folder holding "
+                                       "point_cloud.ply, or a 3DGS training output folder (default: the bundled "
+                                       "demo scene)");
   m_cameras_option = command->add_option("--cameras", cameras_path, "cameras.json (default: the scene's own)");
 }
 

@@ -5,10 +5,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
 #include "flashgs/error.h"
+#include "flashgs/load_progress.h"
 
 namespace flashgs {
 namespace {
@@ -49,15 +51,24 @@ struct stat stat_or_fail(const std::string& path) {
 
 std::string megabytes(std::size_t bytes) { return std::to_string(bytes / 1000000 + (bytes % 1000000 != 0)) + " MB"; }
 
-// Reads until `size` bytes or the end of the file; returns the bytes read.
-std::size_t read_fully(const std::string& path, int fd, char* into, std::size_t size) {
+// Bytes read between two progress reports: small enough that a progress bar moves, large
+// enough that the checks cost nothing.
+constexpr std::size_t kProgressChunk = 4 << 20;
+
+// Reads until `size` bytes or the end of the file; returns the bytes read. With `progress`,
+// in chunks, reporting after each and stopping on a cancel request.
+std::size_t read_fully(const std::string& path, int fd, char* into, std::size_t size,
+                       LoadProgress* progress = nullptr) {
   std::size_t filled = 0;
   while (filled < size) {
-    const ssize_t n = ::read(fd, into + filled, size - filled);
+    if (progress && progress->cancel_requested.load(std::memory_order_relaxed)) throw LoadCancelled(path);
+    const std::size_t want = progress ? std::min(size - filled, kProgressChunk) : size - filled;
+    const ssize_t n = ::read(fd, into + filled, want);
     if (n == 0) break;
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) fail(path, std::string("read error: ") + std::strerror(errno));
     filled += static_cast<std::size_t>(n);
+    if (progress) progress->bytes_done.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
   }
   return filled;
 }
@@ -67,6 +78,24 @@ struct FileDescriptor {
   int fd;
   ~FileDescriptor() { ::close(fd); }
 };
+
+// Opens the regular file at `path` for reading, checked before and after opening; `st` is its status.
+int open_regular(const std::string& path, struct stat* st) {
+  check_regular(path, stat_or_fail(path).st_mode);
+  // O_NONBLOCK: should the path become a FIFO after the check, open() still returns at once.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) fail_to_open(path, errno);
+  if (::fstat(fd, st) != 0) {
+    const int error = errno;
+    ::close(fd);
+    fail_to_open(path, error);
+  }
+  if (!S_ISREG(st->st_mode)) {
+    ::close(fd);
+    check_regular(path, st->st_mode);  // throws
+  }
+  return fd;
+}
 
 }  // namespace
 
@@ -79,30 +108,39 @@ PathKind path_kind(const std::string& path) {
 
 void check_regular_file(const std::string& path) { check_regular(path, stat_or_fail(path).st_mode); }
 
-std::vector<char> read_regular_file(const std::string& path, std::size_t max_bytes) {
-  check_regular_file(path);
-  // O_NONBLOCK: should the path become a FIFO after the check, open() still returns at once.
-  const FileDescriptor file{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)};
-  if (file.fd < 0) fail_to_open(path, errno);
+std::vector<char> read_file_start(const std::string& path, std::size_t max_bytes) {
   struct stat st {};
-  if (::fstat(file.fd, &st) != 0) fail_to_open(path, errno);
-  check_regular(path, st.st_mode);
+  const FileDescriptor file{open_regular(path, &st)};
+  // Not sized by st_size: files of /proc and the like report 0 yet have content.
+  std::vector<char> bytes(max_bytes);
+  bytes.resize(read_fully(path, file.fd, bytes.data(), bytes.size()));
+  return bytes;
+}
+
+std::vector<char> read_regular_file(const std::string& path, std::size_t max_bytes, LoadProgress* progress) {
+  struct stat st {};
+  const FileDescriptor file{open_regular(path, &st)};
   const auto size = static_cast<std::size_t>(st.st_size);
   if (size > max_bytes) fail(path, "the file is " + megabytes(size) + ", more than the " + megabytes(max_bytes) +
                                        " this kind of file may have");
+  if (progress) {
+    progress->bytes_done.store(0, std::memory_order_relaxed);
+    progress->bytes_total.store(size, std::memory_order_relaxed);
+  }
   std::vector<char> bytes(size);
-  const std::size_t filled = read_fully(path, file.fd, bytes.data(), size);
+  const std::size_t filled = read_fully(path, file.fd, bytes.data(), size, progress);
   if (filled < size) {  // the file shrank since fstat
     bytes.resize(filled);
     return bytes;
   }
   // Files of /proc and the like report size 0 yet have content, and a file may have grown.
   char chunk[1 << 16];
-  while (const std::size_t n = read_fully(path, file.fd, chunk, sizeof chunk)) {
+  while (const std::size_t n = read_fully(path, file.fd, chunk, sizeof chunk, progress)) {
     if (n > max_bytes - bytes.size())
       fail(path, "the file holds more than the " + megabytes(max_bytes) + " this kind of file may have");
     bytes.insert(bytes.end(), chunk, chunk + n);
   }
+  if (progress) progress->bytes_total.store(bytes.size(), std::memory_order_relaxed);
   return bytes;
 }
 

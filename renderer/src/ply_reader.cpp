@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -16,167 +15,16 @@
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
 #include "flashgs/io.h"
+#include "format_readers.h"
+#include "ply_header.h"
 
 namespace flashgs {
 namespace {
 
-enum class Format { binary_little_endian, binary_big_endian, ascii };
-
-struct Property {
-  std::string name;
-  std::string type;  // canonical: char uchar short ushort int uint float double, or "list"
-  int size = 0;      // bytes in binary formats (of one item, for a list)
-  int kind = 0;      // index into kTypeNames, so the per-value read does no string compares
-  int count_size = 0, count_kind = 0;  // a list's item count: its bytes and type
-  std::size_t offset = 0;  // byte offset inside one binary record (elements without lists)
-  bool is_list() const { return count_size != 0; }
-};
-
-struct Element {
-  std::string name;
-  std::size_t count = 0;
-  std::vector<Property> properties;
-  std::size_t record_size = 0;  // bytes of the properties that are not lists
-  bool has_list() const {
-    return std::any_of(properties.begin(), properties.end(), [](const Property& p) { return p.is_list(); });
-  }
-};
-
-// Largest header we accept; real headers are about 2 KB.
-constexpr std::size_t kMaxHeaderBytes = 1 << 20;
-constexpr const char* kCrOnlyLines = "the header has lines ending in CR alone; PLY header lines end in LF or CR LF";
-
-const char* const kTypeNames[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double"};
-
-int type_kind(const std::string& type) {
-  for (int i = 0; i < 8; ++i)
-    if (type == kTypeNames[i]) return i;
-  return -1;
-}
-
-int type_size(const std::string& type) {
-  if (type == "char" || type == "uchar") return 1;
-  if (type == "short" || type == "ushort") return 2;
-  if (type == "int" || type == "uint" || type == "float") return 4;
-  if (type == "double") return 8;
-  return 0;
-}
-
-// PLY allows both the classic and the sized type names.
-std::string canonical_type(const std::string& type) {
-  static const std::map<std::string, std::string> aliases = {
-      {"int8", "char"},   {"uint8", "uchar"},  {"int16", "short"},   {"uint16", "ushort"},
-      {"int32", "int"},   {"uint32", "uint"},  {"float32", "float"}, {"float64", "double"}};
-  const auto it = aliases.find(type);
-  return it == aliases.end() ? type : it->second;
-}
+using namespace ply;
 
 [[noreturn]] void fail(const std::string& name, const std::string& problem) {
   throw Error(name + ": " + problem);
-}
-
-// File text inside a message: quoted, escaped and cut short.
-std::string quoted(std::string_view text) { return "\"" + printable_file_text(text) + "\""; }
-
-struct Header {
-  Format format = Format::binary_little_endian;
-  std::vector<Element> elements;
-  std::size_t data_offset = 0;  // first byte after "end_header\n"
-};
-
-Header parse_header(const char* data, std::size_t size, const std::string& name) {
-  Header header;
-  if (size == 0) fail(name, "not a PLY file (it is empty)");
-  if (size < 4 || std::memcmp(data, "ply", 3) != 0 || (data[3] != '\n' && data[3] != '\r'))
-    fail(name, "not a PLY file (it does not start with \"ply\")");
-  if (data[3] == '\r' && (size < 5 || data[4] != '\n'))
-    fail(name, kCrOnlyLines);
-  const std::size_t limit = std::min(size, kMaxHeaderBytes);
-  std::size_t pos = 0;
-  bool saw_format = false, saw_end = false;
-  int line_number = 0;
-  while (pos < limit) {
-    std::size_t eol = pos;
-    while (eol < limit && data[eol] != '\n') ++eol;
-    if (eol == limit) break;
-    std::string line(data + pos, eol - pos);
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find('\r') != std::string::npos)
-      fail(name, kCrOnlyLines);
-    pos = eol + 1;
-    ++line_number;
-    std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
-    if (line_number == 1) continue;  // "ply"
-    if (keyword == "format") {
-      std::string format, version;
-      words >> format >> version;
-      if (format == "binary_little_endian") header.format = Format::binary_little_endian;
-      else if (format == "binary_big_endian") header.format = Format::binary_big_endian;
-      else if (format == "ascii") header.format = Format::ascii;
-      else fail(name, "unknown PLY format " + quoted(format));
-      saw_format = true;
-    } else if (keyword == "comment" || keyword == "obj_info" || keyword.empty()) {
-      continue;
-    } else if (keyword == "element") {
-      Element element;
-      std::string count_text;
-      words >> element.name >> count_text;
-      if (element.name.empty() || count_text.empty() ||
-          count_text.find_first_not_of("0123456789") != std::string::npos ||
-          count_text.size() > 19)
-        fail(name, "header line " + std::to_string(line_number) + ": bad element line " + quoted(line));
-      element.count = std::stoull(count_text);
-      header.elements.push_back(element);
-    } else if (keyword == "property") {
-      if (header.elements.empty())
-        fail(name, "header line " + std::to_string(line_number) + ": property before any element");
-      std::string type, prop_name;
-      words >> type;
-      Property property;
-      if (type == "list") {
-        std::string count_type, item_type;
-        words >> count_type >> item_type >> prop_name;
-        count_type = canonical_type(count_type);
-        item_type = canonical_type(item_type);
-        property.type = "list";
-        property.count_size = type_size(count_type);
-        property.count_kind = type_kind(count_type);
-        property.size = type_size(item_type);
-        property.kind = type_kind(item_type);
-        if (property.count_size == 0 || property.count_kind > 5 || property.size == 0)
-          fail(name, "header line " + std::to_string(line_number) + ": bad list property " + quoted(line) +
-                         " (the count needs an integer type, the items a known type)");
-      } else {
-        words >> prop_name;
-        property.type = canonical_type(type);
-        property.size = type_size(property.type);
-        property.kind = type_kind(property.type);
-        if (property.size == 0)
-          fail(name, "header line " + std::to_string(line_number) + ": unknown property type " + quoted(type));
-      }
-      if (prop_name.empty())
-        fail(name, "header line " + std::to_string(line_number) + ": property without a name");
-      property.name = prop_name;
-      Element& element = header.elements.back();
-      property.offset = element.record_size;
-      if (!property.is_list()) element.record_size += static_cast<std::size_t>(property.size);
-      element.properties.push_back(property);
-    } else if (keyword == "end_header") {
-      saw_end = true;
-      break;
-    } else {
-      fail(name, "header line " + std::to_string(line_number) + ": unexpected " + quoted(keyword));
-    }
-  }
-  if (!saw_end && limit < size)
-    fail(name, "no end_header line in the first " + std::to_string(kMaxHeaderBytes >> 20) +
-                   " MB (real PLY headers are a few KB)");
-  if (!saw_end) fail(name, "the header has no end_header line (truncated or not a PLY file)");
-  if (!saw_format) fail(name, "the header has no format line");
-  header.data_offset = pos;
-  return header;
 }
 
 // The properties of the vertex element that a Gaussian needs, by index into properties.
@@ -453,11 +301,10 @@ std::unique_ptr<RecordSource> binary_source(const Header& header, std::size_t ve
   return std::make_unique<BinarySource>(start + offset, vertex, swap);
 }
 
-float sigmoid(double logit) { return static_cast<float>(1.0 / (1.0 + std::exp(-logit))); }
-
 }  // namespace
 
-Scene parse_ply(const char* data, std::size_t size, const std::string& name, LoadReport* report) {
+Scene parse_ply(const char* data, std::size_t size, const std::string& name, LoadReport* report,
+                LoadProgress* progress) {
   LoadReport local_report;
   if (!report) report = &local_report;
   *report = LoadReport{};
@@ -501,52 +348,34 @@ Scene parse_ply(const char* data, std::size_t size, const std::string& name, Loa
   std::vector<double> values(vertex.properties.size());
   std::vector<float> rest(static_cast<std::size_t>(rest_n));
   const int xyz[3] = {layout.x, layout.y, layout.z};
+  DecodeProgress decoding(progress, name, vertex.count);
   for (std::size_t i = 0; i < vertex.count; ++i) {
+    decoding.at(i);
     source->read(i, values);
-    // Every value is checked as the float it is stored as: a double of 1e300 is finite, its float is not.
-    float pos[3], scale[3], dc[3];
-    for (int k = 0; k < 3; ++k) pos[k] = static_cast<float>(values[xyz[k]]);
-    for (int k = 0; k < 3; ++k) scale[k] = static_cast<float>(std::exp(values[layout.scale[k]]));
-    for (int k = 0; k < 3; ++k) dc[k] = static_cast<float>(values[layout.dc[k]]);
-    double quat[4];
-    for (int k = 0; k < 4; ++k) quat[k] = values[layout.rot[k]];
+    DecodedGaussian g;
+    for (int k = 0; k < 3; ++k) {
+      g.position[k] = values[xyz[k]];
+      g.scale[k] = std::exp(values[layout.scale[k]]);
+      g.sh_dc[k] = values[layout.dc[k]];
+    }
+    for (int k = 0; k < 4; ++k) g.rotation[k] = values[layout.rot[k]];
     const double opacity_logit = values[layout.opacity];
-    bool finite = std::isfinite(opacity_logit);
+    g.opacity = std::isfinite(opacity_logit) ? 1.0 / (1.0 + std::exp(-opacity_logit)) : NAN;
     // INRIA stores f_rest channel-major (all R, then G, then B); we keep [k][channel].
     for (int k = 0; k < per_channel; ++k)
-      for (int ch = 0; ch < 3; ++ch) {
-        rest[k * 3 + ch] = static_cast<float>(values[layout.rest[ch * per_channel + k]]);
-        finite &= std::isfinite(rest[k * 3 + ch]);
-      }
-    for (int k = 0; k < 3; ++k) finite &= std::isfinite(pos[k]) & std::isfinite(scale[k]) & std::isfinite(dc[k]);
-    for (int k = 0; k < 4; ++k) finite &= std::isfinite(quat[k]);
-    if (!finite) {  // NaN/Inf in the file, a double beyond float range, or a log-scale whose exp overflows
-      report->dropped_non_finite++;
-      continue;
-    }
-    double norm = std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
-    if (!(norm > 0.0) || !std::isfinite(norm)) {
-      // A zero quaternion has no rotation; 3DGS would divide by zero. Identity keeps the scales.
-      report->repaired_zero_quaternion++;
-      quat[0] = 1; quat[1] = quat[2] = quat[3] = 0;
-      norm = 1;
-    }
-    scene.positions.insert(scene.positions.end(), pos, pos + 3);
-    scene.scales.insert(scene.scales.end(), scale, scale + 3);
-    scene.sh_dc.insert(scene.sh_dc.end(), dc, dc + 3);
-    for (int k = 0; k < 4; ++k) scene.rotations.push_back(static_cast<float>(quat[k] / norm));
-    scene.opacities.push_back(sigmoid(opacity_logit));
-    scene.sh_rest.insert(scene.sh_rest.end(), rest.begin(), rest.end());
+      for (int ch = 0; ch < 3; ++ch) rest[k * 3 + ch] = static_cast<float>(values[layout.rest[ch * per_channel + k]]);
+    append_gaussian(scene, g, rest.data(), *report);
   }
+  decoding.done(vertex.count);
   source->finish();
   if (scene.size() == 0)
     fail(name, "all " + std::to_string(vertex.count) + " Gaussians have NaN or Inf attributes");
   return scene;
 }
 
-Scene load_ply(const std::string& path, LoadReport* report) {
-  const std::vector<char> bytes = read_regular_file(path);
-  return parse_ply(bytes.data(), bytes.size(), path, report);
+Scene load_ply(const std::string& path, LoadReport* report, LoadProgress* progress) {
+  const std::vector<char> bytes = read_regular_file(path, std::numeric_limits<std::size_t>::max(), progress);
+  return parse_ply(bytes.data(), bytes.size(), path, report, progress);
 }
 
 }  // namespace flashgs

@@ -1,12 +1,175 @@
-// Chooses the reader for a scene file.
+// The registry of scene-file formats: how each is recognised, what it is called, and which
+// parser reads it; load_scene_file picks the first that recognises the file.
 #include "flashgs/scene_formats.h"
 
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstring>
+#include <limits>
+#include <string_view>
+#include <vector>
+
+#include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "flashgs/io.h"
+#include "format_readers.h"
 
 namespace flashgs {
+namespace {
 
-Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress* /*progress*/) {
-  return load_ply(path, report);
+// What a recogniser sees: the file's name and its first kStartBytes (all of them for small files).
+struct FileStart {
+  const std::string& name;
+  std::string_view bytes;
+};
+
+using Recogniser = bool (*)(const FileStart&);
+using Parser = Scene (*)(const char*, std::size_t, const std::string&, LoadReport&, LoadProgress*);
+using PathReader = Scene (*)(const std::string&, LoadReport&, LoadProgress*);
+
+// A format parses the file's bytes, or (when its file names others beside it, as SOG's
+// meta.json does) reads from the path itself; exactly one of the two is set.
+struct FormatReader {
+  SceneFormat format;
+  Recogniser recognises;
+  Parser parse;
+  PathReader read = nullptr;
+};
+
+// Bytes a recogniser may look at: more than any PLY header of a Gaussian scene.
+constexpr std::size_t kStartBytes = 64 << 10;
+
+bool ends_with(const std::string& text, std::string_view suffix) {
+  if (text.size() < suffix.size()) return false;
+  return std::equal(suffix.begin(), suffix.end(), text.end() - static_cast<std::ptrdiff_t>(suffix.size()),
+                    [](char a, char b) { return a == std::tolower(static_cast<unsigned char>(b)); });
 }
+
+bool starts_as_ply(const FileStart& f) {
+  return f.bytes.size() >= 4 && f.bytes.compare(0, 3, "ply") == 0 && (f.bytes[3] == '\n' || f.bytes[3] == '\r');
+}
+
+// The header, as far as the first bytes hold it (the parser checks it properly).
+std::string_view ply_header_text(const FileStart& f) {
+  const std::size_t end = f.bytes.find("end_header");
+  return f.bytes.substr(0, end == std::string_view::npos ? f.bytes.size() : end);
+}
+
+bool is_compressed_ply(const FileStart& f) {
+  if (!starts_as_ply(f)) return false;
+  const std::string_view header = ply_header_text(f);
+  return header.find("\nelement chunk ") != std::string_view::npos &&
+         header.find(" packed_position") != std::string_view::npos;
+}
+
+// Any other PLY: the INRIA reader says what is missing when it is not a Gaussian scene.
+bool is_ply(const FileStart& f) { return starts_as_ply(f); }
+
+// .splat has no magic number: the extension decides, and its parser checks the size.
+bool is_splat(const FileStart& f) { return ends_with(f.name, ".splat"); }
+
+Scene parse_inria_ply(const char* data, std::size_t size, const std::string& name, LoadReport& report,
+                      LoadProgress* progress) {
+  return parse_ply(data, size, name, &report, progress);
+}
+
+// In order: formats with a magic number or header first, extension-only formats last.
+const FormatReader kReaders[] = {
+    {SceneFormat::compressed_ply, is_compressed_ply, parse_compressed_ply},
+    {SceneFormat::inria_ply, is_ply, parse_inria_ply},
+    {SceneFormat::splat, is_splat, parse_splat},
+};
+
+double seconds_since(std::chrono::steady_clock::time_point began) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+}
+
+// "it starts with "GIF89a"", or "it is empty".
+std::string describe_start(const FileStart& f) {
+  if (f.bytes.empty()) return "it is empty";
+  return "it starts with \"" + printable_file_text(f.bytes.substr(0, 8)) + "\"";
+}
+
+// The first reader that recognises the file; throws the one "not a scene file" line otherwise.
+const FormatReader& recognise(const FileStart& start) {
+  for (const FormatReader& reader : kReaders)
+    if (reader.recognises(start)) return reader;
+  throw Error(start.name + ": not a scene file: " + describe_start(start) + "; expected a PLY, .splat, .spz or SOG");
+}
+
+void note_format(LoadReport& report, SceneFormat format) {
+  report.format = format_name(format);
+  report.quantisation = format_quantisation(format);
+}
+
+}  // namespace
+
+const char* format_name(SceneFormat format) {
+  switch (format) {
+    case SceneFormat::inria_ply: return "INRIA PLY";
+    case SceneFormat::compressed_ply: return "PlayCanvas compressed PLY";
+    case SceneFormat::splat: return ".splat (antimatter15)";
+    case SceneFormat::spz: return "SPZ (Niantic)";
+    case SceneFormat::sog: return "SOG (PlayCanvas)";
+  }
+  return "unknown";
+}
+
+const char* format_quantisation(SceneFormat format) {
+  switch (format) {
+    case SceneFormat::inria_ply: return "none: float or double per value";
+    case SceneFormat::compressed_ply:
+      return "11-10-11 positions and log-scales and 8-8-8-8 colour and opacity in 256-Gaussian chunks (min/max), "
+             "2-10-10-10 smallest-three rotations, 8-bit SH";
+    case SceneFormat::splat:
+      return "float positions and scales, 8-bit colour, opacity and rotation components; no SH bands";
+    case SceneFormat::spz: return "fixed-point positions, 8-bit scales, rotations, colours, opacity and SH";
+    case SceneFormat::sog: return "16-bit positions, 8-bit quaternions, codebook scales, colours and SH in WebP textures";
+  }
+  return "";
+}
+
+Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& name, LoadReport* report,
+                        LoadProgress* progress) {
+  LoadReport local_report;
+  if (!report) report = &local_report;
+  const FormatReader& reader = recognise({name, std::string_view(data, std::min(size, kStartBytes))});
+  if (!reader.parse)
+    throw Error(name + ": " + format_name(reader.format) + " reads the files beside this one: open it by its path");
+  const auto began = std::chrono::steady_clock::now();
+  Scene scene = reader.parse(data, size, name, *report, progress);
+  report->decode_seconds = seconds_since(began);
+  note_format(*report, reader.format);
+  return scene;
+}
+
+Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress* progress) {
+  LoadReport local_report;
+  if (!report) report = &local_report;
+  // Recognised from its start first: a file of no known format is not read whole.
+  const std::vector<char> start = read_file_start(path, kStartBytes);
+  const FormatReader& reader = recognise({path, std::string_view(start.data(), start.size())});
+  const auto began = std::chrono::steady_clock::now();
+  if (reader.read) {  // reading and decoding interleave: all of it counts as decoding
+    Scene scene = reader.read(path, *report, progress);
+    report->decode_seconds = seconds_since(began);
+    note_format(*report, reader.format);
+    return scene;
+  }
+  const std::vector<char> bytes = read_regular_file(path, std::numeric_limits<std::size_t>::max(), progress);
+  const double read_seconds = seconds_since(began);
+  Scene scene = parse_scene_bytes(bytes.data(), bytes.size(), path, report, progress);
+  report->read_seconds = read_seconds;
+  return scene;
+}
+
+SceneWriter scene_writer_for(const std::string& path) {
+  if (ends_with(path, ".ply")) return save_ply;
+  if (ends_with(path, ".splat")) return save_splat;
+  return nullptr;
+}
+
+const char* writable_scene_extensions() { return ".ply (INRIA PLY) or .splat"; }
 
 }  // namespace flashgs

@@ -28,6 +28,14 @@ std::string summarize_scene(const Scene& scene, const LoadReport* report) {
   std::ostringstream out;
   const std::size_t n = scene.size();
   if (report) out << "file:            " << report->path << "\n";
+  if (report && !report->format.empty()) {
+    char times[120];
+    std::snprintf(times, sizeof times, "read %.3f s, decoded in %.3f s\n", report->read_seconds,
+                  report->decode_seconds);
+    out << "format:          " << report->format << "\n";
+    out << "quantisation:    " << report->quantisation << "\n";
+    out << "load time:       " << times;
+  }
   out << "gaussians:       " << n << "\n";
   out << "sh degree:       " << scene.sh_degree << " (" << sh_coefficient_count(scene.sh_degree)
       << " coefficients per channel)\n";

@@ -9,6 +9,8 @@
 
 namespace flashgs {
 
+struct LoadProgress;
+
 // What a path names once symbolic links are followed.
 enum class PathKind { regular_file, folder, other };
 
@@ -21,8 +23,15 @@ PathKind path_kind(const std::string& path);
 void check_regular_file(const std::string& path);
 
 // The whole content of the regular file at `path`, checked as above and opened without
-// blocking; throws flashgs::Error when it holds more than `max_bytes`.
+// blocking; throws flashgs::Error when it holds more than `max_bytes`. With `progress`, the
+// file is read in chunks of a few MB: bytes_total and bytes_done follow, and a set
+// cancel_requested throws flashgs::LoadCancelled before the next chunk.
 std::vector<char> read_regular_file(const std::string& path,
-                                    std::size_t max_bytes = std::numeric_limits<std::size_t>::max());
+                                    std::size_t max_bytes = std::numeric_limits<std::size_t>::max(),
+                                    LoadProgress* progress = nullptr);
+
+// The first `max_bytes` of the regular file at `path` (all of it when shorter), checked and
+// opened as above: what a format recogniser looks at before the whole file is read.
+std::vector<char> read_file_start(const std::string& path, std::size_t max_bytes);
 
 }  // namespace flashgs

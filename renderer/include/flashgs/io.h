@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "flashgs/camera.h"
+#include "flashgs/load_progress.h"
 #include "flashgs/scene.h"
 
 namespace flashgs {
@@ -25,11 +26,12 @@ std::string default_cameras_path(const std::string& ply_path);
 
 // Reads a 3DGS PLY, layout taken from its header. Throws flashgs::Error naming the file and
 // the problem on anything it cannot read exactly. Gaussians with NaN/Inf attributes are
-// dropped and counted in `report`.
-Scene load_ply(const std::string& path, LoadReport* report = nullptr);
+// dropped and counted in `report`. `progress` (see load_progress.h) follows the bytes read and
+// the Gaussians decoded; its cancel request throws flashgs::LoadCancelled.
+Scene load_ply(const std::string& path, LoadReport* report = nullptr, LoadProgress* progress = nullptr);
 // Same, from bytes in memory (`name` is used in messages). The fuzz test drives this.
 Scene parse_ply(const char* data, std::size_t size, const std::string& name,
-                LoadReport* report = nullptr);
+                LoadReport* report = nullptr, LoadProgress* progress = nullptr);
 // Writes the INRIA layout (binary little endian, logit opacity, log scales).
 void save_ply(const Scene& scene, const std::string& path);
 

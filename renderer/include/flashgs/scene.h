@@ -43,6 +43,12 @@ struct LoadReport {
   std::size_t ignored_properties = 0;       // properties present but not used (normals, ...)
   std::vector<std::string> ignored_property_names;
   int sh_degree_in_file = 0;
+  // Filled by load_scene_file: format_name() and format_quantisation() of the file's format,
+  // and the seconds spent reading the bytes and decoding them.
+  std::string format;
+  std::string quantisation;
+  double read_seconds = 0;
+  double decode_seconds = 0;
 };
 
 }  // namespace flashgs

@@ -1,6 +1,7 @@
 // The one entry point for scene files in every format the project reads; the format is chosen by content.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "flashgs/load_progress.h"
@@ -8,11 +9,35 @@
 
 namespace flashgs {
 
-// Reads the scene file at `path` (for now the INRIA PLY; each further format adds a reader
-// behind this function). Throws flashgs::Error naming the file and the problem, or
-// flashgs::LoadCancelled when `progress->cancel_requested` was set. `report` and `progress`
-// may be null.
+enum class SceneFormat { inria_ply, compressed_ply, splat, spz, sog };
+
+// "INRIA PLY", "PlayCanvas compressed PLY", ...
+const char* format_name(SceneFormat format);
+// How the format stores the Gaussians (its quantisation), one line for `flashgs info`.
+const char* format_quantisation(SceneFormat format);
+
+// Reads the scene file at `path`, its format recognised by its first bytes (the PLY header,
+// a magic number) and, for formats without one (.splat), by the extension. Fills `report`
+// (format, read and decode times, what was dropped) and `progress` (bytes, then Gaussians).
+// Throws flashgs::Error naming the file and the problem (one line "<path>: not a scene file:
+// ..." when no format matches), or flashgs::LoadCancelled when `progress->cancel_requested`
+// was set. `report` and `progress` may be null.
 Scene load_scene_file(const std::string& path, LoadReport* report = nullptr,
                       LoadProgress* progress = nullptr);
+// The same for a file's bytes already in memory (`name` is its path, used for messages and
+// for the extension); the fuzz tests drive this.
+Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& name,
+                        LoadReport* report = nullptr, LoadProgress* progress = nullptr);
+
+// Writes `scene` as .splat: 32-byte records of float position and scale, 8-bit RGBA (colour
+// 0.5 + SH_C0 * dc, clamped to [0, 1]; opacity) and 8-bit quaternion (q * 128 + 128, w x y z),
+// each byte rounded to the nearest. SH bands beyond degree 0 are not kept.
+void save_splat(const Scene& scene, const std::string& path);
+// The writer of the format `path`'s extension names: save_ply for .ply (INRIA PLY),
+// save_splat for .splat; null for any other extension.
+using SceneWriter = void (*)(const Scene& scene, const std::string& path);
+SceneWriter scene_writer_for(const std::string& path);
+// The extensions scene_writer_for knows, for messages: ".ply (INRIA PLY) or .splat".
+const char* writable_scene_extensions();
 
 }  // namespace flashgs
