@@ -31,7 +31,7 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
   using Reduce = cub::BlockReduce<float, kChunkSize>;
   __shared__ typename Reduce::TempStorage storage;
   __shared__ float centre[3];
-  __shared__ float shared_radius, shared_scale;
+  __shared__ float shared_radius, shared_scale, shared_min_opacity;
   __shared__ int all_bounded;
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * kChunkSize + threadIdx.x;
   const bool valid = i < scene.count;
@@ -68,9 +68,12 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
   __syncthreads();
   const float scale = fmaxf(fabsf(sd.x), fmaxf(fabsf(sd.y), fabsf(sd.z)));
   const float max_scale = Reduce(storage).Reduce(valid ? scale : 0.0f, Larger());
+  __syncthreads();
+  const float min_opacity = Reduce(storage).Reduce(valid ? po.w : INFINITY, Smaller());
   if (threadIdx.x == 0) {
     shared_radius = radius;
     shared_scale = max_scale;
+    shared_min_opacity = min_opacity;
   }
   __syncthreads();
   if (threadIdx.x == 0) {
@@ -81,7 +84,10 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
     // Rounded up: the float of a distance may be below the distance.
     b.radius = shared_radius * (1.0f + 1e-6f) + 1e-30f;
     b.max_scale = shared_scale;
+    b.min_opacity = shared_min_opacity;
     b.cullable = all_bounded != 0 && bounded(b.radius) ? 1u : 0u;
+    const std::size_t first = static_cast<std::size_t>(blockIdx.x) * kChunkSize;
+    b.members = static_cast<unsigned>(scene.count - first < kChunkSize ? scene.count - first : kChunkSize);
     bounds[blockIdx.x] = b;
   }
 }

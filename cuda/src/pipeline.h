@@ -32,11 +32,21 @@ constexpr int kChunkSize = 256;
 // matrix would not be a rotation, and the footprint bound assumes one).
 struct ChunkBound {
   float cx, cy, cz, radius;
-  float max_scale;  // largest |scale| of the chunk
+  float max_scale;    // largest |scale| of the chunk
+  float min_opacity;  // smallest opacity: none is culled for low opacity when it is >= tau
   unsigned cullable;
+  unsigned members;   // Gaussians in the chunk (kChunkSize but for the last)
 };
 
-// The per-frame constants of the chunk test (chunk_outside_view), from chunk_cull_frame().
+// What the chunk test says of a chunk this frame.
+enum ChunkVerdict : int {
+  kChunkProject = 0,     // may reach the image: every Gaussian is projected
+  kChunkClassify = 1,    // outside the view: each Gaussian's reason read from its centre and opacity
+  kChunkAllNear = 2,     // every centre behind the near plane: no Gaussian is read
+  kChunkAllOffscreen = 3 // in front, outside, none below tau: no Gaussian is read
+};
+
+// The per-frame constants of the chunk test (chunk_verdict), from chunk_cull_frame().
 // Proof that a chunk passing it has no Gaussian on the image: a flash footprint's half-width
 // is at most s sqrt(lambda_max + 0.3 + 0.32) + 1 pixels (dilation, spread floor, ceil) with
 // s^2 = max(9, 2 ln(o_max / tau)) the largest threshold, and lambda_max <= (K sigma / z)^2

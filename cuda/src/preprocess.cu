@@ -258,10 +258,17 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
                                                             PreprocessArgs args) {
   static_assert(kBlock == kChunkSize, "a block is one chunk");
   __shared__ unsigned block_counts[gm::kCullReasonCount];  // by gm::CullReason
-  __shared__ bool chunk_outside;
+  __shared__ int chunk;  // ChunkVerdict
   if (threadIdx.x < gm::kCullReasonCount) block_counts[threadIdx.x] = 0;
-  if (threadIdx.x == 0)
-    chunk_outside = args.chunk_cull && chunk_outside_view(scene.chunks[blockIdx.x], args.camera, args.chunk_frame);
+  if (threadIdx.x == 0) {
+    chunk = args.chunk_cull ? chunk_verdict(scene.chunks[blockIdx.x], args.camera, args.geometry, args.chunk_frame)
+                            : kChunkProject;
+    if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {  // counted without reading a Gaussian
+      const unsigned members = scene.chunks[blockIdx.x].members;
+      atomicAdd(&buf.counters->by_reason[chunk == kChunkAllNear ? gm::kCulledNear : gm::kCulledOffscreen], members);
+      atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(members));
+    }
+  }
   __syncthreads();
 
   const unsigned i = blockIdx.x * kBlock + threadIdx.x;
@@ -269,7 +276,13 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   const bool valid = i < scene.count;
   const gm::CameraParams& cam = args.camera;
 
-  if (chunk_outside) {  // the whole block: only the centre and opacity are read
+  if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {
+    if constexpr (!FUSED) {
+      if (valid) buf.pair_counts[i] = 0;
+    }
+    return;
+  }
+  if (chunk == kChunkClassify) {  // the whole block: only the centre and opacity are read
     int reason = gm::kCulledOffscreen;
     if (valid) {
       const float4 po = __ldg(scene.position_opacity + i);
