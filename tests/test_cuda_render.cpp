@@ -150,8 +150,9 @@ TEST(CudaChunkCull, ChangesNothingButTheWork) {
   const auto scene = tiled_demo_scene();
   setenv("FLASHGS_CHUNK_CULL", "0", 1);
   auto plain = make_cuda_renderer();
-  unsetenv("FLASHGS_CHUNK_CULL");
+  setenv("FLASHGS_CHUNK_CULL", "1", 1);  // the tiled demo is below the size that culls by default
   auto culling = make_cuda_renderer();
+  unsetenv("FLASHGS_CHUNK_CULL");
   plain->set_scene(scene);
   culling->set_scene(scene);
   std::uint64_t culled = 0;
@@ -179,7 +180,9 @@ TEST(CudaChunkCull, ChangesNothingButTheWork) {
 TEST(CudaVsCpu, TiledSceneWithChunkCull) {
   FLASHGS_REQUIRE_CUDA();
   const auto scene = tiled_demo_scene();
+  setenv("FLASHGS_CHUNK_CULL", "1", 1);
   compare_scene("tiled demo", scene, chunk_cull_cameras(*scene));
+  unsetenv("FLASHGS_CHUNK_CULL");
 }
 
 // The frames the sanitizer run uses (tools/device/gpu_check.sh runs this test under
