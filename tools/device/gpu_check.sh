@@ -7,7 +7,8 @@
 #                                       build-bg wait-build
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
 # cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
-# there; `build` builds everything on the machine instead, into build-dev).
+# there; `build` builds everything on the machine instead, into build-dev) and sysroot/usr with
+# Debian's Highway (include/hwy, lib/x86_64-linux-gnu/{libhwy.so*,cmake/hwy}).
 set -u
 ROOT=$(pwd)
 OUT=${OUT:-$ROOT/out}
@@ -26,6 +27,7 @@ setup() {
   if [ ! -e /work/main/assets ]; then mkdir -p /work/main && ln -sfn "$ROOT/assets" /work/main/assets; fi
   ls /work/shared/scenes/ | tr '\n' ' '; echo
   ldconfig -p | grep -q libgomp.so.1 || export LD_LIBRARY_PATH=$ROOT/.deps/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+  export LD_LIBRARY_PATH=$ROOT/.deps/sysroot/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
   if "$BIN/flashgs" --help > /dev/null 2>&1; then
     FLASHGS=$BIN/flashgs
     TESTS=$BIN/test_cuda_render
@@ -37,7 +39,9 @@ setup() {
 }
 
 build() {
+  # .deps/sysroot: Debian's Highway (headers, library, CMake config) for the SIMD CPU blend.
   cmake -S . -B build-dev -G Ninja -DCMAKE_BUILD_TYPE=Release -DFLASHGS_HEADER_DEPS_DIR="$ROOT/.deps/include" \
+    -DCMAKE_PREFIX_PATH="$ROOT/.deps/sysroot/usr" \
     -DCMAKE_CUDA_ARCHITECTURES=90 -DFLASHGS_BUILD_APP=OFF -DFLASHGS_SHARED_SCENES="$SCENES" \
     -DFLASHGS_GTEST_SOURCE_DIR="$ROOT/.deps/googletest" > "$OUT/build.log" 2>&1 &&
     ninja -C build-dev flashgs test_cuda_render test_stress_gpu >> "$OUT/build.log" 2>&1
