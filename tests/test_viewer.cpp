@@ -15,6 +15,7 @@
 #include "flashgs/image.h"
 #include "flashgs/image_io.h"
 #include "flashgs/frame_memory.h"
+#include "heatmap_legend.h"
 #include "memory_budget.h"
 #include "test_support.h"
 
@@ -95,13 +96,14 @@ const char* const kInputHelper = "";
 //                        sets `closed` (its exit status in `exit_status`)
 // A failing step sets `status`. The script then exits with `crash_status` if the viewer is gone
 // without being closed, else with `status`. Returns its result with the viewer's log appended.
+// `env` (e.g. "PATH=/x:$PATH") is set for the viewer alone.
 RunResult run_live_viewer(const std::string& prefix, const std::string& name, const std::string& viewer_args,
-                          const std::string& steps, int crash_status) {
+                          const std::string& steps, int crash_status, const std::string& env = "") {
   const std::string dir = out_dir(), script = dir + "/" + name + ".sh", log = dir + "/" + name + ".log";
   if (FILE* f = std::fopen(script.c_str(), "w")) {
     std::fputs(("viewer=$1 drop=$2 input=$3 log=$4\n"
                 "cd \"$(dirname \"$log\")\"\n"
-                "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
+                + (env.empty() ? std::string() : "env " + env + " ") + "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
                 "pid=$!\n"
                 "closed=0 exit_status=\n"
                 "wait_count() {\n"
@@ -328,7 +330,7 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   // The button's place in a 1280x720 window at UI scale 1 (the panel layout is fixed).
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
-                            "[ $status -eq 0 ] && { \"$input\" move 95 650 && hold button \" mouse0 \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { \"$input\" move 95 673 && hold button \" mouse0 \" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=12; }\n";
   const RunResult r = run_live_viewer(prefix, "click", "--backend cpu --size 1280x720 --log-input", steps, 13);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 no comparison, 13 crash)\n"
@@ -347,7 +349,8 @@ TEST(Viewer, TypedSliderValuesAreClampedToTheirRanges) {
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   if (!flashgs::image_io_has_oiio()) GTEST_SKIP() << "F12 saves PNG, which needs OpenImageIO";
   const std::string dir = out_dir();
-  std::filesystem::remove(dir + "/flashgs_screenshot.png");
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().filename().string().rfind("flashgs_20", 0) == 0) std::filesystem::remove(e.path());
   // Slider places in a 640x720 window at UI scale 1 (the panel layout is fixed): "s per
   // camera" at (100, 196), "Render scale" at (110, 281). GLFW key codes: Ctrl 341, Enter 257, Space 32.
   auto typed = [](int x, int y, const std::string& text) {
@@ -360,14 +363,14 @@ TEST(Viewer, TypedSliderValuesAreClampedToTheirRanges) {
       "[ $status -eq 0 ] && { " + typed(100, 196, "0") + " || status=11; }\n"
       "[ $status -eq 0 ] && { hold space \" key32 \" || status=12; }\n"
       "[ $status -eq 0 ] && { \"$input\" down F12 && \"$input\" up F12 || status=12; }\n"
-      "[ $status -eq 0 ] && { wait_for \"saved flashgs_screenshot\" || status=13; }\n"
-      "[ $status -eq 0 ] && { cp flashgs_screenshot.png playing_after_typed_zero.png; hold space \" key32 \" || status=14; }\n"
+      "[ $status -eq 0 ] && { wait_for \"saved ./flashgs_20\" || status=13; }\n"
+      "[ $status -eq 0 ] && { cp \"$(ls flashgs_20*.png | head -1)\" playing_after_typed_zero.png; hold space \" key32 \" || status=14; }\n"
       "[ $status -eq 0 ] && { " + typed(110, 281, "40") + " || status=14; }\n"
       "[ $status -eq 0 ] && { \"$input\" down F12 && \"$input\" up F12 || status=14; }\n"
-      "[ $status -eq 0 ] && { wait_count \"saved flashgs_screenshot\" 2 || status=15; }\n"
+      "[ $status -eq 0 ] && { wait_count \"saved ./flashgs_20\" 2 || status=15; }\n"
       "[ $status -eq 0 ] && { close_window || status=17; }\n";
   std::filesystem::remove(dir + "/playing_after_typed_zero.png");
-  const RunResult r = run_live_viewer(prefix, "typed_sliders", "--backend cpu --size 640x720 --log-input", steps, 16);
+  const RunResult r = run_live_viewer(prefix, "typed_sliders", "--backend cpu --size 640x720 --log-input --screenshot-dir .", steps, 16);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 start, 11 typing 0, 12 play + screenshot, 13 no screenshot, 14 typing 40, "
                                "15 no screenshot, 16 crash, 17 close)\n"
@@ -379,11 +382,12 @@ TEST(Viewer, TypedSliderValuesAreClampedToTheirRanges) {
   std::printf("playing after a typed 0: %.1f %% of the pixels lit\n", 100.0 * lit);
   EXPECT_GT(lit, 0.05);
   // 40 became the range's top, 4: a 2560x2880 frame.
-  EXPECT_NE(r.output.find("saved flashgs_screenshot.png (2560x2880)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(".png (2560x2880)"), std::string::npos) << r.output;
 #endif
 }
 
-// The heat-map shader draws over the frame, and its legend runs from blue (0) to red (max).
+// The heat-map shader draws over the frame; its legend bar is the viridis ramp from 0 to the
+// maximum, with tick marks and values at round counts and a caption naming the scale.
 TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir();
@@ -396,13 +400,139 @@ TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
   const flashgs::Image on = flashgs::read_image(with), off = flashgs::read_image(without);
   ASSERT_EQ(on.width, 480);
   EXPECT_LT(flashgs::compare_images(on, off).psnr_db, 30.0) << "the overlay changed nothing";
-  // Legend bar: x in [480 - 300, 480 - 20), y in [270 - 30, 270 - 16) at UI scale 1.
-  const float* low = on.pixel(185, 247);
-  const float* high = on.pixel(455, 247);
-  EXPECT_GT(low[2], 0.25f);
-  EXPECT_LT(low[0], 0.2f);
-  EXPECT_GT(high[0], 0.7f);
-  EXPECT_LT(high[2], 0.2f);
+  // The legend as logged: "pairs per 16x16 tile, log scale, ticks 0@0% 1@9% ... MAX@100%".
+  const std::string key = "heat-map legend: pairs per 16x16 tile, log scale, ticks ";
+  const auto at = a.output.find(key);
+  ASSERT_NE(at, std::string::npos) << a.output;
+  std::vector<std::pair<long, int>> ticks;  // value, percent along the bar
+  {
+    const std::string line = a.output.substr(at + key.size(), a.output.find('\n', at) - at - key.size());
+    std::size_t i = 0;
+    while (i < line.size()) {
+      long value = 0;
+      int percent = 0;
+      if (std::sscanf(line.c_str() + i, "%ld@%d%%", &value, &percent) != 2) break;
+      ticks.emplace_back(value, percent);
+      i = line.find(' ', i);
+      if (i == std::string::npos) break;
+      ++i;
+    }
+  }
+  ASSERT_GE(ticks.size(), 3u) << a.output;
+  EXPECT_EQ(ticks[0], std::make_pair(0L, 0));
+  EXPECT_EQ(ticks[1].first, 1);
+  EXPECT_EQ(ticks.back().second, 100);
+  const long max_count = ticks.back().first;
+  EXPECT_GT(max_count, 10);
+  for (std::size_t k = 1; k + 1 < ticks.size(); ++k) {
+    EXPECT_EQ(ticks[k].first, ticks[k - 1].first == 0 ? 1 : ticks[k - 1].first * 10) << "log ticks are powers of ten";
+    EXPECT_NEAR(ticks[k].second, 100.0 * std::log1p(double(ticks[k].first)) / std::log1p(double(max_count)), 0.6);
+  }
+  // Bar: x in [480 - 300, 480 - 20), y in [270 - 46, 270 - 32) at UI scale 1; the ramp's
+  // colour at each place, and a white tick mark just below the bar at each tick.
+  const float x0 = 180.0f, x1 = 460.0f;
+  for (float t : {0.02f, 0.25f, 0.5f, 0.75f, 0.98f}) {
+    const int x = int(x0 + t * (x1 - x0));
+    const float* p = on.pixel(x, 231);
+    const auto want = flashgs::viewer::heat_colour((float(x) + 0.5f - x0) / (x1 - x0));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], want[c], 3.0f / 255.0f) << "bar at t " << t << " channel " << c;
+  }
+  for (const auto& [value, percent] : ticks) {
+    const int x = std::min(int(x1) - 1, int(std::lround(x0 + percent / 100.0 * (x1 - x0))));
+    float brightest = 0.0f;
+    for (int dx = -1; dx <= 1; ++dx) brightest = std::max(brightest, on.pixel(x + dx, 240)[0]);
+    EXPECT_GT(brightest, 0.7f) << "no tick mark for " << value << " at x " << x;
+  }
+}
+
+// The split view: left of the divider the baseline's render, right of it the current
+// configuration's, a white line between; the difference view shows |error| magnified, lit
+// exactly where the two renders differ.
+TEST(Viewer, SplitViewAndDifferenceImageShowTheTwoConfigurations) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string split = dir + "/split_view" + kExt, diff = dir + "/difference_view" + kExt;
+  const std::string base = dir + "/split_baseline" + kExt, flash = dir + "/split_flash" + kExt;
+  const std::string common = prefix + viewer() + " --backend cpu --size 480x270 --camera 5 --frames 2 ";
+  const RunResult a = run(common + "--no-ui --compare --split-at 0.4 --window-screenshot " + split + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const RunResult b = run(common + "--no-ui --compare --compare-view difference --window-screenshot " + diff + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const RunResult c = run(common + "--algorithm baseline --screenshot " + base + " --exit");
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  const RunResult d = run(common + "--screenshot " + flash + " --exit");
+  ASSERT_EQ(d.exit_code, 0) << d.output;
+  const auto factor_at = b.output.find("difference image x");
+  ASSERT_NE(factor_at, std::string::npos) << b.output;
+  const double factor = std::atof(b.output.c_str() + factor_at + std::string("difference image x").size());
+  EXPECT_GE(factor, 1.0);
+  const flashgs::Image s = flashgs::read_image(split), e = flashgs::read_image(diff);
+  const flashgs::Image l = flashgs::read_image(base), r = flashgs::read_image(flash);
+  ASSERT_EQ(s.width, 480);
+  ASSERT_EQ(l.width, 480);
+  // Rows clear of the labels (bottom) and the hidden-panels hint (top left).
+  const int divider = int(0.4 * 480);
+  std::size_t left_off = 0, right_off = 0, sides_differ = 0, dark_where_differ = 0;
+  for (int y = 30; y < 200; ++y)
+    for (int x = 0; x < 480; ++x) {
+      if (std::abs(x - divider) <= 2) continue;
+      const float* got = s.pixel(x, y);
+      const float* want = x < divider ? l.pixel(x, y) : r.pixel(x, y);
+      // Exact 8-bit equality: the sides differ by one step at most pixels where they differ.
+      bool same = true, differ = false, differ_clearly = false;
+      for (int k = 0; k < 3; ++k) {
+        same = same && std::abs(got[k] - want[k]) <= 0.5f / 255.0f;
+        const float between = std::abs(l.pixel(x, y)[k] - r.pixel(x, y)[k]);
+        differ = differ || between > 0.5f / 255.0f;
+        differ_clearly = differ_clearly || between > 1.5f / 255.0f;
+      }
+      (x < divider ? left_off : right_off) += !same;
+      sides_differ += differ;
+      // Two 8-bit steps apart, the float renders differ by more than one: magnified, it shows.
+      const float* shown = e.pixel(x, y);
+      dark_where_differ += differ_clearly && shown[0] + shown[1] + shown[2] < 0.5f / 255.0f;
+    }
+  std::printf("split view: %zu / %zu pixels off on the left / right; renders differ at %zu pixels, factor x%.0f\n",
+              left_off, right_off, sides_differ, factor);
+  EXPECT_EQ(left_off, 0u) << "left of the divider is not the baseline's render";
+  EXPECT_EQ(right_off, 0u) << "right of the divider is not the current configuration's render";
+  EXPECT_EQ(dark_where_differ, 0u) << "the difference image is black where the renders differ";
+  // The divider: a white line at 40 % of the width.
+  for (int y : {40, 120, 190}) EXPECT_GT(s.pixel(divider, y)[0] + s.pixel(divider, y)[1] + s.pixel(divider, y)[2], 2.9f);
+  EXPECT_GT(sides_differ, 0u) << "baseline and flash render alike here: the check above proves nothing";
+}
+
+// Baseline against baseline is refused with the reason, and nothing is drawn over the frame.
+TEST(Viewer, ComparingAConfigurationWithItselfIsRefused) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 320x180 --camera 2 --frames 2 --algorithm baseline "
+                          "--compare --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("compare: both sides are baseline: nothing to compare"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("viewer compare:"), std::string::npos) << r.output;
+}
+
+// One loop of the camera path as an image sequence; without ffmpeg on PATH, the sequence only.
+TEST(Viewer, ThePathExportsAsAnImageSequence) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string folder = out_dir() + "/path_export";
+  std::filesystem::remove_all(folder);
+  const RunResult r = run(prefix + "env PATH=/usr/bin:/bin " + viewer() + " --backend cpu --size 160x90 --frames 1 "
+                          "--export-path " + folder + " --export-frames 4 --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  if (std::filesystem::exists("/usr/bin/ffmpeg") || std::filesystem::exists("/bin/ffmpeg")) GTEST_SKIP() << "ffmpeg is in /usr/bin: the no-video case cannot be run";
+  EXPECT_NE(r.output.find("path export: 4 frames in " + folder + " (no ffmpeg on PATH: image sequence only)"),
+            std::string::npos) << r.output;
+  std::vector<flashgs::Image> frames;
+  for (int i = 0; i < 4; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%05d", i);
+    ASSERT_TRUE(std::filesystem::exists(folder + name + kExt)) << name;
+    frames.push_back(flashgs::read_image(folder + name + kExt));
+    EXPECT_EQ(frames.back().width, 160);
+  }
+  EXPECT_FALSE(std::filesystem::exists(folder + "/frame_00004" + kExt));
+  EXPECT_LT(flashgs::compare_images(frames[0], frames[2]).psnr_db, 30.0) << "the frames do not follow the path";
 }
 
 TEST(Viewer, CameraPathReportsFrameTimes) {

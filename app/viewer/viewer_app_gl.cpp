@@ -531,7 +531,14 @@ void ViewerApp::log_held_input() {
   if (held.empty()) return;
   double x = 0, y = 0;
   m_window->cursor(&x, &y);
-  std::fprintf(stderr, "flashgs-viewer: frame %d held:%s at %.0f,%.0f\n", m_presented, held.c_str(), x, y);
+  // The pose too: a test dragging through X checks which way the view went.
+  const Pose& p = m_controller.pose();
+  const glm::vec3 f = p.rotation[2], r = p.rotation[0], pivot = m_controller.pivot();
+  std::fprintf(stderr,
+               "flashgs-viewer: frame %d held:%s at %.0f,%.0f | camera %.6f %.6f %.6f forward %.6f %.6f %.6f "
+               "right %.6f %.6f %.6f pivot %.6f %.6f %.6f\n",
+               m_presented, held.c_str(), x, y, p.position.x, p.position.y, p.position.z, f.x, f.y, f.z, r.x, r.y, r.z,
+               pivot.x, pivot.y, pivot.z);
 }
 
 void ViewerApp::set_notice(const std::string& message) {
@@ -842,8 +849,9 @@ int ViewerApp::run() {
     const float fb_scale = m_window->framebuffer_scale();
     // Bottom right, clear of the main panel (top left) and the statistics (top right).
     const float u = m_ui_scale * fb_scale;  // legend sizes in pixels
-    const float legend_px[4] = {float(fb_w) - 300.0f * u, float(fb_h) - 30.0f * u, float(fb_w) - 20.0f * u,
-                                float(fb_h) - 16.0f * u};
+    // Room below the bar for the tick labels, above it for the caption.
+    const float legend_px[4] = {float(fb_w) - 300.0f * u, float(fb_h) - 46.0f * u, float(fb_w) - 20.0f * u,
+                                float(fb_h) - 32.0f * u};
     m_ui->begin_frame();  // every frame: the legend, help and hint show with the panels hidden too
     {
       model.frame_path = m_path->name();

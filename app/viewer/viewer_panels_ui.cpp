@@ -313,9 +313,11 @@ void legend_labels(const UiModel& m, const ViewerSettings& s) {
   const float* r = m.legend_rect_points;
   const ImU32 white = IM_COL32(255, 255, 255, 255);
   const float line = ImGui::GetTextLineHeight();
-  // Caption above the bar, tick marks and values below it: all on one dark backing.
-  draw->AddRectFilled(ImVec2(r[0] - ui(6), r[1] - line - ui(6)), ImVec2(r[2] + ui(30), r[3] + line + ui(6)),
-                      IM_COL32(0, 0, 0, 160), ui(3.0f));
+  // Caption above the bar, tick marks and values below it, each on a dark backing that
+  // leaves the bar's colours (the GL pass under this) untouched.
+  const ImU32 backing = IM_COL32(0, 0, 0, 160);
+  draw->AddRectFilled(ImVec2(r[0] - ui(6), r[1] - line - ui(6)), ImVec2(r[2] + ui(6), r[1]), backing, ui(3.0f));
+  draw->AddRectFilled(ImVec2(r[0] - ui(16), r[3]), ImVec2(r[2] + ui(16), r[3] + line + ui(6)), backing, ui(3.0f));
   const std::string caption = legend_caption(m.tile_size, s.heatmap_log, s.heatmap_lock_max);
   draw->AddText(ImVec2(r[0], r[1] - line - ui(3)), white, caption.c_str());
   for (const LegendTick& t : legend_ticks(m.heatmap_max, s.heatmap_log)) {
