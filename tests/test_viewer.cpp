@@ -338,6 +338,111 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
 #endif
 }
 
+// The pose logged with each held-button frame (--log-input): camera, forward, right, pivot.
+struct LoggedPose {
+  double v[12] = {};
+  bool ok = false;
+};
+
+std::vector<LoggedPose> poses_while_held(const std::string& log, const std::string& token) {
+  std::vector<LoggedPose> out;
+  std::size_t at = 0;
+  while ((at = log.find("held:", at)) != std::string::npos) {
+    const std::size_t end = log.find('\n', at);
+    const std::string line = log.substr(at, end - at);
+    at = end;
+    if (line.find(token) == std::string::npos) continue;
+    const auto c = line.find("| camera ");
+    if (c == std::string::npos) continue;
+    LoggedPose p;
+    p.ok = std::sscanf(line.c_str() + c, "| camera %lf %lf %lf forward %lf %lf %lf right %lf %lf %lf pivot %lf %lf %lf",
+                       &p.v[0], &p.v[1], &p.v[2], &p.v[3], &p.v[4], &p.v[5], &p.v[6], &p.v[7], &p.v[8], &p.v[9],
+                       &p.v[10], &p.v[11]) == 12;
+    out.push_back(p);
+  }
+  return out;
+}
+
+double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double distance3(const double* a, const double* b) {
+  const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  return std::sqrt(dot3(d, d));
+}
+
+// Real mouse drags (XTEST) over the image: the left button orbits the object-sized demo
+// scene (the default mode there) about its pivot, turning the view right when dragged right;
+// the right button pans it sideways without turning.
+TEST(Viewer, MouseDragsOrbitAndPanTheView) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // Over the image: right of the main panel, below the statistics (1280x800 at UI scale 1).
+  // The pointer is moved, then two frames pass (a harmless key held: Control_R, GLFW 345)
+  // before the button goes down, so that the move is not taken as part of the drag.
+  auto drag = [](const std::string& button, const std::string& token) {
+    return "\"$input\" move 800 600 && hold Control_R \" key345 \" && press " + button + " \"" + token +
+           "\" && n=$(grep -cF -- \"" + token + "\" \"$log\") && \"$input\" move 900 600 && wait_count \"" + token +
+           "\" $((n + 2)); r=$?; \"$input\" up " + button + "; [ $r -eq 0 ]";
+  };
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { " + drag("button", " mouse0 ") + " || status=11; }\n"
+                            "[ $status -eq 0 ] && { " + drag("button3", " mouse1 ") + " || status=12; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=14; }\n";
+  const RunResult r = run_live_viewer(prefix, "drag", "--backend cpu --size 1280x800 --log-input", steps, 13);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 left drag, 12 right drag, 13 crash, 14 close)\n"
+                            << r.output;
+  EXPECT_NE(r.output.find("navigation: orbit"), std::string::npos) << r.output;
+  const auto left = poses_while_held(r.output, " mouse0 "), right = poses_while_held(r.output, " mouse1 ");
+  ASSERT_GE(left.size(), 3u) << r.output;
+  ASSERT_GE(right.size(), 3u) << r.output;
+  const LoggedPose &a = left.front(), &b = left.back();
+  ASSERT_TRUE(a.ok && b.ok) << r.output;
+  // Orbit: the view turned right (toward the old right axis), same distance to the same pivot.
+  EXPECT_GT(dot3(b.v + 3, a.v + 6), 0.05) << r.output;
+  EXPECT_NEAR(distance3(b.v, b.v + 9), distance3(a.v, a.v + 9), 1e-3 * distance3(a.v, a.v + 9));
+  EXPECT_LT(distance3(a.v + 9, b.v + 9), 1e-5);
+  const LoggedPose &c = right.front(), &d = right.back();
+  ASSERT_TRUE(c.ok && d.ok) << r.output;
+  // Pan: the same direction, the camera moved left (the scene follows the pointer right).
+  EXPECT_GT(dot3(c.v + 3, d.v + 3), 0.999999) << r.output;
+  const double moved[3] = {d.v[0] - c.v[0], d.v[1] - c.v[1], d.v[2] - c.v[2]};
+  EXPECT_LT(dot3(moved, c.v + 6), -1e-3) << r.output;
+#endif
+}
+
+// Ctrl+O opens the desktop's dialog (here a stand-in zenity on PATH that answers with a
+// scene), and the scene it answers with is loaded.
+TEST(Viewer, CtrlOOpensTheSceneChosenInTheDesktopDialog) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string dir = out_dir(), bin = dir + "/fake_dialog_bin", scene = dir + "/dialog_scene.ply";
+  std::filesystem::create_directories(bin);
+  std::filesystem::copy_file(flashgs::demo_scene_path(), scene, std::filesystem::copy_options::overwrite_existing);
+  if (FILE* f = std::fopen((bin + "/zenity").c_str(), "w")) {
+    std::fprintf(f, "#!/bin/sh\necho '%s'\n", scene.c_str());
+    std::fclose(f);
+  }
+  std::filesystem::permissions(bin + "/zenity", std::filesystem::perms::owner_all);
+  // GLFW key code of Control_L: 341.
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { press Control_L \" key341 \" && \"$input\" down o && \"$input\" up o; "
+                            "r=$?; \"$input\" up Control_L; [ $r -eq 0 ] || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"file dialog: zenity\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"" + scene + ": 30000 Gaussians\" || status=13; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "dialog", "--backend cpu --size 800x450 --log-input", steps, 14,
+                                      "PATH=" + bin + ":$PATH");
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 Ctrl+O, 12 no dialog, 13 not loaded, 14 crash, 15 close)\n"
+                            << r.output;
+#endif
+}
+
 // Ctrl+click on a slider turns it into a text field: what is typed there is clamped to the
 // slider's range. The issue's two cases: 0 seconds per camera, then Space (the path then
 // divided by zero and read a camera key at index INT_MIN), and a render scale of 40.
