@@ -13,7 +13,7 @@ void draw_help_window(bool* open, float ui_scale) {
   ImGui::SetNextWindowBgAlpha(0.92f);
   if (ImGui::Begin("Keys and mouse (F1)", open, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse)) {
     if (ImGui::BeginTable("shortcuts", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
-      ImGui::TableSetupColumn("keys", ImGuiTableColumnFlags_WidthFixed, 230.0f * ui_scale);
+      ImGui::TableSetupColumn("keys", ImGuiTableColumnFlags_WidthFixed, 250.0f * ui_scale);
       ImGui::TableSetupColumn("does");
       ImGui::TableHeadersRow();
       for (const Shortcut& s : kShortcuts) {

@@ -12,7 +12,7 @@ struct Shortcut {
 // key handling in viewer_app_gl.cpp is the other side of this table).
 inline constexpr Shortcut kShortcuts[] = {
     {"left-drag", "look around (fly) / orbit about the pivot (orbit)"},
-    {"right- or middle-drag, Shift+left-drag", "pan"},
+    {"right/middle-drag, Shift+left", "pan"},
     {"wheel", "dolly toward / away from the view"},
     {"W A S D, Q E", "move (fly) or dolly (orbit, W/S); down / up along the world up"},
     {"Shift (held)", "move four times faster"},

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace flashgs::viewer {
 
@@ -11,14 +12,22 @@ Image difference_image(const Image& a, const Image& b, float* factor) {
   *factor = 1.0f;
   if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size()) return out;
   out.resize(a.width, a.height);
-  float worst = 0.0f;
+  std::vector<float> nonzero;
   for (std::size_t i = 0; i < a.rgb.size(); ++i) {
     const float d = std::abs(a.rgb[i] - b.rgb[i]);
     out.rgb[i] = std::isfinite(d) ? d : 1.0f;
-    worst = std::max(worst, out.rgb[i]);
+    if (out.rgb[i] > 0.0f) nonzero.push_back(out.rgb[i]);
+  }
+  // Scaled for the bulk of the errors, not the single worst one (which would leave the rest
+  // black): the 99th percentile of the non-zero errors reaches half of white; larger ones clip.
+  float typical = 0.0f;
+  if (!nonzero.empty()) {
+    const std::size_t k = std::min(nonzero.size() - 1, nonzero.size() * 99 / 100);
+    std::nth_element(nonzero.begin(), nonzero.begin() + std::ptrdiff_t(k), nonzero.end());
+    typical = nonzero[k];
   }
   float f = 1.0f;
-  while (worst > 0.0f && worst * f < 0.5f && f < 1024.0f) f *= 2.0f;
+  while (typical > 0.0f && typical * f < 0.5f && f < 1024.0f) f *= 2.0f;
   for (float& v : out.rgb) v = std::min(1.0f, v * f);
   *factor = f;
   return out;

@@ -5,9 +5,10 @@
 
 namespace flashgs::viewer {
 
-// |a - b| per channel times a power of two chosen so that the largest error is at least half
-// as bright as white (x1 when the error is already that large; up to x1024). `factor` gets the
-// magnification; identical images give black with factor 1. Sizes must match (else empty).
+// |a - b| per channel times a power of two chosen so that the 99th percentile of the non-zero
+// errors is at least half as bright as white (x1 when already that large; up to x1024; larger
+// errors clip to white). `factor` gets the magnification; identical images give black with
+// factor 1. Sizes must match (else empty).
 Image difference_image(const Image& a, const Image& b, float* factor);
 
 // The divider's place, a fraction of the window width from the left, kept in [0.02, 0.98].
