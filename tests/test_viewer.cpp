@@ -443,6 +443,30 @@ TEST(Viewer, CtrlOOpensTheSceneChosenInTheDesktopDialog) {
 #endif
 }
 
+// F1 opens the shortcut table, Tab hides the panels (the window then shows the help and the
+// hint only), Esc quits with exit status 0.
+TEST(Viewer, F1ShowsHelpTabHidesThePanelsAndEscQuits) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // GLFW key codes: F1 290, Tab 258, Escape 256.
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { hold F1 \" key290 \" && wait_for \"help shown (F1)\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { hold Tab \" key258 \" && wait_for \"panels hidden (Tab)\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { \"$input\" down Escape; \"$input\" up Escape; "
+                            "for _ in $(seq 1 1200); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done; "
+                            "if kill -0 $pid 2>/dev/null; then status=15; else wait $pid; exit_status=$?; closed=1; fi; }\n"
+                            "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=14\n";
+  const RunResult r = run_live_viewer(prefix, "help_keys", "--backend cpu --size 800x450 --log-input", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 no help, 12 panels not hidden, 13 crash, 14 exit status, 15 Esc did not quit)\n"
+                            << r.output;
+  EXPECT_NE(r.output.find("quit (Esc / Ctrl+Q)"), std::string::npos) << r.output;
+#endif
+}
+
 // Ctrl+click on a slider turns it into a text field: what is typed there is clamped to the
 // slider's range. The two cases: 0 seconds per camera, then Space (the path then
 // divided by zero and read a camera key at index INT_MIN), and a render scale of 40.

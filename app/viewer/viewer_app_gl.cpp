@@ -251,11 +251,20 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   if (pressed(GLFW_KEY_SPACE)) actions.toggle_play = true;
   if (pressed(GLFW_KEY_C)) actions.compare = true;
   if (pressed(GLFW_KEY_H)) m_settings.heatmap = !m_settings.heatmap;
-  if (pressed(GLFW_KEY_F1)) m_settings.show_help = !m_settings.show_help;
-  if (pressed(GLFW_KEY_TAB)) m_settings.show_ui = !m_settings.show_ui;
+  if (pressed(GLFW_KEY_F1)) {
+    m_settings.show_help = !m_settings.show_help;
+    std::fprintf(stderr, "flashgs-viewer: help %s (F1)\n", m_settings.show_help ? "shown" : "closed");
+  }
+  if (pressed(GLFW_KEY_TAB)) {
+    m_settings.show_ui = !m_settings.show_ui;
+    std::fprintf(stderr, "flashgs-viewer: panels %s (Tab)\n", m_settings.show_ui ? "shown" : "hidden");
+  }
   if (pressed(GLFW_KEY_F)) actions.frame_scene = true;
   if (pressed(GLFW_KEY_G)) m_settings.show_grid = !m_settings.show_grid;
-  if (pressed(GLFW_KEY_ESCAPE) || (pressed(GLFW_KEY_Q) && (mods & GLFW_MOD_CONTROL))) m_window->request_close();
+  if (pressed(GLFW_KEY_ESCAPE) || (pressed(GLFW_KEY_Q) && (mods & GLFW_MOD_CONTROL))) {
+    std::fprintf(stderr, "flashgs-viewer: quit (Esc / Ctrl+Q)\n");
+    m_window->request_close();
+  }
   if (pressed(GLFW_KEY_O) && (mods & GLFW_MOD_CONTROL)) actions.open_dialog = true;
   if (pressed(GLFW_KEY_F12)) {
     if (mods & GLFW_MOD_SHIFT) m_pending_window_shot = next_screenshot_path(m_settings.screenshot_folder, "window");
