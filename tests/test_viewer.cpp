@@ -574,6 +574,28 @@ TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
   }
 }
 
+// "in screenshots": the saved image shows the heat map and its legend as the window does
+// (the panels, drawn after, are not in it); without it, the rendered image alone.
+TEST(Viewer, ScreenshotsIncludeTheHeatMapWhenAsked) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string with = dir + "/shot_with_overlay" + kExt, plain = dir + "/shot_without_overlay" + kExt;
+  const std::string common = prefix + viewer() + " --backend cpu --size 480x270 --camera 1 --frames 2 --heatmap ";
+  const RunResult a = run(common + "--screenshot-overlay --screenshot " + with + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const RunResult b = run(common + "--screenshot " + plain + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const flashgs::Image on = flashgs::read_image(with), off = flashgs::read_image(plain);
+  ASSERT_EQ(on.width, 480);
+  ASSERT_EQ(off.width, 480);
+  EXPECT_LT(flashgs::compare_images(on, off).psnr_db, 30.0) << "the overlay is not in the screenshot";
+  // The legend bar (x 180..460, y 224..238 at UI scale 1) in the ramp's colours.
+  const auto want = flashgs::viewer::heat_colour((320.5f - 180.0f) / 280.0f);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(on.pixel(320, 231)[c], want[c], 3.0f / 255.0f) << c;
+  }
+}
+
 // The split view: left of the divider the baseline's render, right of it the current
 // configuration's, a white line between; the difference view shows |error| magnified, lit
 // exactly where the two renders differ.

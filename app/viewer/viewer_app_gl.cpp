@@ -70,6 +70,7 @@ ViewerApp::ViewerApp(ViewerArgs args) : m_args(std::move(args)) {
   m_settings.mode = m_args.orbit ? NavigationMode::orbit : NavigationMode::fly;  // auto: install_scene
   m_settings.show_ui = !m_args.no_ui;
   m_settings.show_help = m_args.help_window;
+  m_settings.screenshot_overlay = m_args.screenshot_overlay;
   m_settings.show_grid = m_args.grid;
   m_settings.show_frustums = m_args.frustums;
   m_settings.up_axis = int(std::find(kUpAxisNames, kUpAxisNames + kUpAxisCount, m_args.up) - kUpAxisNames) % kUpAxisCount;
@@ -339,11 +340,7 @@ void ViewerApp::apply_actions(const UiActions& a) {
     set_notice("path export cancelled after " + std::to_string(m_export.done_frames()) + " frames");
     m_export.cancel();
   }
-  if (a.screenshot) {
-    const std::string path = next_screenshot_path(m_settings.screenshot_folder, "");
-    if (m_settings.screenshot_overlay && m_settings.heatmap) m_pending_overlay_shot = path;  // at the frame's draw
-    else save_screenshot(path);
-  }
+  if (a.screenshot) take_screenshot(next_screenshot_path(m_settings.screenshot_folder, ""));
   if (a.compare && m_have_frame) run_comparison();
 }
 
@@ -599,6 +596,13 @@ void ViewerApp::render_failed(int width, int height, const std::string& why) {
   }
 }
 
+void ViewerApp::take_screenshot(const std::string& path) {
+  // With the overlay: the framebuffer once this frame's image and heat map are drawn, before
+  // the panels; else the rendered image itself.
+  if (m_settings.screenshot_overlay && m_settings.heatmap) m_pending_overlay_shot = path;
+  else save_screenshot(path);
+}
+
 void ViewerApp::save_screenshot(const std::string& path) {
   try {
     m_path->present_latest();
@@ -705,9 +709,11 @@ void ViewerApp::finish_script() {
     while (m_export.active()) export_step();
   }
   if (m_args.check_frame && m_have_frame) check_displayed_frame();
-  if (!m_args.screenshot.empty()) save_screenshot(m_args.screenshot);
+  if (!m_args.screenshot.empty()) take_screenshot(m_args.screenshot);
   std::fflush(stdout);
-  if (!m_args.window_screenshot.empty()) {
+  if (!m_pending_overlay_shot.empty()) {
+    m_close_after_shot = m_args.exit_after;  // taken while the next frame is drawn
+  } else if (!m_args.window_screenshot.empty()) {
     // Taken at the end of the next frame, once the panels show this frame's statistics.
     m_pending_window_shot = m_args.window_screenshot;
     m_close_after_shot = m_args.exit_after;

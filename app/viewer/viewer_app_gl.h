@@ -59,6 +59,7 @@ class ViewerApp {
   void apply_actions(const UiActions& actions);
   void ensure_texture(int width, int height);
   void render_frame(const Camera& camera);
+  void take_screenshot(const std::string& path);  // the rendered image, or with the heat map (setting)
   void save_screenshot(const std::string& path);
   void save_window_screenshot(const std::string& path, int width, int height);
   void run_comparison();

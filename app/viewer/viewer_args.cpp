@@ -81,6 +81,8 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_option("--compare-right", a->compare_right, "the comparison's right side (default current)")->check(choice);
   app.add_option("--split-at", a->split_at, "the split view's divider, a fraction of the width")
       ->check(finite_in(ValueRange{0.02f, 0.98f}));
+  app.add_flag("--screenshot-overlay", a->screenshot_overlay,
+               "screenshots include the heat map (at the window's size) as the window shows it");
   app.add_option("--screenshot-dir", a->screenshot_dir,
                  "folder for F12's timestamped screenshots (default: the XDG pictures folder, else the working directory)");
   app.add_option("--export-path", a->export_path,
