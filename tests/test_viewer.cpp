@@ -16,7 +16,10 @@
 #include "flashgs/image_io.h"
 #include "flashgs/frame_memory.h"
 #include "heatmap_legend.h"
+#include "camera_controller.h"
 #include "memory_budget.h"
+#include "scene_lines.h"
+#include "scene_state.h"
 #include "test_support.h"
 
 namespace {
@@ -409,6 +412,46 @@ TEST(Viewer, MouseDragsOrbitAndPanTheView) {
   EXPECT_GT(dot3(c.v + 3, d.v + 3), 0.999999) << r.output;
   const double moved[3] = {d.v[0] - c.v[0], d.v[1] - c.v[1], d.v[2] - c.v[2]};
   EXPECT_LT(dot3(moved, c.v + 6), -1e-3) << r.output;
+#endif
+}
+
+// A click (XTEST) on a training camera's frustum jumps to that camera: the test projects the
+// demo scene's camera centres into the start view (camera 0's pose with a 150-degree field of
+// view, so that the ring of cameras is in it) and clicks on one of them.
+TEST(Viewer, ClickingAFrustumJumpsToThatCamera) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  namespace fv = flashgs::viewer;
+  const fv::LoadedScene scene = fv::load_scene(flashgs::demo_scene_path());
+  ASSERT_GT(scene.cameras.size(), 2u);
+  fv::CameraController controller;
+  controller.snap_to(scene.cameras[0]);
+  const flashgs::Camera view = controller.render_camera(1280, 720, 150.0f);
+  const auto centres = fv::project_segments(fv::camera_frustums(scene.cameras, 0.1f, -1), view, 1e-3f);
+  int target = -1, x = 0, y = 0;
+  for (std::size_t k = 1; k < scene.cameras.size() && target < 0; ++k) {
+    const fv::ScreenSegment& s = centres[k * 10];  // each frustum's first segment starts at its centre
+    if (s.x0 > 60 && s.x0 < 1220 && s.y0 > 60 && s.y0 < 660 &&
+        fv::pick_camera(scene.cameras, view, s.x0, s.y0, 14.0f) == int(k)) {
+      target = int(k);
+      x = int(std::lround(s.x0));
+      y = int(std::lround(s.y0));
+    }
+  }
+  ASSERT_GE(target, 0) << "no camera in the start view";
+  const std::string steps = "wait_for \"frame path\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$input\" move " + std::to_string(x) + " " + std::to_string(y) +
+                            " && hold Control_R \" key345 \" && hold button \" mouse0 \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"clicked the frustum of camera " + std::to_string(target) +
+                            "\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=14; }\n";
+  const RunResult r = run_live_viewer(prefix, "frustum_click",
+                                      "--backend cpu --size 1280x720 --camera 0 --fov 150 --frustums --no-ui --log-input", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 not picked, 13 crash, 14 close)\n"
+                            << r.output;
 #endif
 }
 
