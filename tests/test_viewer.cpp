@@ -761,7 +761,9 @@ TEST(Viewer, NonFiniteAndOutOfRangeOptionsAreRefusedNamingTheOption) {
       {"--scale nan", "--scale"},          {"--scale inf", "--scale"},     {"--scale 40", "--scale"},
       {"--fov nan", "--fov"},              {"--tau nan", "--tau"},         {"--background 0,nan,0", "--background"},
       {"--camera -1", "--camera"},         {"--render-size 0x10", "--render-size"},
-      {"--render-size 99999999999x1", "--render-size"}, {"--size 12x", "--size"}};
+      {"--render-size 99999999999x1", "--render-size"}, {"--size 12x", "--size"},
+      {"--compare-left nonsense", "--compare-left"}, {"--split-at nan", "--split-at"},
+      {"--split-at 2", "--split-at"},      {"--export-frames 0", "--export-frames"}};
   for (const auto& [args, option] : cases) {
     const RunResult r = run("timeout 60 " + viewer() + " " + args + " --backend cpu --frames 1 --exit");
     EXPECT_NE(r.exit_code, 0) << args << "\n" << r.output;

@@ -427,6 +427,7 @@ void ViewerApp::open_file_dialog() {
 void ViewerApp::start_path_export(const std::string& folder, int frames) {
   if (!m_camera_path || m_camera_path->empty()) {
     set_notice("path export: the scene has no cameras to make a path from");
+    if (m_scripted) m_exit_code = 2;
     return;
   }
   const std::string problem = m_export.start(folder, frames);
