@@ -415,6 +415,33 @@ TEST(Viewer, MouseDragsOrbitAndPanTheView) {
 #endif
 }
 
+// Without zenity or kdialog on PATH, Ctrl+O opens the in-app browser on the scene's folder;
+// a click on a PLY there opens it.
+TEST(Viewer, CtrlOWithoutADesktopDialogOpensTheInAppBrowser) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  for (const char* tool : {"/usr/bin/zenity", "/usr/bin/kdialog", "/bin/zenity", "/bin/kdialog"})
+    if (std::filesystem::exists(tool)) GTEST_SKIP() << tool << " is installed: the desktop dialog would open";
+  // The browser sits in the middle of a 1100x700 window (460x420 points at UI scale 1): its
+  // folder's first PLY (the demo's point_cloud.ply) at (380, 222).
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$input\" move 700 500 && press Control_L \" key341 \" && "
+                            "\"$input\" down o && \"$input\" up o; r=$?; \"$input\" up Control_L; [ $r -eq 0 ] || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"file dialog: in-app browser\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { \"$input\" move 380 222 && hold button \" mouse0 \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_count \"point_cloud.ply: 30000 Gaussians\" 2 || status=13; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "browser", "--backend cpu --size 1100x700 --log-input", steps, 14,
+                                      "PATH=/usr/bin:/bin");
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 Ctrl+O or click, 12 no browser, 13 not loaded, 14 crash, 15 close)\n"
+                            << r.output;
+#endif
+}
+
 // A click (XTEST) on a training camera's frustum jumps to that camera: the test projects the
 // demo scene's camera centres into the start view (camera 0's pose with a 150-degree field of
 // view, so that the ring of cameras is in it) and clicks on one of them.

@@ -10,6 +10,7 @@ namespace flashgs::viewer {
 
 void FileBrowser::open(const std::string& folder) {
   m_open = true;
+  m_just_opened = true;
   std::error_code ec;
   list(std::filesystem::is_directory(folder, ec) ? folder : std::filesystem::current_path(ec).string());
 }
@@ -36,7 +37,14 @@ void FileBrowser::list(const std::string& folder) {
 std::string FileBrowser::draw(float ui_scale) {
   if (!m_open) return "";
   std::string chosen;
+  // In the middle of the window, over the panels, opaque: it is a modal choice.
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x * 0.5f, vp->WorkPos.y + vp->WorkSize.y * 0.5f),
+                          ImGuiCond_Appearing, ImVec2(0.5f, 0.5f));
   ImGui::SetNextWindowSize(ImVec2(460 * ui_scale, 420 * ui_scale), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowBgAlpha(0.97f);
+  if (m_just_opened) ImGui::SetNextWindowFocus();
+  m_just_opened = false;
   if (ImGui::Begin("Open a scene", &m_open)) {
     ImGui::TextWrapped("%s", m_folder.c_str());
     if (ImGui::Button("Up")) list(std::filesystem::path(m_folder).parent_path().string());

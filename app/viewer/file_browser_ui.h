@@ -17,6 +17,7 @@ class FileBrowser {
   void list(const std::string& folder);
 
   bool m_open = false;
+  bool m_just_opened = false;  // takes the focus in its first frame
   std::string m_folder;
   std::vector<std::string> m_folders, m_files;  // names in m_folder
   std::string m_error;
