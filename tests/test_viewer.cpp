@@ -277,6 +277,33 @@ TEST(Viewer, DroppedFilesOpenAndABadOneKeepsTheViewerRunning) {
 #endif
 }
 
+// A 3DGS training output folder dropped on the window: the highest iteration's PLY opens,
+// with the cameras.json of the model root.
+TEST(Viewer, ADropped3dgsOutputFolderOpensItsLastIteration) {
+#if !defined(FLASHGS_X11_DROP) || !defined(FLASHGS_X11_INPUT)
+  GTEST_SKIP() << "built without Xlib or libXtst: the drop and input helpers are absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  namespace fs = std::filesystem;
+  const std::string model = out_dir() + "/dropped_model";
+  fs::remove_all(model);
+  for (const char* iteration : {"iteration_7000", "iteration_30000"}) {
+    fs::create_directories(model + "/point_cloud/" + iteration);
+    fs::copy_file(flashgs::demo_scene_path(), model + "/point_cloud/" + iteration + "/point_cloud.ply");
+  }
+  fs::copy_file(fs::path(flashgs::demo_scene_path()).parent_path() / "cameras.json", model + "/cameras.json");
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$drop\" 600 300 \"" + model + "\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"iteration_30000/point_cloud.ply: 30000 Gaussians, SH degree 1, "
+                            "36 cameras\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=14; }\n";
+  const RunResult r = run_live_viewer(prefix, "drop_model", "--backend cpu --size 800x450", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 drop, 12 not loaded, 13 crash, 14 close)\n"
+                            << r.output;
+#endif
+}
+
 // A FIFO dropped on the window: one clear message, the scene stays, and closing the window
 // does not wait for anything (opening a FIFO blocks until a writer appears).
 TEST(Viewer, ADroppedFifoIsRefusedAndTheWindowClosesPromptly) {
@@ -642,6 +669,36 @@ TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
     for (int dx = -1; dx <= 1; ++dx) brightest = std::max(brightest, on.pixel(x + dx, 240)[0]);
     EXPECT_GT(brightest, 0.7f) << "no tick mark for " << value << " at x " << x;
   }
+}
+
+// G / --grid: the ground grid and the world axes are drawn over the frame (the x axis red, the
+// y axis green), the frustums in orange.
+TEST(Viewer, GridAxesAndFrustumsAreDrawnOverTheFrame) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string with = dir + "/guides_on" + kExt, without = dir + "/guides_off" + kExt;
+  const std::string common = prefix + viewer() + " --backend cpu --size 480x270 --frames 2 --no-ui --keys S:1.5 ";
+  const RunResult a = run(common + "--grid --frustums --window-screenshot " + with + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const RunResult b = run(common + "--window-screenshot " + without + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const flashgs::Image on = flashgs::read_image(with), off = flashgs::read_image(without);
+  ASSERT_EQ(on.width, off.width);
+  std::size_t changed = 0, red = 0, green = 0, orange = 0;
+  for (int y = 30; y < on.height; ++y)  // below the hidden-panels hint
+    for (int x = 0; x < on.width; ++x) {
+      const float *p = on.pixel(x, y), *q = off.pixel(x, y);
+      if (std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]) < 0.1f) continue;
+      ++changed;
+      red += p[0] > 0.8f && p[1] < 0.4f && p[2] < 0.4f;
+      green += p[1] > 0.8f && p[0] < 0.5f && p[2] < 0.5f;
+      orange += p[0] > 0.8f && p[1] > 0.4f && p[1] < 0.75f && p[2] < 0.3f;
+    }
+  std::printf("guides: %zu pixels changed, %zu red, %zu green, %zu orange\n", changed, red, green, orange);
+  EXPECT_GT(changed, 2000u);
+  EXPECT_GT(red, 5u) << "no x axis";
+  EXPECT_GT(green, 5u) << "no y axis";
+  EXPECT_GT(orange, 50u) << "no frustums";
 }
 
 // "in screenshots": the saved image shows the heat map and its legend as the window does
