@@ -46,7 +46,7 @@ std::string same_configuration_problem(const RenderOptions& left, const RenderOp
 }
 
 CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOptions& left_options,
-                          const RenderOptions& right_options) {
+                          const RenderOptions& right_options, bool warm_up) {
   CompareResult r;
   r.left_label = left_options.label();
   r.right_label = right_options.label();
@@ -58,12 +58,11 @@ CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOpt
     const RenderOptions left = untracked(left_options), right = untracked(right_options);
     FrameStats sl, sr;
     using clock = std::chrono::steady_clock;
-    // Each rendered twice; the second is timed, so a first-use allocation does not count.
-    path.render_image(camera, right, r.right_image, &sr);
+    if (warm_up) path.render_image(camera, right, r.right_image, &sr);
     auto t0 = clock::now();
     path.render_image(camera, right, r.right_image, &sr);
     auto t1 = clock::now();
-    path.render_image(camera, left, r.left_image, &sl);
+    if (warm_up) path.render_image(camera, left, r.left_image, &sl);
     auto t2 = clock::now();
     path.render_image(camera, left, r.left_image, &sl);
     auto t3 = clock::now();

@@ -40,7 +40,11 @@ struct CompareResult {
 };
 
 // Renders `camera` with `left` and with `right` through `path`'s host-memory route and
-// compares them. Never throws: errors (and two equal configurations) land in `error`.
-CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOptions& left, const RenderOptions& right);
+// compares them. With `warm_up` each is rendered twice and the second timed (a GPU path's
+// first use of a size allocates); the CPU path's buffers are already sized by the frame
+// just shown, and a second render would double the wait. Never throws: errors (and two
+// equal configurations) land in `error`.
+CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOptions& left, const RenderOptions& right,
+                          bool warm_up = true);
 
 }  // namespace flashgs::viewer

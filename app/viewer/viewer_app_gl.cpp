@@ -347,7 +347,7 @@ void ViewerApp::apply_actions(const UiActions& a) {
 void ViewerApp::run_comparison() {
   const RenderOptions left = compare_choice_options(m_settings.compare_left, m_settings.options);
   const RenderOptions right = compare_choice_options(m_settings.compare_right, m_settings.options);
-  m_compare = run_compare(*m_path, m_last_camera, left, right);
+  m_compare = run_compare(*m_path, m_last_camera, left, right, /*warm_up=*/!m_path_is_cpu);
   m_compare_camera = m_last_camera;
   m_compare_options = m_last_options;
   if (!m_compare.valid) {
