@@ -10,20 +10,13 @@ uniform float u_opacity;      // blend weight of the overlay
 uniform vec4 u_legend_rect;   // window-pixel rect (x0, y0, x1, y1), y down; the bar runs 0 -> max left to right
 uniform vec2 u_viewport;      // window framebuffer size in pixels
 
-// A perceptually ordered blue -> cyan -> green -> yellow -> red ramp, piecewise linear so that
-// the legend and the overlay agree exactly.
+uniform vec3 u_ramp[9];       // the colour ramp's evenly spaced stops (heatmap_legend.h: kHeatRamp)
+
+// Piecewise linear between the stops, as heat_colour() on the host: legend and overlay agree.
 vec3 ramp(float t) {
-  t = clamp(t, 0.0, 1.0);
-  const vec3 c0 = vec3(0.05, 0.03, 0.35);
-  const vec3 c1 = vec3(0.00, 0.45, 0.95);
-  const vec3 c2 = vec3(0.10, 0.85, 0.45);
-  const vec3 c3 = vec3(0.98, 0.90, 0.15);
-  const vec3 c4 = vec3(0.90, 0.10, 0.05);
-  float s = t * 4.0;
-  if (s < 1.0) return mix(c0, c1, s);
-  if (s < 2.0) return mix(c1, c2, s - 1.0);
-  if (s < 3.0) return mix(c2, c3, s - 2.0);
-  return mix(c3, c4, s - 3.0);
+  float s = clamp(t, 0.0, 1.0) * 8.0;
+  int i = min(int(s), 7);
+  return mix(u_ramp[i], u_ramp[i + 1], s - float(i));
 }
 
 float normalised(float c) {

@@ -15,7 +15,11 @@
 #include "flashgs/image.h"
 #include "flashgs/image_io.h"
 #include "flashgs/frame_memory.h"
+#include "heatmap_legend.h"
+#include "camera_controller.h"
 #include "memory_budget.h"
+#include "scene_lines.h"
+#include "scene_state.h"
 #include "test_support.h"
 
 namespace {
@@ -95,13 +99,14 @@ const char* const kInputHelper = "";
 //                        sets `closed` (its exit status in `exit_status`)
 // A failing step sets `status`. The script then exits with `crash_status` if the viewer is gone
 // without being closed, else with `status`. Returns its result with the viewer's log appended.
+// `env` (e.g. "PATH=/x:$PATH") is set for the viewer alone.
 RunResult run_live_viewer(const std::string& prefix, const std::string& name, const std::string& viewer_args,
-                          const std::string& steps, int crash_status) {
+                          const std::string& steps, int crash_status, const std::string& env = "") {
   const std::string dir = out_dir(), script = dir + "/" + name + ".sh", log = dir + "/" + name + ".log";
   if (FILE* f = std::fopen(script.c_str(), "w")) {
     std::fputs(("viewer=$1 drop=$2 input=$3 log=$4\n"
                 "cd \"$(dirname \"$log\")\"\n"
-                "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
+                + (env.empty() ? std::string() : "env " + env + " ") + "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
                 "pid=$!\n"
                 "closed=0 exit_status=\n"
                 "wait_count() {\n"
@@ -272,6 +277,33 @@ TEST(Viewer, DroppedFilesOpenAndABadOneKeepsTheViewerRunning) {
 #endif
 }
 
+// A 3DGS training output folder dropped on the window: the highest iteration's PLY opens,
+// with the cameras.json of the model root.
+TEST(Viewer, ADropped3dgsOutputFolderOpensItsLastIteration) {
+#if !defined(FLASHGS_X11_DROP) || !defined(FLASHGS_X11_INPUT)
+  GTEST_SKIP() << "built without Xlib or libXtst: the drop and input helpers are absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  namespace fs = std::filesystem;
+  const std::string model = out_dir() + "/dropped_model";
+  fs::remove_all(model);
+  for (const char* iteration : {"iteration_7000", "iteration_30000"}) {
+    fs::create_directories(model + "/point_cloud/" + iteration);
+    fs::copy_file(flashgs::demo_scene_path(), model + "/point_cloud/" + iteration + "/point_cloud.ply");
+  }
+  fs::copy_file(fs::path(flashgs::demo_scene_path()).parent_path() / "cameras.json", model + "/cameras.json");
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$drop\" 600 300 \"" + model + "\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"iteration_30000/point_cloud.ply: 30000 Gaussians, SH degree 1, "
+                            "36 cameras\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=14; }\n";
+  const RunResult r = run_live_viewer(prefix, "drop_model", "--backend cpu --size 800x450", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 drop, 12 not loaded, 13 crash, 14 close)\n"
+                            << r.output;
+#endif
+}
+
 // A FIFO dropped on the window: one clear message, the scene stays, and closing the window
 // does not wait for anything (opening a FIFO blocks until a writer appears).
 TEST(Viewer, ADroppedFifoIsRefusedAndTheWindowClosesPromptly) {
@@ -328,11 +360,207 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   // The button's place in a 1280x720 window at UI scale 1 (the panel layout is fixed).
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
-                            "[ $status -eq 0 ] && { \"$input\" move 95 650 && hold button \" mouse0 \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { \"$input\" move 95 673 && hold button \" mouse0 \" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=12; }\n";
   const RunResult r = run_live_viewer(prefix, "click", "--backend cpu --size 1280x720 --log-input", steps, 13);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 no comparison, 13 crash)\n"
                             << r.output;
+#endif
+}
+
+// The pose logged with each held-button frame (--log-input): camera, forward, right, pivot.
+struct LoggedPose {
+  double v[12] = {};
+  bool ok = false;
+};
+
+std::vector<LoggedPose> poses_while_held(const std::string& log, const std::string& token) {
+  std::vector<LoggedPose> out;
+  std::size_t at = 0;
+  while ((at = log.find("held:", at)) != std::string::npos) {
+    const std::size_t end = log.find('\n', at);
+    const std::string line = log.substr(at, end - at);
+    at = end;
+    if (line.find(token) == std::string::npos) continue;
+    const auto c = line.find("| camera ");
+    if (c == std::string::npos) continue;
+    LoggedPose p;
+    p.ok = std::sscanf(line.c_str() + c, "| camera %lf %lf %lf forward %lf %lf %lf right %lf %lf %lf pivot %lf %lf %lf",
+                       &p.v[0], &p.v[1], &p.v[2], &p.v[3], &p.v[4], &p.v[5], &p.v[6], &p.v[7], &p.v[8], &p.v[9],
+                       &p.v[10], &p.v[11]) == 12;
+    out.push_back(p);
+  }
+  return out;
+}
+
+double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double distance3(const double* a, const double* b) {
+  const double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+  return std::sqrt(dot3(d, d));
+}
+
+// Real mouse drags (XTEST) over the image: the left button orbits the object-sized demo
+// scene (the default mode there) about its pivot, turning the view right when dragged right;
+// the right button pans it sideways without turning.
+TEST(Viewer, MouseDragsOrbitAndPanTheView) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // Over the image: right of the main panel, below the statistics (1280x800 at UI scale 1).
+  // The pointer is moved, then two frames pass (a harmless key held: Control_R, GLFW 345)
+  // before the button goes down, so that the move is not taken as part of the drag.
+  auto drag = [](const std::string& button, const std::string& token) {
+    return "\"$input\" move 800 600 && hold Control_R \" key345 \" && press " + button + " \"" + token +
+           "\" && n=$(grep -cF -- \"" + token + "\" \"$log\") && \"$input\" move 900 600 && wait_count \"" + token +
+           "\" $((n + 2)); r=$?; \"$input\" up " + button + "; [ $r -eq 0 ]";
+  };
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { " + drag("button", " mouse0 ") + " || status=11; }\n"
+                            "[ $status -eq 0 ] && { " + drag("button3", " mouse1 ") + " || status=12; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=14; }\n";
+  const RunResult r = run_live_viewer(prefix, "drag", "--backend cpu --size 1280x800 --log-input", steps, 13);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 left drag, 12 right drag, 13 crash, 14 close)\n"
+                            << r.output;
+  EXPECT_NE(r.output.find("navigation: orbit"), std::string::npos) << r.output;
+  const auto left = poses_while_held(r.output, " mouse0 "), right = poses_while_held(r.output, " mouse1 ");
+  ASSERT_GE(left.size(), 3u) << r.output;
+  ASSERT_GE(right.size(), 3u) << r.output;
+  const LoggedPose &a = left.front(), &b = left.back();
+  ASSERT_TRUE(a.ok && b.ok) << r.output;
+  // Orbit: the view turned right (toward the old right axis), same distance to the same pivot.
+  EXPECT_GT(dot3(b.v + 3, a.v + 6), 0.05) << r.output;
+  EXPECT_NEAR(distance3(b.v, b.v + 9), distance3(a.v, a.v + 9), 1e-3 * distance3(a.v, a.v + 9));
+  EXPECT_LT(distance3(a.v + 9, b.v + 9), 1e-5);
+  const LoggedPose &c = right.front(), &d = right.back();
+  ASSERT_TRUE(c.ok && d.ok) << r.output;
+  // Pan: the same direction, the camera moved left (the scene follows the pointer right).
+  EXPECT_GT(dot3(c.v + 3, d.v + 3), 0.999999) << r.output;
+  const double moved[3] = {d.v[0] - c.v[0], d.v[1] - c.v[1], d.v[2] - c.v[2]};
+  EXPECT_LT(dot3(moved, c.v + 6), -1e-3) << r.output;
+#endif
+}
+
+// Without zenity or kdialog on PATH, Ctrl+O opens the in-app browser on the scene's folder;
+// a click on a PLY there opens it.
+TEST(Viewer, CtrlOWithoutADesktopDialogOpensTheInAppBrowser) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  for (const char* tool : {"/usr/bin/zenity", "/usr/bin/kdialog", "/bin/zenity", "/bin/kdialog"})
+    if (std::filesystem::exists(tool)) GTEST_SKIP() << tool << " is installed: the desktop dialog would open";
+  // The browser sits in the middle of a 1100x700 window (460x420 points at UI scale 1): its
+  // folder's first PLY (the demo's point_cloud.ply) at (380, 222).
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$input\" move 700 500 && press Control_L \" key341 \" && "
+                            "\"$input\" down o && \"$input\" up o; r=$?; \"$input\" up Control_L; [ $r -eq 0 ] || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"file dialog: in-app browser\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { \"$input\" move 380 222 && hold button \" mouse0 \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_count \"point_cloud.ply: 30000 Gaussians\" 2 || status=13; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "browser", "--backend cpu --size 1100x700 --log-input", steps, 14,
+                                      "PATH=/usr/bin:/bin");
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 Ctrl+O or click, 12 no browser, 13 not loaded, 14 crash, 15 close)\n"
+                            << r.output;
+#endif
+}
+
+// A click (XTEST) on a training camera's frustum jumps to that camera: the test projects the
+// demo scene's camera centres into the start view (camera 0's pose with a 150-degree field of
+// view, so that the ring of cameras is in it) and clicks on one of them.
+TEST(Viewer, ClickingAFrustumJumpsToThatCamera) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  namespace fv = flashgs::viewer;
+  const fv::LoadedScene scene = fv::load_scene(flashgs::demo_scene_path());
+  ASSERT_GT(scene.cameras.size(), 2u);
+  fv::CameraController controller;
+  controller.snap_to(scene.cameras[0]);
+  const flashgs::Camera view = controller.render_camera(1280, 720, 150.0f);
+  const auto centres = fv::project_segments(fv::camera_frustums(scene.cameras, 0.1f, -1), view, 1e-3f);
+  int target = -1, x = 0, y = 0;
+  for (std::size_t k = 1; k < scene.cameras.size() && target < 0; ++k) {
+    const fv::ScreenSegment& s = centres[k * 10];  // each frustum's first segment starts at its centre
+    if (s.x0 > 60 && s.x0 < 1220 && s.y0 > 60 && s.y0 < 660 &&
+        fv::pick_camera(scene.cameras, view, s.x0, s.y0, 14.0f) == int(k)) {
+      target = int(k);
+      x = int(std::lround(s.x0));
+      y = int(std::lround(s.y0));
+    }
+  }
+  ASSERT_GE(target, 0) << "no camera in the start view";
+  const std::string steps = "wait_for \"frame path\" || status=10\n"
+                            "[ $status -eq 0 ] && { \"$input\" move " + std::to_string(x) + " " + std::to_string(y) +
+                            " && hold Control_R \" key345 \" && hold button \" mouse0 \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"clicked the frustum of camera " + std::to_string(target) +
+                            "\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=14; }\n";
+  const RunResult r = run_live_viewer(prefix, "frustum_click",
+                                      "--backend cpu --size 1280x720 --camera 0 --fov 150 --frustums --no-ui --log-input", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 not picked, 13 crash, 14 close)\n"
+                            << r.output;
+#endif
+}
+
+// Ctrl+O opens the desktop's dialog (here a stand-in zenity on PATH that answers with a
+// scene), and the scene it answers with is loaded.
+TEST(Viewer, CtrlOOpensTheSceneChosenInTheDesktopDialog) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string dir = out_dir(), bin = dir + "/fake_dialog_bin", scene = dir + "/dialog_scene.ply";
+  std::filesystem::create_directories(bin);
+  std::filesystem::copy_file(flashgs::demo_scene_path(), scene, std::filesystem::copy_options::overwrite_existing);
+  if (FILE* f = std::fopen((bin + "/zenity").c_str(), "w")) {
+    std::fprintf(f, "#!/bin/sh\necho '%s'\n", scene.c_str());
+    std::fclose(f);
+  }
+  std::filesystem::permissions(bin + "/zenity", std::filesystem::perms::owner_all);
+  // GLFW key code of Control_L: 341.
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { press Control_L \" key341 \" && \"$input\" down o && \"$input\" up o; "
+                            "r=$?; \"$input\" up Control_L; [ $r -eq 0 ] || status=11; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"file dialog: zenity\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"" + scene + ": 30000 Gaussians\" || status=13; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "dialog", "--backend cpu --size 800x450 --log-input", steps, 14,
+                                      "PATH=" + bin + ":$PATH");
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 Ctrl+O, 12 no dialog, 13 not loaded, 14 crash, 15 close)\n"
+                            << r.output;
+#endif
+}
+
+// F1 opens the shortcut table, Tab hides the panels (the window then shows the help and the
+// hint only), Esc quits with exit status 0.
+TEST(Viewer, F1ShowsHelpTabHidesThePanelsAndEscQuits) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // GLFW key codes: F1 290, Tab 258, Escape 256.
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { hold F1 \" key290 \" && wait_for \"help shown (F1)\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { hold Tab \" key258 \" && wait_for \"panels hidden (Tab)\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { \"$input\" down Escape; \"$input\" up Escape; "
+                            "for _ in $(seq 1 1200); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done; "
+                            "if kill -0 $pid 2>/dev/null; then status=15; else wait $pid; exit_status=$?; closed=1; fi; }\n"
+                            "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=14\n";
+  const RunResult r = run_live_viewer(prefix, "help_keys", "--backend cpu --size 800x450 --log-input", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 no help, 12 panels not hidden, 13 crash, 14 exit status, 15 Esc did not quit)\n"
+                            << r.output;
+  EXPECT_NE(r.output.find("quit (Esc / Ctrl+Q)"), std::string::npos) << r.output;
 #endif
 }
 
@@ -347,7 +575,8 @@ TEST(Viewer, TypedSliderValuesAreClampedToTheirRanges) {
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   if (!flashgs::image_io_has_oiio()) GTEST_SKIP() << "F12 saves PNG, which needs OpenImageIO";
   const std::string dir = out_dir();
-  std::filesystem::remove(dir + "/flashgs_screenshot.png");
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().filename().string().rfind("flashgs_20", 0) == 0) std::filesystem::remove(e.path());
   // Slider places in a 640x720 window at UI scale 1 (the panel layout is fixed): "s per
   // camera" at (100, 196), "Render scale" at (110, 281). GLFW key codes: Ctrl 341, Enter 257, Space 32.
   auto typed = [](int x, int y, const std::string& text) {
@@ -360,14 +589,14 @@ TEST(Viewer, TypedSliderValuesAreClampedToTheirRanges) {
       "[ $status -eq 0 ] && { " + typed(100, 196, "0") + " || status=11; }\n"
       "[ $status -eq 0 ] && { hold space \" key32 \" || status=12; }\n"
       "[ $status -eq 0 ] && { \"$input\" down F12 && \"$input\" up F12 || status=12; }\n"
-      "[ $status -eq 0 ] && { wait_for \"saved flashgs_screenshot\" || status=13; }\n"
-      "[ $status -eq 0 ] && { cp flashgs_screenshot.png playing_after_typed_zero.png; hold space \" key32 \" || status=14; }\n"
+      "[ $status -eq 0 ] && { wait_for \"saved ./flashgs_20\" || status=13; }\n"
+      "[ $status -eq 0 ] && { cp \"$(ls flashgs_20*.png | head -1)\" playing_after_typed_zero.png; hold space \" key32 \" || status=14; }\n"
       "[ $status -eq 0 ] && { " + typed(110, 281, "40") + " || status=14; }\n"
       "[ $status -eq 0 ] && { \"$input\" down F12 && \"$input\" up F12 || status=14; }\n"
-      "[ $status -eq 0 ] && { wait_count \"saved flashgs_screenshot\" 2 || status=15; }\n"
+      "[ $status -eq 0 ] && { wait_count \"saved ./flashgs_20\" 2 || status=15; }\n"
       "[ $status -eq 0 ] && { close_window || status=17; }\n";
   std::filesystem::remove(dir + "/playing_after_typed_zero.png");
-  const RunResult r = run_live_viewer(prefix, "typed_sliders", "--backend cpu --size 640x720 --log-input", steps, 16);
+  const RunResult r = run_live_viewer(prefix, "typed_sliders", "--backend cpu --size 640x720 --log-input --screenshot-dir .", steps, 16);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 start, 11 typing 0, 12 play + screenshot, 13 no screenshot, 14 typing 40, "
                                "15 no screenshot, 16 crash, 17 close)\n"
@@ -379,11 +608,12 @@ TEST(Viewer, TypedSliderValuesAreClampedToTheirRanges) {
   std::printf("playing after a typed 0: %.1f %% of the pixels lit\n", 100.0 * lit);
   EXPECT_GT(lit, 0.05);
   // 40 became the range's top, 4: a 2560x2880 frame.
-  EXPECT_NE(r.output.find("saved flashgs_screenshot.png (2560x2880)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(".png (2560x2880)"), std::string::npos) << r.output;
 #endif
 }
 
-// The heat-map shader draws over the frame, and its legend runs from blue (0) to red (max).
+// The heat-map shader draws over the frame; its legend bar is the viridis ramp from 0 to the
+// maximum, with tick marks and values at round counts and a caption naming the scale.
 TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir();
@@ -396,13 +626,191 @@ TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
   const flashgs::Image on = flashgs::read_image(with), off = flashgs::read_image(without);
   ASSERT_EQ(on.width, 480);
   EXPECT_LT(flashgs::compare_images(on, off).psnr_db, 30.0) << "the overlay changed nothing";
-  // Legend bar: x in [480 - 300, 480 - 20), y in [270 - 30, 270 - 16) at UI scale 1.
-  const float* low = on.pixel(185, 247);
-  const float* high = on.pixel(455, 247);
-  EXPECT_GT(low[2], 0.25f);
-  EXPECT_LT(low[0], 0.2f);
-  EXPECT_GT(high[0], 0.7f);
-  EXPECT_LT(high[2], 0.2f);
+  // The legend as logged: "pairs per 16x16 tile, log scale, ticks 0@0% 1@9% ... MAX@100%".
+  const std::string key = "heat-map legend: pairs per 16x16 tile, log scale, ticks ";
+  const auto at = a.output.find(key);
+  ASSERT_NE(at, std::string::npos) << a.output;
+  std::vector<std::pair<long, int>> ticks;  // value, percent along the bar
+  {
+    const std::string line = a.output.substr(at + key.size(), a.output.find('\n', at) - at - key.size());
+    std::size_t i = 0;
+    while (i < line.size()) {
+      long value = 0;
+      int percent = 0;
+      if (std::sscanf(line.c_str() + i, "%ld@%d%%", &value, &percent) != 2) break;
+      ticks.emplace_back(value, percent);
+      i = line.find(' ', i);
+      if (i == std::string::npos) break;
+      ++i;
+    }
+  }
+  ASSERT_GE(ticks.size(), 3u) << a.output;
+  EXPECT_EQ(ticks[0], std::make_pair(0L, 0));
+  EXPECT_EQ(ticks[1].first, 1);
+  EXPECT_EQ(ticks.back().second, 100);
+  const long max_count = ticks.back().first;
+  EXPECT_GT(max_count, 10);
+  for (std::size_t k = 1; k + 1 < ticks.size(); ++k) {
+    EXPECT_EQ(ticks[k].first, ticks[k - 1].first == 0 ? 1 : ticks[k - 1].first * 10) << "log ticks are powers of ten";
+    EXPECT_NEAR(ticks[k].second, 100.0 * std::log1p(double(ticks[k].first)) / std::log1p(double(max_count)), 0.6);
+  }
+  // Bar: x in [480 - 300, 480 - 20), y in [270 - 46, 270 - 32) at UI scale 1; the ramp's
+  // colour at each place, and a white tick mark just below the bar at each tick.
+  const float x0 = 180.0f, x1 = 460.0f;
+  for (float t : {0.02f, 0.25f, 0.5f, 0.75f, 0.98f}) {
+    const int x = int(x0 + t * (x1 - x0));
+    const float* p = on.pixel(x, 231);
+    const auto want = flashgs::viewer::heat_colour((float(x) + 0.5f - x0) / (x1 - x0));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], want[c], 3.0f / 255.0f) << "bar at t " << t << " channel " << c;
+  }
+  for (const auto& [value, percent] : ticks) {
+    const int x = std::min(int(x1) - 1, int(std::lround(x0 + percent / 100.0 * (x1 - x0))));
+    float brightest = 0.0f;
+    for (int dx = -1; dx <= 1; ++dx) brightest = std::max(brightest, on.pixel(x + dx, 240)[0]);
+    EXPECT_GT(brightest, 0.7f) << "no tick mark for " << value << " at x " << x;
+  }
+}
+
+// G / --grid: the ground grid and the world axes are drawn over the frame (the x axis red, the
+// y axis green), the frustums in orange.
+TEST(Viewer, GridAxesAndFrustumsAreDrawnOverTheFrame) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string with = dir + "/guides_on" + kExt, without = dir + "/guides_off" + kExt;
+  const std::string common = prefix + viewer() + " --backend cpu --size 480x270 --frames 2 --no-ui --keys S:1.5 ";
+  const RunResult a = run(common + "--grid --frustums --window-screenshot " + with + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const RunResult b = run(common + "--window-screenshot " + without + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const flashgs::Image on = flashgs::read_image(with), off = flashgs::read_image(without);
+  ASSERT_EQ(on.width, off.width);
+  std::size_t changed = 0, red = 0, green = 0, orange = 0;
+  for (int y = 30; y < on.height; ++y)  // below the hidden-panels hint
+    for (int x = 0; x < on.width; ++x) {
+      const float *p = on.pixel(x, y), *q = off.pixel(x, y);
+      if (std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]) < 0.1f) continue;
+      ++changed;
+      red += p[0] > 0.8f && p[1] < 0.4f && p[2] < 0.4f;
+      green += p[1] > 0.8f && p[0] < 0.5f && p[2] < 0.5f;
+      orange += p[0] > 0.8f && p[1] > 0.4f && p[1] < 0.75f && p[2] < 0.3f;
+    }
+  std::printf("guides: %zu pixels changed, %zu red, %zu green, %zu orange\n", changed, red, green, orange);
+  EXPECT_GT(changed, 2000u);
+  EXPECT_GT(red, 5u) << "no x axis";
+  EXPECT_GT(green, 5u) << "no y axis";
+  EXPECT_GT(orange, 50u) << "no frustums";
+}
+
+// "in screenshots": the saved image shows the heat map and its legend as the window does
+// (the panels, drawn after, are not in it); without it, the rendered image alone.
+TEST(Viewer, ScreenshotsIncludeTheHeatMapWhenAsked) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string with = dir + "/shot_with_overlay" + kExt, plain = dir + "/shot_without_overlay" + kExt;
+  const std::string common = prefix + viewer() + " --backend cpu --size 480x270 --camera 1 --frames 2 --heatmap ";
+  const RunResult a = run(common + "--screenshot-overlay --screenshot " + with + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const RunResult b = run(common + "--screenshot " + plain + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const flashgs::Image on = flashgs::read_image(with), off = flashgs::read_image(plain);
+  ASSERT_EQ(on.width, 480);
+  ASSERT_EQ(off.width, 480);
+  EXPECT_LT(flashgs::compare_images(on, off).psnr_db, 30.0) << "the overlay is not in the screenshot";
+  // The legend bar (x 180..460, y 224..238 at UI scale 1) in the ramp's colours.
+  const auto want = flashgs::viewer::heat_colour((320.5f - 180.0f) / 280.0f);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(on.pixel(320, 231)[c], want[c], 3.0f / 255.0f) << c;
+  }
+}
+
+// The split view: left of the divider the baseline's render, right of it the current
+// configuration's, a white line between; the difference view shows |error| magnified, lit
+// exactly where the two renders differ.
+TEST(Viewer, SplitViewAndDifferenceImageShowTheTwoConfigurations) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string split = dir + "/split_view" + kExt, diff = dir + "/difference_view" + kExt;
+  const std::string base = dir + "/split_baseline" + kExt, flash = dir + "/split_flash" + kExt;
+  const std::string common = prefix + viewer() + " --backend cpu --size 480x270 --camera 5 --frames 2 ";
+  const RunResult a = run(common + "--no-ui --compare --split-at 0.4 --window-screenshot " + split + " --exit");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const RunResult b = run(common + "--no-ui --compare --compare-view difference --window-screenshot " + diff + " --exit");
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const RunResult c = run(common + "--algorithm baseline --screenshot " + base + " --exit");
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  const RunResult d = run(common + "--screenshot " + flash + " --exit");
+  ASSERT_EQ(d.exit_code, 0) << d.output;
+  const auto factor_at = b.output.find("difference image x");
+  ASSERT_NE(factor_at, std::string::npos) << b.output;
+  const double factor = std::atof(b.output.c_str() + factor_at + std::string("difference image x").size());
+  EXPECT_GE(factor, 1.0);
+  const flashgs::Image s = flashgs::read_image(split), e = flashgs::read_image(diff);
+  const flashgs::Image l = flashgs::read_image(base), r = flashgs::read_image(flash);
+  ASSERT_EQ(s.width, 480);
+  ASSERT_EQ(l.width, 480);
+  // Rows clear of the labels (bottom) and the hidden-panels hint (top left).
+  const int divider = int(0.4 * 480);
+  std::size_t left_off = 0, right_off = 0, sides_differ = 0, dark_where_differ = 0;
+  for (int y = 30; y < 200; ++y)
+    for (int x = 0; x < 480; ++x) {
+      if (std::abs(x - divider) <= 2) continue;
+      const float* got = s.pixel(x, y);
+      const float* want = x < divider ? l.pixel(x, y) : r.pixel(x, y);
+      // Exact 8-bit equality: the sides differ by one step at most pixels where they differ.
+      bool same = true, differ = false, differ_clearly = false;
+      for (int k = 0; k < 3; ++k) {
+        same = same && std::abs(got[k] - want[k]) <= 0.5f / 255.0f;
+        const float between = std::abs(l.pixel(x, y)[k] - r.pixel(x, y)[k]);
+        differ = differ || between > 0.5f / 255.0f;
+        differ_clearly = differ_clearly || between > 1.5f / 255.0f;
+      }
+      (x < divider ? left_off : right_off) += !same;
+      sides_differ += differ;
+      // Two 8-bit steps apart, the float renders differ by more than one: magnified, it shows.
+      const float* shown = e.pixel(x, y);
+      dark_where_differ += differ_clearly && shown[0] + shown[1] + shown[2] < 0.5f / 255.0f;
+    }
+  std::printf("split view: %zu / %zu pixels off on the left / right; renders differ at %zu pixels, factor x%.0f\n",
+              left_off, right_off, sides_differ, factor);
+  EXPECT_EQ(left_off, 0u) << "left of the divider is not the baseline's render";
+  EXPECT_EQ(right_off, 0u) << "right of the divider is not the current configuration's render";
+  EXPECT_EQ(dark_where_differ, 0u) << "the difference image is black where the renders differ";
+  // The divider: a white line at 40 % of the width.
+  for (int y : {40, 120, 190}) EXPECT_GT(s.pixel(divider, y)[0] + s.pixel(divider, y)[1] + s.pixel(divider, y)[2], 2.9f);
+  EXPECT_GT(sides_differ, 0u) << "baseline and flash render alike here: the check above proves nothing";
+}
+
+// Baseline against baseline is refused with the reason, and nothing is drawn over the frame.
+TEST(Viewer, ComparingAConfigurationWithItselfIsRefused) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 320x180 --camera 2 --frames 2 --algorithm baseline "
+                          "--compare --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("compare: both sides are baseline: nothing to compare"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("viewer compare:"), std::string::npos) << r.output;
+}
+
+// One loop of the camera path as an image sequence; without ffmpeg on PATH, the sequence only.
+TEST(Viewer, ThePathExportsAsAnImageSequence) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string folder = out_dir() + "/path_export";
+  std::filesystem::remove_all(folder);
+  const RunResult r = run(prefix + "env PATH=/usr/bin:/bin " + viewer() + " --backend cpu --size 160x90 --frames 1 "
+                          "--export-path " + folder + " --export-frames 4 --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  if (std::filesystem::exists("/usr/bin/ffmpeg") || std::filesystem::exists("/bin/ffmpeg")) GTEST_SKIP() << "ffmpeg is in /usr/bin: the no-video case cannot be run";
+  EXPECT_NE(r.output.find("path export: 4 frames in " + folder + " (no ffmpeg on PATH: image sequence only)"),
+            std::string::npos) << r.output;
+  std::vector<flashgs::Image> frames;
+  for (int i = 0; i < 4; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame_%05d", i);
+    ASSERT_TRUE(std::filesystem::exists(folder + name + kExt)) << name;
+    frames.push_back(flashgs::read_image(folder + name + kExt));
+    EXPECT_EQ(frames.back().width, 160);
+  }
+  EXPECT_FALSE(std::filesystem::exists(folder + "/frame_00004" + kExt));
+  EXPECT_LT(flashgs::compare_images(frames[0], frames[2]).psnr_db, 30.0) << "the frames do not follow the path";
 }
 
 TEST(Viewer, CameraPathReportsFrameTimes) {
@@ -437,7 +845,9 @@ TEST(Viewer, NonFiniteAndOutOfRangeOptionsAreRefusedNamingTheOption) {
       {"--scale nan", "--scale"},          {"--scale inf", "--scale"},     {"--scale 40", "--scale"},
       {"--fov nan", "--fov"},              {"--tau nan", "--tau"},         {"--background 0,nan,0", "--background"},
       {"--camera -1", "--camera"},         {"--render-size 0x10", "--render-size"},
-      {"--render-size 99999999999x1", "--render-size"}, {"--size 12x", "--size"}};
+      {"--render-size 99999999999x1", "--render-size"}, {"--size 12x", "--size"},
+      {"--compare-left nonsense", "--compare-left"}, {"--split-at nan", "--split-at"},
+      {"--split-at 2", "--split-at"},      {"--export-frames 0", "--export-frames"}};
   for (const auto& [args, option] : cases) {
     const RunResult r = run("timeout 60 " + viewer() + " " + args + " --backend cpu --frames 1 --exit");
     EXPECT_NE(r.exit_code, 0) << args << "\n" << r.output;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <limits>
 #include <thread>
@@ -14,15 +15,22 @@
 
 #include "camera_controller.h"
 #include "camera_path.h"
+#include "compare_mode.h"
+#include "file_dialog.h"
 #include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
 #include "key_script.h"
 #include "flashgs/frame_memory.h"
+#include "heatmap_legend.h"
 #include "memory_budget.h"
+#include "path_export.h"
 #include "scene_loader.h"
+#include "scene_lines.h"
 #include "scene_state.h"
+#include "screenshot_names.h"
+#include "split_view.h"
 #include "stats_history.h"
 #include "test_support.h"
 #include "viewer_settings.h"
@@ -60,6 +68,13 @@ std::string scratch_dir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+// The world point at view-space (x, y, z) of `view`.
+glm::vec3 view_point(const flashgs::Camera& view, float x, float y, float z) {
+  const float* r = view.rotation;
+  return glm::vec3(view.position[0], view.position[1], view.position[2]) + glm::vec3(r[0], r[1], r[2]) * x +
+         glm::vec3(r[3], r[4], r[5]) * y + glm::vec3(r[6], r[7], r[8]) * z;
 }
 
 }  // namespace
@@ -479,4 +494,272 @@ TEST(ViewerSceneLoader, ABlockedLoadIsAbandonedWithoutWaiting) {
   while (fv::SceneLoader::running() != running_before && std::chrono::steady_clock::now() < deadline)
     std::this_thread::yield();
   EXPECT_EQ(fv::SceneLoader::running(), running_before) << "the abandoned threads did not end";
+}
+
+// Navigation as SIBR, SuperSplat and viser users expect it (issue 11).
+TEST(ViewerNavigation, FlyPanMovesAcrossTheViewAndKeepsTheDirection) {
+  fv::ViewerSettings s;
+  fv::CameraController c;
+  c.reset(glm::vec3(0), 2.0f, glm::vec3(0, -1, 0));
+  const fv::Pose before = c.pose();
+  fv::NavigationInput in;
+  in.pan_dx = 100;  // dragging right moves the scene right: the camera goes left
+  in.pan_dy = 50;   // dragging down moves the scene down: the camera goes up (its -y)
+  ASSERT_TRUE(c.update(in, 0.016f, s));
+  const glm::vec3 moved = c.pose().position - before.position;
+  EXPECT_LT(glm::dot(moved, before.rotation[0]), -1e-3f);
+  EXPECT_LT(glm::dot(moved, before.rotation[1]), -1e-3f);
+  EXPECT_NEAR(glm::dot(moved, before.rotation[2]), 0.0f, 1e-5f);
+  EXPECT_LT(max_abs_diff(c.pose().rotation, before.rotation), 1e-6f);
+}
+
+TEST(ViewerNavigation, TheWheelDolliesInFlyModeAndCtrlWheelSetsTheSpeed) {
+  fv::ViewerSettings s;
+  fv::CameraController c;
+  c.reset(glm::vec3(0), 2.0f, glm::vec3(0, -1, 0));
+  const fv::Pose before = c.pose();
+  const float distance = glm::length(before.position);  // the default view looks at the centre
+  fv::NavigationInput wheel;
+  wheel.scroll = 2;
+  ASSERT_TRUE(c.update(wheel, 0.016f, s));
+  const glm::vec3 moved = c.pose().position - before.position;
+  EXPECT_GT(glm::dot(moved, before.rotation[2]), 0.0f) << "the wheel forward must move toward the view";
+  EXPECT_NEAR(glm::length(glm::cross(moved, before.rotation[2])), 0.0f, 1e-4f);
+  EXPECT_LT(glm::length(c.pose().position), distance);
+  EXPECT_EQ(s.move_speed, 1.0f) << "the wheel alone must not change the speed";
+  fv::NavigationInput faster;
+  faster.speed_steps = 2;  // two + presses, or Ctrl+wheel two steps
+  c.update(faster, 0.016f, s);
+  EXPECT_NEAR(s.move_speed, 1.5625f, 1e-5f);
+  faster.speed_steps = -1e9f;  // clamped, never zero or negative
+  c.update(faster, 0.016f, s);
+  EXPECT_GE(s.move_speed, fv::kMoveSpeedRange.min);
+}
+
+TEST(ViewerNavigation, FrameSceneLooksAtTheWholeScene) {
+  fv::ViewerSettings s;
+  fv::CameraController c;
+  const glm::vec3 centre(1, 2, 3);
+  c.reset(centre, 2.0f, glm::vec3(0, 1, 0));
+  fv::NavigationInput away;
+  away.back = true;
+  away.right = true;
+  c.update(away, 3.0f, s);
+  c.frame_scene(60.0f, 16.0f / 9.0f);
+  const fv::Pose p = c.pose();
+  const glm::vec3 to_centre = centre - p.position;
+  // On the view axis, the pivot at the centre, far enough for a sphere of the extent to fit
+  // the narrower (vertical) field of view.
+  EXPECT_GT(glm::dot(glm::normalize(to_centre), p.rotation[2]), 0.9999f);
+  EXPECT_LT(glm::length(c.pivot() - centre), 1e-4f);
+  const float half_vertical = std::atan(std::tan(float(M_PI) / 6.0f) * 9.0f / 16.0f);
+  EXPECT_NEAR(std::asin(2.0f / glm::length(to_centre)), half_vertical, 1e-3f);  // fits, and no farther
+}
+
+TEST(ViewerNavigation, ObjectScenesOrbitAndRoomsFly) {
+  // Cameras on a ring of radius 3 around an object of extent 1: an object.
+  EXPECT_TRUE(fv::is_object_sized(glm::vec3(0.5f, -0.2f, 1.0f), 1.0f, orbit(12)));
+  // The same cameras inside a room of extent 10: fly.
+  EXPECT_FALSE(fv::is_object_sized(glm::vec3(0.5f, -0.2f, 1.0f), 10.0f, orbit(12)));
+  EXPECT_TRUE(fv::is_object_sized(glm::vec3(0), 1.0f, {}));
+}
+
+TEST(ViewerHeatmap, LegendTicksAreRoundValuesAtTheirPlaceOnTheScale) {
+  const auto ticks = fv::legend_ticks(1771, true);
+  std::vector<std::uint64_t> values;
+  for (const auto& t : ticks) values.push_back(t.value);
+  EXPECT_EQ(values, (std::vector<std::uint64_t>{0, 1, 10, 100, 1771})) << "1000 is too close to 1771 on a log scale";
+  for (const auto& t : ticks) EXPECT_NEAR(t.position, std::log1p(double(t.value)) / std::log1p(1771.0), 1e-6);
+  const auto linear = fv::legend_ticks(1771, false);
+  std::vector<std::uint64_t> lin;
+  for (const auto& t : linear) lin.push_back(t.value);
+  EXPECT_EQ(lin, (std::vector<std::uint64_t>{0, 500, 1000, 1500, 1771}));
+  EXPECT_NEAR(linear[1].position, 500.0f / 1771.0f, 1e-6f);
+  EXPECT_EQ(fv::legend_ticks(0, true).back().value, 1u);  // an empty frame still has a scale
+  EXPECT_EQ(fv::legend_caption(16, true, false), "pairs per 16x16 tile, log scale");
+  EXPECT_EQ(fv::legend_caption(16, false, true), "pairs per 16x16 tile, linear scale (max locked)");
+}
+
+TEST(ViewerHeatmap, TheLockKeepsTheMaximumAcrossConfigurations) {
+  fv::HeatScale scale;
+  EXPECT_EQ(scale.update(1771, false), 1771u);
+  EXPECT_EQ(scale.update(900, false), 900u);
+  EXPECT_EQ(scale.update(1771, true), 1771u);  // locking takes this frame's maximum...
+  EXPECT_EQ(scale.update(600, true), 1771u);   // ...and keeps it
+  EXPECT_EQ(scale.update(2500, true), 1771u);
+  EXPECT_EQ(scale.update(600, false), 600u);   // unlocked: follows the frame again
+}
+
+TEST(ViewerHeatmap, TheRampIsViridisLikeAndMonotoneInLightness) {
+  // Dark purple to yellow through blue-green; luminance rises throughout (readable in grey
+  // and with red-green colour-blindness).
+  const auto low = fv::heat_colour(0.0f), mid = fv::heat_colour(0.5f), high = fv::heat_colour(1.0f);
+  EXPECT_GT(low[2], low[1]);
+  EXPECT_GT(mid[1], mid[0]);
+  EXPECT_GT(high[0], 0.9f);
+  EXPECT_LT(high[2], 0.2f);
+  float last = -1.0f;
+  for (int i = 0; i <= 64; ++i) {
+    const auto c = fv::heat_colour(i / 64.0f);
+    const float luma = 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+    EXPECT_GT(luma, last) << "at " << i;
+    last = luma;
+  }
+  EXPECT_EQ(fv::heat_colour(std::nanf("")), fv::heat_colour(0.0f));
+}
+
+TEST(ViewerCompare, DifferenceImageIsMagnifiedAndTheFactorReported) {
+  flashgs::Image a, b;
+  a.resize(4, 2);
+  b.resize(4, 2);
+  b.pixel(1, 1)[0] = 3.0f / 255.0f;  // one value off by 3/255
+  float factor = 0;
+  const flashgs::Image d = fv::difference_image(a, b, &factor);
+  EXPECT_EQ(factor, 64.0f);  // 3/255 * 64 = 0.75: at least half of white
+  EXPECT_NEAR(d.pixel(1, 1)[0], 3.0f / 255.0f * 64.0f, 1e-6f);
+  EXPECT_EQ(d.pixel(0, 0)[0], 0.0f);
+  const flashgs::Image same = fv::difference_image(a, a, &factor);
+  EXPECT_EQ(factor, 1.0f);
+  for (float v : same.rgb) EXPECT_EQ(v, 0.0f);
+}
+
+TEST(ViewerCompare, TheDividerIsGrabbedNearItAndFollowsTheDrag) {
+  fv::SplitDivider d;
+  EXPECT_FALSE(d.grabs(300, 1000));
+  d.press(300, 1000);
+  EXPECT_FALSE(d.dragging());
+  d.press(505, 1000);
+  ASSERT_TRUE(d.dragging());
+  d.drag_to(250, 1000);
+  EXPECT_FLOAT_EQ(d.fraction(), 0.25f);
+  d.drag_to(-50, 1000);
+  EXPECT_FLOAT_EQ(d.fraction(), 0.02f);
+  d.release();
+  d.drag_to(900, 1000);
+  EXPECT_FLOAT_EQ(d.fraction(), 0.02f);
+}
+
+TEST(ViewerCompare, AnyTwoConfigurationsAndTheSameOneTwiceIsRefused) {
+  flashgs::RenderOptions current;
+  current.tau = 0.01f;
+  current.sh_degree_cap = 1;
+  ASSERT_EQ(fv::compare_choice_name(fv::kCompareBaseline), "baseline");
+  ASSERT_EQ(fv::compare_choice_name(2), "flash");
+  const int no_tight = fv::compare_choice_from_name("flash-no_tight_bbox");
+  ASSERT_GT(no_tight, 2);
+  const flashgs::RenderOptions o = fv::compare_choice_options(no_tight, current);
+  EXPECT_FALSE(o.tight_bbox);
+  EXPECT_TRUE(o.opacity_aware_radius);
+  EXPECT_EQ(o.tau, 0.01f);  // colour inputs from the current settings
+  EXPECT_EQ(o.sh_degree_cap, 1);
+  EXPECT_EQ(fv::compare_choice_from_name("nonsense"), -1);
+  // Baseline vs baseline (the current settings being the baseline): refused with the reason.
+  const flashgs::RenderOptions base = fv::compare_choice_options(fv::kCompareBaseline, current);
+  const std::string problem = fv::same_configuration_problem(base, fv::compare_choice_options(fv::kCompareCurrent, base));
+  EXPECT_NE(problem.find("both sides are baseline"), std::string::npos) << problem;
+  EXPECT_EQ(fv::same_configuration_problem(base, o), "");
+}
+
+TEST(ViewerScreenshots, NamesAreTimestampedAndNeverReused) {
+  const std::string dir = scratch_dir("viewer_shots");
+  const std::time_t t = 1764612345;
+  const std::string first = fv::timestamped_screenshot_path(dir, "", t);
+  EXPECT_NE(first.find(dir + "/flashgs_20"), std::string::npos) << first;
+  EXPECT_EQ(first.substr(first.size() - 4), ".png");
+  { std::ofstream(first) << "x"; }
+  const std::string second = fv::timestamped_screenshot_path(dir, "", t);  // the same second
+  EXPECT_NE(second, first);
+  { std::ofstream(second) << "x"; }
+  const std::string third = fv::timestamped_screenshot_path(dir, "", t);
+  EXPECT_NE(third, first);
+  EXPECT_NE(third, second);
+  EXPECT_NE(fv::timestamped_screenshot_path(dir, "window", t).find("flashgs_window_"), std::string::npos);
+}
+
+TEST(ViewerScreenshots, TheDefaultFolderIsTheXdgPicturesFolder) {
+  const std::string dir = scratch_dir("viewer_pictures");
+  setenv("XDG_PICTURES_DIR", dir.c_str(), 1);
+  EXPECT_EQ(fv::default_screenshot_folder(), dir);
+  setenv("XDG_PICTURES_DIR", (dir + "/absent").c_str(), 1);  // not a folder: the next choice
+  EXPECT_NE(fv::default_screenshot_folder(), dir + "/absent");
+  unsetenv("XDG_PICTURES_DIR");
+}
+
+TEST(ViewerGuides, FrustumsProjectWhereTheCamerasAreAndAClickPicksOne) {
+  const auto cameras = orbit(8);
+  fv::CameraController c;
+  c.reset(glm::vec3(0.5f, -0.2f, 1.0f), 1.0f, glm::vec3(0, 1, 0));
+  fv::NavigationInput back;
+  back.back = true;
+  fv::ViewerSettings s;
+  c.update(back, 6.0f, s);  // far behind: every camera in view
+  const flashgs::Camera view = c.render_camera(640, 360, 60.0f);
+  const auto segments = fv::project_segments(fv::camera_frustums(cameras, 0.1f, 2), view, 1e-3f);
+  EXPECT_EQ(segments.size(), cameras.size() * 10);
+  // The first segment of camera k starts at its centre: clicking there picks k.
+  for (int k : {0, 3, 5}) {
+    const fv::ScreenSegment& s = segments[std::size_t(k) * 10];
+    EXPECT_EQ(fv::pick_camera(cameras, view, s.x0 + 2.0f, s.y0 - 2.0f, 14.0f), k);
+  }
+  EXPECT_EQ(fv::pick_camera(cameras, view, -500.0f, -500.0f, 14.0f), -1);
+  // Segments crossing behind the view are cut at the near plane, never mirrored.
+  const fv::WorldSegment through{view_point(view, 0, 0, 1), view_point(view, 0, 0, -1), {1, 1, 1, 1}};
+  const auto cut = fv::project_segments({through}, view, 0.01f);
+  ASSERT_EQ(cut.size(), 1u);
+  EXPECT_NEAR(cut[0].x0, view.cx, 1e-2f);
+  const auto grid = fv::grid_and_axes(glm::vec3(0.5f, -0.2f, 1.0f), 1.0f, glm::vec3(0, 1, 0));
+  EXPECT_EQ(grid.size(), 2u * 21u + 3u);
+  for (const auto& g : grid) {
+    if (g.rgba[3] < 1.0f) {
+      EXPECT_NEAR(g.a.y, 0.0f, 1e-5f) << "grid lines lie in the ground plane";
+    }
+  }
+}
+
+TEST(ViewerFiles, TheDesktopDialogsAnswerIsTheChosenPath) {
+  const std::string dir = scratch_dir("viewer_dialog");
+  const std::string fake = dir + "/zenity";
+  { std::ofstream(fake) << "#!/bin/sh\necho /some/where/scene.ply\n"; }
+  chmod(fake.c_str(), 0755);
+  const std::string old_path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", (dir + ":" + old_path).c_str(), 1);
+  EXPECT_EQ(fv::find_on_path("zenity"), fake);
+  fv::FileDialog dialog;
+  ASSERT_TRUE(dialog.open_native(dir));
+  EXPECT_EQ(dialog.tool(), "zenity");
+  std::string chosen;
+  for (int i = 0; i < 2000 && chosen.empty(); ++i) {  // its thread answers once the child exits
+    chosen = dialog.take_choice();
+    if (chosen.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(chosen, "/some/where/scene.ply");
+  setenv("PATH", "/nonexistent", 1);
+  EXPECT_EQ(fv::find_on_path("zenity"), "");
+  EXPECT_FALSE(fv::FileDialog().open_native(dir)) << "no dialog on PATH: the in-app browser";
+  setenv("PATH", old_path.c_str(), 1);
+}
+
+TEST(ViewerFiles, PathExportNumbersFramesAndFindsFfmpegAtRunTime) {
+  const std::string dir = scratch_dir("viewer_export");
+  fv::PathExport e;
+  EXPECT_NE(e.start(dir + "/frames", 0), "");
+  ASSERT_EQ(e.start(dir + "/frames", 3), "");
+  EXPECT_TRUE(std::filesystem::is_directory(dir + "/frames"));
+  std::vector<std::string> files;
+  while (e.active()) {
+    files.push_back(e.next_file());
+    EXPECT_NEAR(e.next_t(), double(files.size() - 1) / 3.0, 1e-12);
+    e.advance();
+  }
+  ASSERT_EQ(files.size(), 3u);
+  EXPECT_NE(files[2].find("frame_00002."), std::string::npos) << files[2];
+  const std::string old_path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", "/nonexistent", 1);
+  EXPECT_EQ(e.video_command(30), "");
+  const std::string fake = dir + "/ffmpeg";
+  { std::ofstream(fake) << "#!/bin/sh\n"; }
+  chmod(fake.c_str(), 0755);
+  setenv("PATH", dir.c_str(), 1);
+  EXPECT_NE(e.video_command(30).find("path.mp4"), std::string::npos);
+  setenv("PATH", old_path.c_str(), 1);
 }

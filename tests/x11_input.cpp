@@ -1,7 +1,7 @@
 // x11_input: a user's mouse and keyboard through the XTEST extension, and a window manager's close request (viewer test helper).
 //
 //   x11_input move X Y          pointer to (X, Y) on the root window
-//   x11_input down|up button    left button pressed / released
+//   x11_input down|up button    left button pressed / released (button2: middle, button3: right)
 //   x11_input down|up KEYSYM    key pressed / released (X keysym name: Control_L, Return, space, F12)
 //   x11_input type TEXT         each character of TEXT pressed and released
 //   x11_input close X Y         WM_DELETE_WINDOW to the top-level window at (X, Y)
@@ -75,7 +75,9 @@ int main(int argc, char** argv) {
   if (verb == "move" && argc == 4) {
     XTestFakeMotionEvent(d, -1, std::atoi(argv[2]), std::atoi(argv[3]), CurrentTime);
   } else if ((verb == "down" || verb == "up") && argc == 3) {
-    if (std::string(argv[2]) == "button") XTestFakeButtonEvent(d, 1, verb == "down" ? True : False, CurrentTime);
+    const std::string what = argv[2];
+    if (what == "button" || what == "button2" || what == "button3")
+      XTestFakeButtonEvent(d, what == "button" ? 1 : what[6] - '0', verb == "down" ? True : False, CurrentTime);
     else ok = send_key(d, argv[2], verb == "down");
   } else if (verb == "type" && argc == 3) {
     for (const char* c = argv[2]; *c && ok; ++c) {

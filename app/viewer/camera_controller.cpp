@@ -24,6 +24,8 @@ glm::mat3 orthonormalised(const glm::mat3& r) {
 // More than any real drag or wheel turn within one frame (a 16K screen crossed four times).
 constexpr float kMaxDragPoints = 65536.0f;
 constexpr float kMaxScrollSteps = 100.0f;
+constexpr float kSpeedStep = 1.25f;      // one +/- press or Ctrl+wheel step
+constexpr float kPanPerPoint = 0.0015f;  // pan per window point, in units of the pivot distance
 
 float finite_clamped(float v, float limit) { return std::isfinite(v) ? std::clamp(v, -limit, limit) : 0.0f; }
 
@@ -36,6 +38,7 @@ NavigationInput sanitized(const NavigationInput& in) {
   out.pan_dx = finite_clamped(in.pan_dx, kMaxDragPoints);
   out.pan_dy = finite_clamped(in.pan_dy, kMaxDragPoints);
   out.scroll = finite_clamped(in.scroll, kMaxScrollSteps);
+  out.speed_steps = finite_clamped(in.speed_steps, kMaxScrollSteps);
   return out;
 }
 
@@ -147,13 +150,27 @@ bool CameraController::update(const NavigationInput& input, float dt, ViewerSett
 
 bool CameraController::apply(const NavigationInput& in, float dt, ViewerSettings& settings) {
   if (m_mode != settings.mode) set_mode(settings.mode);
+  if (in.speed_steps != 0.0f)
+    settings.move_speed = kMoveSpeedRange.clamp(settings.move_speed * std::pow(kSpeedStep, in.speed_steps), 1.0f);
   bool changed = false;
   const float sens = settings.look_sensitivity;
+  if (in.look_dx != 0.0f || in.look_dy != 0.0f) {
+    rotate_view(-in.look_dx * sens, -in.look_dy * sens);
+    changed = true;
+  }
+  // A drag moves the scene with the pointer, at the pivot's depth: the point under the
+  // pointer stays under it (for the default 60-degree view).
+  const glm::vec3 pan = -(m_pose.rotation[0] * in.pan_dx + m_pose.rotation[1] * in.pan_dy) *
+                        (m_orbit_distance * kPanPerPoint);
   if (m_mode == NavigationMode::fly) {
-    if (in.scroll != 0.0f)
-      settings.move_speed = std::clamp(settings.move_speed * std::pow(1.2f, in.scroll), kMoveSpeedRange.min, kMoveSpeedRange.max);
-    if (in.look_dx != 0.0f || in.look_dy != 0.0f) {
-      rotate_view(-in.look_dx * sens, -in.look_dy * sens);
+    if (in.pan_dx != 0.0f || in.pan_dy != 0.0f) {
+      m_pose.position += pan;
+      changed = true;
+    }
+    // The wheel dollies along the view by a tenth of the distance to the pivot, at least a
+    // hundredth of the scene, so it slows near surfaces and never stalls.
+    if (in.scroll != 0.0f) {
+      m_pose.position += m_pose.rotation[2] * (in.scroll * std::max(0.1f * m_orbit_distance, 0.01f * m_extent));
       changed = true;
     }
     const glm::vec3 right = m_pose.rotation[0], forward = m_pose.rotation[2];
@@ -166,21 +183,17 @@ bool CameraController::apply(const NavigationInput& in, float dt, ViewerSettings
     }
     if (changed) place_pivot_ahead();
   } else {
-    if (in.look_dx != 0.0f || in.look_dy != 0.0f) {
-      rotate_view(-in.look_dx * sens, -in.look_dy * sens);
-      changed = true;
-    }
     if (in.pan_dx != 0.0f || in.pan_dy != 0.0f) {
-      const float k = m_orbit_distance * 0.0015f;
-      m_pivot -= (m_pose.rotation[0] * in.pan_dx + m_pose.rotation[1] * in.pan_dy) * k;
+      m_pivot += pan;
       changed = true;
     }
     if (in.scroll != 0.0f) {
       m_orbit_distance = std::clamp(m_orbit_distance * std::pow(0.88f, in.scroll), 1e-4f * m_extent, 1e3f * m_extent);
       changed = true;
     }
-    // W/S dolly toward the pivot at a rate proportional to the distance (frame-rate independent).
-    const float dolly = float(in.back - in.forward) * (in.fast ? 4.0f : 1.0f);
+    // W/S dolly toward the pivot at a rate proportional to the distance (frame-rate
+    // independent), scaled by the speed setting.
+    const float dolly = float(in.back - in.forward) * (in.fast ? 4.0f : 1.0f) * settings.move_speed;
     if (dolly != 0.0f) {
       m_orbit_distance = std::clamp(m_orbit_distance * std::exp(dolly * dt), 1e-4f * m_extent, 1e3f * m_extent);
       changed = true;
@@ -189,6 +202,26 @@ bool CameraController::apply(const NavigationInput& in, float dt, ViewerSettings
   }
   if (changed) m_snapped_valid = false;
   return changed;
+}
+
+void CameraController::frame_scene(float fov_x_degrees, float aspect) {
+  const float half_x = 0.5f * kFovRange.clamp(fov_x_degrees, 60.0f) * float(M_PI / 180.0);
+  if (!(aspect > 0.0f) || !std::isfinite(aspect)) aspect = 16.0f / 9.0f;
+  const float half_y = std::atan(std::tan(half_x) / aspect);
+  // The sphere fits the narrower of the two fields.
+  const float distance = m_extent / std::sin(std::min(half_x, half_y));
+  m_pivot = m_centre;
+  m_orbit_distance = distance;
+  m_pose.position = m_centre - m_pose.rotation[2] * distance;
+  m_snapped_valid = false;
+}
+
+bool is_object_sized(const glm::vec3& centre, float extent, const std::vector<Camera>& cameras) {
+  if (cameras.empty()) return true;
+  std::size_t outside = 0;
+  for (const Camera& c : cameras)
+    outside += glm::length(glm::vec3(c.position[0], c.position[1], c.position[2]) - centre) > 1.5f * extent;
+  return 2 * outside > cameras.size();
 }
 
 Camera CameraController::render_camera(int width, int height, float fov_x_degrees) const {

@@ -1,6 +1,8 @@
 // CameraController: fly and orbit navigation of the viewer camera, frame-rate independent (no GL, no window).
 #pragma once
 
+#include <vector>
+
 #include <glm/glm.hpp>
 
 #include "flashgs/camera.h"
@@ -14,8 +16,9 @@ struct NavigationInput {
   bool down = false, up = false;                                    // Q E
   bool fast = false;                                                // Shift
   float look_dx = 0, look_dy = 0;  // window points dragged with the look button this frame
-  float pan_dx = 0, pan_dy = 0;    // orbit: window points dragged with the pan button
-  float scroll = 0;                // wheel steps this frame
+  float pan_dx = 0, pan_dy = 0;    // window points dragged with the pan button (right/middle)
+  float scroll = 0;                // wheel steps this frame: dolly toward (+) or away from the view
+  float speed_steps = 0;           // +/- presses and Ctrl+wheel steps: movement speed x1.25 each
 };
 
 // A pose in world space: centre and camera-to-world rotation whose columns are the camera's
@@ -39,6 +42,9 @@ class CameraController {
   // Applies one frame of input over `dt` seconds; returns whether the view changed. Non-finite
   // input is ignored and huge drags are clamped: the pose stays finite whatever arrives.
   bool update(const NavigationInput& input, float dt, ViewerSettings& settings);
+  // Looks at the scene centre from where the whole scene (a sphere of `extent`) fits the
+  // view (`aspect` = width / height), keeping the view direction; the pivot becomes the centre.
+  void frame_scene(float fov_x_degrees, float aspect);
   // Inverts the world-up axis and rolls the camera half a turn so the picture turns upright.
   void flip_up();
   void set_mode(NavigationMode mode);
@@ -73,6 +79,11 @@ class CameraController {
 // hand can do in one frame (a window-system glitch or a script cannot turn into a NaN pose).
 NavigationInput sanitized(const NavigationInput& input);
 bool is_finite(const Pose& pose);
+
+// Whether a scene is an object seen from around (orbit navigation suits it) rather than a
+// space the cameras stand inside (fly): most cameras farther from `centre` than 1.5 extents.
+// Without cameras, an object (generated or single-object scenes).
+bool is_object_sized(const glm::vec3& centre, float extent, const std::vector<Camera>& cameras);
 
 // Pose of a scene camera (inverse of Camera's world-to-camera rotation).
 Pose pose_of(const Camera& camera);

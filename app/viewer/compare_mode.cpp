@@ -1,43 +1,78 @@
-// Baseline-vs-current rendering and comparison for the compare panel.
+// The comparison's configuration choices and the two timed renders.
 #include "compare_mode.h"
 
 #include <chrono>
 #include <exception>
+#include <iterator>
 
 namespace flashgs::viewer {
+namespace {
 
-CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOptions& current) {
+constexpr int kSwitchCount = static_cast<int>(std::size(kRenderSwitches));
+
+RenderOptions untracked(RenderOptions o) {
+  o.collect_tile_counts = false;  // not a configuration, only what the heat map needs
+  return o;
+}
+
+}  // namespace
+
+int compare_choice_count() { return 3 + kSwitchCount; }
+
+RenderOptions compare_choice_options(int choice, const RenderOptions& current) {
+  if (choice <= kCompareCurrent || choice >= compare_choice_count()) return untracked(current);
+  RenderOptions o = choice == kCompareBaseline ? RenderOptions::baseline() : RenderOptions{};
+  if (choice >= 3) o.*(kRenderSwitches[choice - 3].member) = false;
+  o.tau = current.tau;
+  o.sh_degree_cap = current.sh_degree_cap;
+  for (int c = 0; c < 3; ++c) o.background[c] = current.background[c];
+  return o;
+}
+
+std::string compare_choice_name(int choice) {
+  if (choice <= kCompareCurrent || choice >= compare_choice_count()) return "current";
+  return compare_choice_options(choice, RenderOptions{}).label();
+}
+
+int compare_choice_from_name(const std::string& name) {
+  for (int c = 0; c < compare_choice_count(); ++c)
+    if (compare_choice_name(c) == name) return c;
+  return -1;
+}
+
+std::string same_configuration_problem(const RenderOptions& left, const RenderOptions& right) {
+  if (!(untracked(left) == untracked(right))) return "";
+  return "both sides are " + left.label() + ": nothing to compare (choose another configuration for one side)";
+}
+
+CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOptions& left_options,
+                          const RenderOptions& right_options, bool warm_up) {
   CompareResult r;
-  r.current_label = current.label();
+  r.left_label = left_options.label();
+  r.right_label = right_options.label();
   r.width = camera.width;
   r.height = camera.height;
+  r.error = same_configuration_problem(left_options, right_options);
+  if (!r.error.empty()) return r;
   try {
-    RenderOptions baseline = RenderOptions::baseline();
-    // Only the algorithm differs: the same colour inputs, so any difference is the algorithm's.
-    baseline.tau = current.tau;
-    baseline.sh_degree_cap = current.sh_degree_cap;
-    for (int c = 0; c < 3; ++c) baseline.background[c] = current.background[c];
-    RenderOptions cur = current;
-    cur.collect_tile_counts = false;
-    Image a, b;
-    FrameStats sa, sb;
+    const RenderOptions left = untracked(left_options), right = untracked(right_options);
+    FrameStats sl, sr;
     using clock = std::chrono::steady_clock;
-    // Each rendered twice; the second is timed, so a first-use allocation does not count.
-    path.render_image(camera, cur, a, &sa);
+    if (warm_up) path.render_image(camera, right, r.right_image, &sr);
     auto t0 = clock::now();
-    path.render_image(camera, cur, a, &sa);
+    path.render_image(camera, right, r.right_image, &sr);
     auto t1 = clock::now();
-    path.render_image(camera, baseline, b, &sb);
+    if (warm_up) path.render_image(camera, left, r.left_image, &sl);
     auto t2 = clock::now();
-    path.render_image(camera, baseline, b, &sb);
+    path.render_image(camera, left, r.left_image, &sl);
     auto t3 = clock::now();
-    r.current_wall_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
-    r.baseline_wall_ms = std::chrono::duration<double, std::milli>(t3 - t2).count();
-    r.current_ms = sa.times.total_ms;
-    r.baseline_ms = sb.times.total_ms;
-    r.current_kv = sa.kv_pairs;
-    r.baseline_kv = sb.kv_pairs;
-    r.difference = compare_images(a, b);
+    r.right_wall_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    r.left_wall_ms = std::chrono::duration<double, std::milli>(t3 - t2).count();
+    r.right_ms = sr.times.total_ms;
+    r.left_ms = sl.times.total_ms;
+    r.right_kv = sr.kv_pairs;
+    r.left_kv = sl.kv_pairs;
+    r.difference = compare_images(r.right_image, r.left_image);
     r.valid = true;
   } catch (const std::exception& e) {
     r.error = e.what();

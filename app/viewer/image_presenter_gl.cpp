@@ -7,10 +7,25 @@
 #include <cstdio>
 
 #include "flashgs/error.h"
+#include "heatmap_legend.h"
 
 #include "viewer_shaders.h"  // generated from shaders/*.glsl by CMake
 
 namespace flashgs::viewer {
+
+void to_rgba8(const Image& image, std::vector<std::uint8_t>& rgba) {
+  const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
+  rgba.resize(pixels * 4);
+  // 8 Mpixel at 4K: spread over the cores when OpenMP is there (the CPU renderer uses it too).
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(pixels); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      const float v = image.rgb[i * 3 + c];
+      rgba[i * 4 + c] = !(v > 0.0f) ? 0 : static_cast<std::uint8_t>(std::lround(std::min(v, 1.0f) * 255.0f));
+    }
+    rgba[i * 4 + 3] = 255;
+  }
+}
 
 ImagePresenter::~ImagePresenter() {
   glDeleteTextures(m_texture_count, m_textures);
@@ -62,18 +77,7 @@ void ImagePresenter::resize(int width, int height, int count) {
 
 void ImagePresenter::upload(const Image& image) {
   if (image.width != m_width || image.height != m_height || m_texture_count == 0) resize(image.width, image.height);
-  const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
-  m_rgba.resize(pixels * 4);
-  // 8 Mpixel at 4K: spread over the cores when OpenMP is there (the CPU renderer uses it too).
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(pixels); ++i) {
-    for (int c = 0; c < 3; ++c) {
-      const float v = image.rgb[i * 3 + c];
-      // Same rounding as write_image's 8-bit path, so a CPU-path screenshot equals the CLI's PNG.
-      m_rgba[i * 4 + c] = !(v > 0.0f) ? 0 : static_cast<std::uint8_t>(std::lround(std::min(v, 1.0f) * 255.0f));
-    }
-    m_rgba[i * 4 + 3] = 255;
-  }
+  to_rgba8(image, m_rgba);
   m_shown = 0;
   glBindTexture(GL_TEXTURE_2D, m_textures[0]);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
@@ -121,6 +125,7 @@ void ImagePresenter::draw(int fb_width, int fb_height, const HeatmapView* heatma
     glUniform1f(m_heat.uniform("u_max_count"), float(m_max_count));
     glUniform1i(m_heat.uniform("u_log_scale"), heatmap->log_scale ? 1 : 0);
     glUniform1f(m_heat.uniform("u_opacity"), heatmap->opacity);
+    glUniform3fv(m_heat.uniform("u_ramp"), kRampStops, kHeatRamp[0].data());
     glUniform4f(m_heat.uniform("u_legend_rect"), heatmap->legend_rect[0], heatmap->legend_rect[1],
                 heatmap->legend_rect[2], heatmap->legend_rect[3]);
     glUniform2f(m_heat.uniform("u_viewport"), float(fb_width), float(fb_height));

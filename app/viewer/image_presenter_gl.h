@@ -16,6 +16,10 @@ struct HeatmapView {
   float legend_rect[4] = {0, 0, 0, 0};  // window framebuffer pixels (x0, y0, x1, y1), y down
 };
 
+// A float RGB image (top row first) as RGBA8 bytes, rounded as write_image's 8-bit path does
+// (so a CPU-path screenshot equals the CLI's PNG).
+void to_rgba8(const Image& image, std::vector<std::uint8_t>& rgba);
+
 class ImagePresenter {
  public:
   ImagePresenter() = default;

@@ -12,6 +12,7 @@
 #include <GLFW/glfw3.h>
 
 #include "flashgs/demo_scene.h"
+#include "flashgs/gaussian_math.h"
 #include "flashgs/error.h"
 #include "flashgs/image_io.h"
 #include "flashgs/renderer.h"
@@ -20,6 +21,10 @@
 #include "imgui_layer_ui.h"
 #include "flashgs/frame_memory.h"
 #include "memory_budget.h"
+#include "screenshot_names.h"
+#include "line_overlay_gl.h"
+#include "scene_lines.h"
+#include "split_view_gl.h"
 #include "viewer_panels_ui.h"
 #include "window_gl.h"
 
@@ -62,17 +67,28 @@ ViewerApp::ViewerApp(ViewerArgs args) : m_args(std::move(args)) {
   m_settings.forced_width = m_args.render_width;
   m_settings.forced_height = m_args.render_height;
   m_settings.heatmap = m_args.heatmap;
-  m_settings.mode = m_args.orbit ? NavigationMode::orbit : NavigationMode::fly;
+  m_settings.mode = m_args.orbit ? NavigationMode::orbit : NavigationMode::fly;  // auto: install_scene
   m_settings.show_ui = !m_args.no_ui;
+  m_settings.show_help = m_args.help_window;
+  m_settings.screenshot_overlay = m_args.screenshot_overlay;
+  m_settings.show_grid = m_args.grid;
+  m_settings.show_frustums = m_args.frustums;
+  m_settings.up_axis = int(std::find(kUpAxisNames, kUpAxisNames + kUpAxisCount, m_args.up) - kUpAxisNames) % kUpAxisCount;
+  m_settings.compare_view = m_args.compare_view == "numbers" ? CompareView::numbers
+                            : m_args.compare_view == "difference" ? CompareView::difference : CompareView::split;
+  m_settings.compare_left = std::max(0, compare_choice_from_name(m_args.compare_left));
+  m_settings.compare_right = std::max(0, compare_choice_from_name(m_args.compare_right));
+  m_divider.set_fraction(m_args.split_at);
+  m_settings.screenshot_folder = m_args.screenshot_dir.empty() ? default_screenshot_folder() : m_args.screenshot_dir;
   m_scripted = m_args.scripted();
   m_settings.vsync = !(m_args.no_vsync || m_scripted);
   if (!m_args.keys.empty()) m_script = KeyScript::parse(m_args.keys);
-  m_shot_buffer = "flashgs_screenshot.png";
 }
 
 ViewerApp::~ViewerApp() {
   // GL objects and interop registrations go before the context (the window) does.
   m_path.reset();
+  m_split.reset();
   m_ui.reset();
   m_presenter.reset();
   m_window.reset();
@@ -118,6 +134,13 @@ void ViewerApp::install_scene(LoadedScene scene) {
   m_settings.flip_up = m_args.flip_up;
   apply_up_choice();
   if (!m_scene.cameras.empty()) snap_to_camera(0);
+  if (!m_args.orbit && !m_args.fly) {
+    // Seen from around (the cameras stand outside it): orbit, as object viewers do; else fly.
+    const bool object = is_object_sized(m_scene.centre, m_scene.extent, m_scene.cameras);
+    m_settings.mode = object ? NavigationMode::orbit : NavigationMode::fly;
+    std::fprintf(stderr, "flashgs-viewer: navigation: %s (%s)\n", object ? "orbit" : "fly",
+                 object ? "the cameras look at the scene from outside it" : "the cameras stand inside the scene");
+  }
   m_have_frame = false;
   std::string note;
   if (m_scene.report.dropped_non_finite)
@@ -129,7 +152,7 @@ void ViewerApp::install_scene(LoadedScene scene) {
 }
 
 void ViewerApp::apply_up_choice() {
-  glm::vec3 up = m_args.up == "auto" ? m_scene.up : axis_from_text(m_args.up);
+  glm::vec3 up = m_settings.up_axis == 0 ? m_scene.up : axis_from_text(kUpAxisNames[m_settings.up_axis]);
   m_controller.reset(m_scene.centre, m_scene.extent, up);
   if (m_settings.flip_up) m_controller.flip_up();
 }
@@ -141,6 +164,7 @@ void ViewerApp::report_failed_load(const std::string& error) {
 }
 
 bool ViewerApp::open_scene(const std::string& path) {
+  m_path_buffer = path;  // kept in the box when it fails, to be corrected
   try {
     install_scene(load_scene(path, path == m_args.scene ? m_args.cameras : ""));
     m_load_error.clear();
@@ -159,6 +183,7 @@ void ViewerApp::request_open(const std::string& path) {
   }
   // Parsing a large PLY takes seconds: it runs beside the frame loop, which keeps drawing the
   // current scene; the new one is installed (uploaded) on this thread once it is ready.
+  m_path_buffer = path;  // kept in the box when it fails, to be corrected
   if (!m_loader.start(path)) set_notice("still loading " + m_loader.path() + "; " + path + " ignored");
 }
 
@@ -200,8 +225,9 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   for (const std::string& p : m_window->take_drops())
     if (actions.open_path.empty()) actions.open_path = p;
 
-  const bool mouse_free = !(m_ui && m_settings.show_ui && m_ui->wants_mouse());
-  const bool keys_free = !(m_ui && m_settings.show_ui && m_ui->wants_keyboard());
+  // ImGui runs with the panels hidden too (legend, help): its windows still take the input.
+  const bool mouse_free = !(m_ui && m_ui->wants_mouse());
+  const bool keys_free = !(m_ui && m_ui->wants_keyboard());
   const std::vector<KeyPress> presses = m_window->take_key_presses();
   int mods = 0;
   auto pressed = [&](int key) {  // a press event since the last frame; `mods` its modifiers
@@ -226,13 +252,31 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   if (pressed(GLFW_KEY_SPACE)) actions.toggle_play = true;
   if (pressed(GLFW_KEY_C)) actions.compare = true;
   if (pressed(GLFW_KEY_H)) m_settings.heatmap = !m_settings.heatmap;
-  if (pressed(GLFW_KEY_F1)) m_settings.show_ui = !m_settings.show_ui;
-  if (pressed(GLFW_KEY_F12)) {
-    if (mods & GLFW_MOD_SHIFT) m_pending_window_shot = "flashgs_window.png";  // the whole window, panels included
-    else actions.screenshot_path = m_shot_buffer;
+  if (pressed(GLFW_KEY_F1)) {
+    m_settings.show_help = !m_settings.show_help;
+    std::fprintf(stderr, "flashgs-viewer: help %s (F1)\n", m_settings.show_help ? "shown" : "closed");
   }
-  if (pressed(GLFW_KEY_TAB))
+  if (pressed(GLFW_KEY_TAB)) {
+    m_settings.show_ui = !m_settings.show_ui;
+    std::fprintf(stderr, "flashgs-viewer: panels %s (Tab)\n", m_settings.show_ui ? "shown" : "hidden");
+  }
+  if (pressed(GLFW_KEY_F)) actions.frame_scene = true;
+  if (pressed(GLFW_KEY_G)) m_settings.show_grid = !m_settings.show_grid;
+  if (pressed(GLFW_KEY_ESCAPE) || (pressed(GLFW_KEY_Q) && (mods & GLFW_MOD_CONTROL))) {
+    std::fprintf(stderr, "flashgs-viewer: quit (Esc / Ctrl+Q)\n");
+    m_window->request_close();
+  }
+  if (pressed(GLFW_KEY_O) && (mods & GLFW_MOD_CONTROL)) actions.open_dialog = true;
+  if (pressed(GLFW_KEY_F12)) {
+    if (mods & GLFW_MOD_SHIFT) m_pending_window_shot = next_screenshot_path(m_settings.screenshot_folder, "window");
+    else actions.screenshot = true;
+  }
+  if (pressed(GLFW_KEY_O) && !(mods & GLFW_MOD_CONTROL))
     m_settings.mode = m_settings.mode == NavigationMode::fly ? NavigationMode::orbit : NavigationMode::fly;
+  for (int key : {GLFW_KEY_EQUAL, GLFW_KEY_KP_ADD})
+    if (pressed(key)) nav.speed_steps += 1.0f;
+  for (int key : {GLFW_KEY_MINUS, GLFW_KEY_KP_SUBTRACT})
+    if (pressed(key)) nav.speed_steps -= 1.0f;
   if (pressed(GLFW_KEY_B)) {
     const bool to_flash = m_settings.options.is_baseline();
     RenderOptions& o = m_settings.options;
@@ -242,18 +286,22 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
     std::copy(o.background, o.background + 3, fresh.background);
     o = fresh;
   }
-  if (mouse_free) {
-    const bool left = m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT);
+  const bool left_down = m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT);
+  if (mouse_free) actions.snap_camera = frustum_under_click(left_down, x, y);
+  if (mouse_free || m_divider.dragging()) handle_divider_drag(left_down, x);
+  if (mouse_free && !m_divider.dragging()) {
+    const bool left = left_down;
     const bool right = m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT);
     const bool middle = m_window->mouse_down(GLFW_MOUSE_BUTTON_MIDDLE);
-    if (m_settings.mode == NavigationMode::fly) {
-      if (right) nav.look_dx = dx, nav.look_dy = dy;
-    } else {
-      if (left && !nav.fast) nav.look_dx = dx, nav.look_dy = dy;
-      if (right || middle || (left && nav.fast)) nav.pan_dx = dx, nav.pan_dy = dy;
-    }
-    nav.scroll = scroll;
+    // As in SIBR, SuperSplat and viser: left-drag looks (fly) or orbits, right/middle-drag
+    // (or Shift+left) pans, the wheel dollies and Ctrl+wheel sets the speed.
+    if (left && !nav.fast) nav.look_dx = dx, nav.look_dy = dy;
+    if (right || middle || (left && nav.fast)) nav.pan_dx = dx, nav.pan_dy = dy;
+    const bool ctrl = m_window->key_down(GLFW_KEY_LEFT_CONTROL) || m_window->key_down(GLFW_KEY_RIGHT_CONTROL);
+    if (ctrl) nav.speed_steps += scroll;
+    else nav.scroll = scroll;
   }
+  m_left_was_down = left_down;
 }
 
 void ViewerApp::apply_actions(const UiActions& a) {
@@ -279,14 +327,158 @@ void ViewerApp::apply_actions(const UiActions& a) {
     apply_up_choice();
     m_camera_index = -1;
   }
-  if (!a.screenshot_path.empty()) save_screenshot(a.screenshot_path);
-  if (a.compare && m_have_frame) {
-    m_compare = run_compare(*m_path, m_last_camera, m_settings.options);
-    if (m_compare.valid)
-      std::fprintf(stderr, "flashgs-viewer: compare %s vs baseline at %dx%d: PSNR %.2f dB, max abs %.6f, %.3f ms vs %.3f ms\n",
-                   m_compare.current_label.c_str(), m_compare.width, m_compare.height, m_compare.difference.psnr_db,
-                   m_compare.difference.max_abs, m_compare.current_ms, m_compare.baseline_ms);
+  if (a.frame_scene)
+    m_controller.frame_scene(m_settings.fov_x_degrees,
+                             m_have_frame ? float(m_last_camera.width) / float(m_last_camera.height) : 16.0f / 9.0f);
+  if (a.up_changed) {
+    apply_up_choice();
+    m_camera_index = -1;
   }
+  if (a.open_dialog) open_file_dialog();
+  if (!a.export_folder.empty()) start_path_export(a.export_folder, m_args.export_frames);
+  if (a.cancel_export && m_export.active()) {
+    set_notice("path export cancelled after " + std::to_string(m_export.done_frames()) + " frames");
+    m_export.cancel();
+  }
+  if (a.screenshot) take_screenshot(next_screenshot_path(m_settings.screenshot_folder, ""));
+  if (a.compare && m_have_frame) run_comparison();
+}
+
+void ViewerApp::run_comparison() {
+  const RenderOptions left = compare_choice_options(m_settings.compare_left, m_settings.options);
+  const RenderOptions right = compare_choice_options(m_settings.compare_right, m_settings.options);
+  m_compare = run_compare(*m_path, m_last_camera, left, right, /*warm_up=*/!m_path_is_cpu);
+  m_compare_camera = m_last_camera;
+  m_compare_options = m_last_options;
+  if (!m_compare.valid) {
+    set_notice("compare: " + m_compare.error);
+    return;
+  }
+  const Image difference = difference_image(m_compare.right_image, m_compare.left_image, &m_difference_factor);
+  if (!m_split) {
+    m_split = std::make_unique<SplitViewPresenter>();
+    m_split->init();
+  }
+  m_split->set_images(m_compare.left_image, m_compare.right_image, difference);
+  std::fprintf(stderr,
+               "flashgs-viewer: compare %s vs %s at %dx%d: PSNR %.2f dB, max abs %.6f, %.3f ms vs %.3f ms, "
+               "speed-up %.2fx, pair reduction %.1f%%, difference image x%.0f\n",
+               m_compare.right_label.c_str(), m_compare.left_label.c_str(), m_compare.width, m_compare.height,
+               m_compare.difference.psnr_db, m_compare.difference.max_abs, m_compare.right_ms, m_compare.left_ms,
+               m_compare.speed_up(), 100.0 * m_compare.pair_reduction(), m_difference_factor);
+}
+
+bool ViewerApp::comparison_shown() const {
+  return m_split && m_compare.valid && !m_compare.stale && m_settings.compare_view != CompareView::numbers;
+}
+
+void ViewerApp::handle_divider_drag(bool left_down, double x) {
+  int width = 0, height = 0;
+  m_window->window_size(&width, &height);
+  const bool split = comparison_shown() && m_settings.compare_view == CompareView::split;
+  if (left_down && !m_left_was_down && split) m_divider.press(float(x), float(width));
+  else if (left_down && m_divider.dragging()) m_divider.drag_to(float(x), float(width));
+  else if (!left_down) m_divider.release();
+}
+
+int ViewerApp::frustum_under_click(bool left_down, double x, double y) {
+  const bool pressed_now = left_down && !m_left_was_down, released_now = !left_down && m_left_was_down;
+  if (pressed_now) m_press_x = x, m_press_y = y;
+  if (!released_now || !m_settings.show_frustums || !m_have_frame || m_divider.dragging()) return -1;
+  if (std::hypot(x - m_press_x, y - m_press_y) > 4.0) return -1;  // a drag, not a click
+  int width = 0, height = 0;
+  m_window->window_size(&width, &height);
+  if (width <= 0 || height <= 0) return -1;
+  const float sx = float(m_last_camera.width) / float(width), sy = float(m_last_camera.height) / float(height);
+  const int index = pick_camera(m_scene.cameras, m_last_camera, float(x) * sx, float(y) * sy, 14.0f * sx);
+  if (index >= 0) std::fprintf(stderr, "flashgs-viewer: clicked the frustum of camera %d\n", index);
+  return index;
+}
+
+void ViewerApp::draw_guides(int fb_w, int fb_h) {
+  if (!(m_settings.show_grid || m_settings.show_frustums) || !m_have_frame) return;
+  if (!m_lines) {
+    m_lines = std::make_unique<LineOverlay>();
+    m_lines->init();
+  }
+  std::vector<WorldSegment> world;
+  if (m_settings.show_grid) world = grid_and_axes(m_scene.centre, m_scene.extent, m_controller.world_up());
+  if (m_settings.show_frustums) {
+    const std::vector<WorldSegment> f = camera_frustums(m_scene.cameras, 0.08f * m_scene.extent,
+                                                        m_controller.on_scene_camera() ? m_camera_index : -1);
+    world.insert(world.end(), f.begin(), f.end());
+  }
+  m_lines->draw(project_segments(world, m_last_camera, 1e-3f * m_scene.extent), m_last_camera.width,
+                m_last_camera.height, fb_w, fb_h);
+}
+
+void ViewerApp::open_file_dialog() {
+  const std::string folder = m_scene.path.empty() ? std::string(".")
+                                                  : std::filesystem::path(m_scene.path).parent_path().string();
+  if (m_dialog.busy() || m_browser.is_open()) return;
+  if (m_dialog.open_native(folder)) {
+    std::fprintf(stderr, "flashgs-viewer: file dialog: %s\n", m_dialog.tool().c_str());
+  } else {
+    std::fprintf(stderr, "flashgs-viewer: file dialog: in-app browser (no zenity or kdialog on PATH)\n");
+    m_browser.open(folder);
+  }
+}
+
+void ViewerApp::start_path_export(const std::string& folder, int frames) {
+  if (!m_camera_path || m_camera_path->empty()) {
+    set_notice("path export: the scene has no cameras to make a path from");
+    if (m_scripted) m_exit_code = 2;
+    return;
+  }
+  const std::string problem = m_export.start(folder, frames);
+  if (!problem.empty()) {
+    set_notice(problem);
+    if (m_scripted) m_exit_code = 2;
+    return;
+  }
+  m_playing = false;
+  std::fprintf(stderr, "flashgs-viewer: path export: %d frames into %s\n", frames, folder.c_str());
+}
+
+void ViewerApp::export_step() {
+  const int width = m_presenter->width() > 0 ? m_presenter->width() : 1280;
+  const int height = m_presenter->height() > 0 ? m_presenter->height() : 720;
+  CameraController at = m_controller;
+  at.set_pose(m_camera_path->pose_at(m_export.next_t()));
+  const Camera camera = at.render_camera(width, height, m_camera_path->fov_at(m_export.next_t()));
+  RenderOptions options = m_settings.options;
+  options.collect_tile_counts = false;
+  try {
+    Image image;
+    m_path->render_image(camera, options, image, nullptr);
+    write_image(image, m_export.next_file());
+  } catch (const std::exception& e) {
+    set_notice("path export stopped: " + reason(e));
+    m_export.cancel();
+    if (m_scripted) m_exit_code = 2;
+    return;
+  }
+  m_export.advance();
+  if (m_export.active()) return;
+  std::string done = "path export: " + std::to_string(m_export.done_frames()) + " frames in " + m_export.folder();
+  const std::string video = m_export.video_command(30);
+  if (video.empty()) {
+    done += " (no ffmpeg on PATH: image sequence only)";
+  } else {
+    const int rc = std::system(video.c_str());
+    done += rc == 0 ? ", video " + m_export.folder() + "/path.mp4" : ", ffmpeg failed (exit " + std::to_string(rc) + ")";
+  }
+  set_notice(done);
+}
+
+void ViewerApp::log_legend() {
+  // One line per change: tests read the ticks the legend shows.
+  std::string text = legend_caption(gm::kTileSize, m_settings.heatmap_log, m_settings.heatmap_lock_max) + ", ticks";
+  for (const LegendTick& t : legend_ticks(m_heat_scale.max(), m_settings.heatmap_log))
+    text += " " + std::to_string(t.value) + "@" + std::to_string(int(std::lround(t.position * 100))) + "%";
+  if (text == m_logged_legend) return;
+  m_logged_legend = text;
+  std::fprintf(stderr, "flashgs-viewer: heat-map legend: %s\n", text.c_str());
 }
 
 void ViewerApp::ensure_texture(int width, int height) {
@@ -322,12 +514,17 @@ void ViewerApp::render_frame(const Camera& camera) {
     std::uint32_t max_count = m_stats.max_tile_pairs;
     if (max_count == 0)
       for (std::uint32_t c : m_tile_counts) max_count = std::max(max_count, c);
-    m_presenter->set_tile_counts(m_tile_counts, m_stats.tiles_x, m_stats.tiles_y, max_count);
+    const std::uint64_t top = m_heat_scale.update(max_count, m_settings.heatmap_lock_max);
+    m_presenter->set_tile_counts(m_tile_counts, m_stats.tiles_x, m_stats.tiles_y,
+                                 static_cast<std::uint32_t>(std::min<std::uint64_t>(top, UINT32_MAX)));
+    log_legend();
   }
   m_last_camera = camera;
   m_last_options = options;
   m_have_frame = true;
-  if (m_compare.valid) m_compare.stale = true;
+  // Another view or configuration than the comparison's: its images no longer match the frame.
+  if (m_compare.valid && (!same_camera(camera, m_compare_camera) || !(options == m_compare_options)))
+    m_compare.stale = true;
 }
 
 void ViewerApp::log_held_input() {
@@ -341,7 +538,14 @@ void ViewerApp::log_held_input() {
   if (held.empty()) return;
   double x = 0, y = 0;
   m_window->cursor(&x, &y);
-  std::fprintf(stderr, "flashgs-viewer: frame %d held:%s at %.0f,%.0f\n", m_presented, held.c_str(), x, y);
+  // The pose too: a test dragging through X checks which way the view went.
+  const Pose& p = m_controller.pose();
+  const glm::vec3 f = p.rotation[2], r = p.rotation[0], pivot = m_controller.pivot();
+  std::fprintf(stderr,
+               "flashgs-viewer: frame %d held:%s at %.0f,%.0f | camera %.6f %.6f %.6f forward %.6f %.6f %.6f "
+               "right %.6f %.6f %.6f pivot %.6f %.6f %.6f\n",
+               m_presented, held.c_str(), x, y, p.position.x, p.position.y, p.position.z, f.x, f.y, f.z, r.x, r.y, r.z,
+               pivot.x, pivot.y, pivot.z);
 }
 
 void ViewerApp::set_notice(const std::string& message) {
@@ -391,6 +595,13 @@ void ViewerApp::render_failed(int width, int height, const std::string& why) {
     m_exit_code = 2;
     m_window->request_close();
   }
+}
+
+void ViewerApp::take_screenshot(const std::string& path) {
+  // With the overlay: the framebuffer once this frame's image and heat map are drawn, before
+  // the panels; else the rendered image itself.
+  if (m_settings.screenshot_overlay && m_settings.heatmap) m_pending_overlay_shot = path;
+  else save_screenshot(path);
 }
 
 void ViewerApp::save_screenshot(const std::string& path) {
@@ -491,13 +702,19 @@ void ViewerApp::finish_script() {
     a.compare = true;
     apply_actions(a);
     if (m_compare.valid)
-      std::printf("viewer compare: %s vs baseline PSNR %.2f dB max abs %.6f\n", m_compare.current_label.c_str(),
-                  m_compare.difference.psnr_db, m_compare.difference.max_abs);
+      std::printf("viewer compare: %s vs %s PSNR %.2f dB max abs %.6f\n", m_compare.right_label.c_str(),
+                  m_compare.left_label.c_str(), m_compare.difference.psnr_db, m_compare.difference.max_abs);
+  }
+  if (!m_args.export_path.empty()) {
+    start_path_export(m_args.export_path, m_args.export_frames);
+    while (m_export.active()) export_step();
   }
   if (m_args.check_frame && m_have_frame) check_displayed_frame();
-  if (!m_args.screenshot.empty()) save_screenshot(m_args.screenshot);
+  if (!m_args.screenshot.empty()) take_screenshot(m_args.screenshot);
   std::fflush(stdout);
-  if (!m_args.window_screenshot.empty()) {
+  if (!m_pending_overlay_shot.empty()) {
+    m_close_after_shot = m_args.exit_after;  // taken while the next frame is drawn
+  } else if (!m_args.window_screenshot.empty()) {
     // Taken at the end of the next frame, once the panels show this frame's statistics.
     m_pending_window_shot = m_args.window_screenshot;
     m_close_after_shot = m_args.exit_after;
@@ -648,10 +865,11 @@ int ViewerApp::run() {
     const float fb_scale = m_window->framebuffer_scale();
     // Bottom right, clear of the main panel (top left) and the statistics (top right).
     const float u = m_ui_scale * fb_scale;  // legend sizes in pixels
-    const float legend_px[4] = {float(fb_w) - 300.0f * u, float(fb_h) - 30.0f * u, float(fb_w) - 20.0f * u,
-                                float(fb_h) - 16.0f * u};
-    if (m_settings.show_ui) {
-      m_ui->begin_frame();
+    // Room below the bar for the tick labels, above it for the caption.
+    const float legend_px[4] = {float(fb_w) - 300.0f * u, float(fb_h) - 46.0f * u, float(fb_w) - 20.0f * u,
+                                float(fb_h) - 32.0f * u};
+    m_ui->begin_frame();  // every frame: the legend, help and hint show with the panels hidden too
+    {
       model.frame_path = m_path->name();
       model.frame_path_note = m_path_note;
       model.backend = m_path_is_cpu ? Backend::cpu : Backend::cuda;
@@ -672,18 +890,33 @@ int ViewerApp::run() {
       model.history = &m_history;
       model.compare = &m_compare;
       model.heatmap_max = m_presenter->heatmap_max();
+      model.tile_size = gm::kTileSize;
+      model.compare_shown = comparison_shown();
+      model.divider = m_divider.fraction();
+      model.difference_factor = m_difference_factor;
+      model.compare_problem =
+          same_configuration_problem(compare_choice_options(m_settings.compare_left, m_settings.options),
+                                     compare_choice_options(m_settings.compare_right, m_settings.options));
+      model.export_done = m_export.done_frames();
+      model.export_total = m_export.active() ? m_export.total_frames() : 0;
+      model.dialog_tool = m_dialog.tool();
+      model.dialog_open = m_dialog.busy() || m_browser.is_open();
       for (int k = 0; k < 4; ++k) model.legend_rect_points[k] = legend_px[k] / fb_scale;
       model.status = m_status;
       model.ui_scale = m_ui_scale;
       const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
       for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
       const ViewerSettings before = m_settings;
-      draw_panels(model, m_settings, actions, m_path_buffer, m_shot_buffer);
+      if (m_settings.show_ui) draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer);
+      draw_overlays(model, m_settings);
+      if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
       keep_settings_valid(m_settings, before);
     }
+    if (const std::string chosen = m_dialog.take_choice(); !chosen.empty()) actions.open_path = chosen;
     if (m_args.log_input) log_held_input();
     apply_actions(actions);
     finish_pending_load();
+    if (m_export.active() && !m_scripted) export_step();  // one frame of the export per window frame
 
     const bool steering = nav.forward || nav.back || nav.left || nav.right || nav.up || nav.down ||
                           nav.look_dx != 0.0f || nav.look_dy != 0.0f || nav.pan_dx != 0.0f || nav.pan_dy != 0.0f;
@@ -754,8 +987,18 @@ int ViewerApp::run() {
     glClearColor(0, 0, 0, 1);
     glClear(GL_COLOR_BUFFER_BIT);
     const auto t_draw = Clock::now();
-    m_presenter->draw(fb_w, fb_h, m_settings.heatmap ? &heat : nullptr);
-    if (m_settings.show_ui) m_ui->end_frame();
+    const bool comparing = comparison_shown();
+    m_presenter->draw(fb_w, fb_h, m_settings.heatmap && !comparing ? &heat : nullptr);
+    if (!comparing) draw_guides(fb_w, fb_h);
+    if (comparing)
+      m_split->draw(fb_w, fb_h, m_divider.fraction(), std::max(2.0f, 2.0f * m_ui_scale * fb_scale),
+                    m_settings.compare_view == CompareView::difference);
+    if (!m_pending_overlay_shot.empty()) {  // the image as shown, heat map included, panels not
+      save_window_screenshot(m_pending_overlay_shot, fb_w, fb_h);
+      m_status = "saved " + m_pending_overlay_shot + " (heat map included)";
+      m_pending_overlay_shot.clear();
+    }
+    m_ui->end_frame();
     if (!m_pending_window_shot.empty()) {
       save_window_screenshot(m_pending_window_shot, fb_w, fb_h);
       m_pending_window_shot.clear();

@@ -8,10 +8,15 @@
 #include "camera_controller.h"
 #include "camera_path.h"
 #include "compare_mode.h"
+#include "file_browser_ui.h"
+#include "file_dialog.h"
+#include "heatmap_legend.h"
+#include "path_export.h"
 #include "frame_path.h"
 #include "key_script.h"
 #include "scene_loader.h"
 #include "scene_state.h"
+#include "split_view.h"
 #include "stats_history.h"
 #include "viewer_args.h"
 #include "viewer_settings.h"
@@ -20,6 +25,8 @@ namespace flashgs::viewer {
 
 class Window;
 class ImagePresenter;
+class SplitViewPresenter;
+class LineOverlay;
 class ImGuiLayer;
 struct UiActions;
 
@@ -52,8 +59,18 @@ class ViewerApp {
   void apply_actions(const UiActions& actions);
   void ensure_texture(int width, int height);
   void render_frame(const Camera& camera);
+  void take_screenshot(const std::string& path);  // the rendered image, or with the heat map (setting)
   void save_screenshot(const std::string& path);
   void save_window_screenshot(const std::string& path, int width, int height);
+  void run_comparison();
+  bool comparison_shown() const;  // the split or difference image replaces the frame
+  void handle_divider_drag(bool left_down, double x);
+  int frustum_under_click(bool left_down, double x, double y);  // on release of a click, else -1
+  void draw_guides(int fb_w, int fb_h);  // grid, axes and frustums over the frame
+  void open_file_dialog();
+  void start_path_export(const std::string& folder, int frames);
+  void export_step();  // renders and writes the export's next frame
+  void log_legend();   // the heat-map legend's ticks, once per change
   void finish_script();
   void check_displayed_frame();
 
@@ -61,6 +78,8 @@ class ViewerApp {
   ViewerSettings m_settings;
   std::unique_ptr<Window> m_window;
   std::unique_ptr<ImagePresenter> m_presenter;
+  std::unique_ptr<SplitViewPresenter> m_split;
+  std::unique_ptr<LineOverlay> m_lines;
   std::unique_ptr<ImGuiLayer> m_ui;
   std::unique_ptr<FramePath> m_path;
   std::string m_path_note;
@@ -83,6 +102,18 @@ class ViewerApp {
   StatsHistory m_history;
   std::vector<std::uint32_t> m_tile_counts;
   CompareResult m_compare;
+  Camera m_compare_camera;          // the view and configuration the comparison was made for
+  RenderOptions m_compare_options;
+  float m_difference_factor = 1.0f;  // the difference image's magnification
+  SplitDivider m_divider;
+  bool m_left_was_down = false;
+  double m_press_x = 0, m_press_y = 0;  // where the left button went down (a click snaps to a frustum)
+  HeatScale m_heat_scale;
+  std::string m_logged_legend;
+  FileDialog m_dialog;
+  FileBrowser m_browser;
+  PathExport m_export;
+  std::string m_pending_overlay_shot;  // a screenshot of the image with the heat map, taken before the panels are drawn
   std::string m_status;
   double m_fps = 0;
   float m_ui_scale = 1.0f;
@@ -100,7 +131,7 @@ class ViewerApp {
 
   // Input state between frames.
   double m_last_cursor_x = 0, m_last_cursor_y = 0;
-  std::string m_path_buffer, m_shot_buffer;
+  std::string m_path_buffer, m_export_buffer;
 
   // Scripted mode.
   bool m_scripted = false;

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "compare_mode.h"
 #include "finite_option.h"
 #include "flashgs/error.h"
 #include "flashgs/parse.h"
@@ -63,8 +64,32 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
       ->expected(3)
       ->check(finite_in(kBackgroundRange));
   app.add_flag("--heatmap", a->heatmap, "start with the per-tile pair-count overlay on");
-  app.add_flag("--orbit", a->orbit, "start in orbit mode (default: fly)");
-  app.add_flag("--no-ui", a->no_ui, "hide the panels (F1 toggles them)");
+  auto* orbit = app.add_flag("--orbit", a->orbit, "start in orbit mode (default: orbit for object-sized scenes, else fly)");
+  app.add_flag("--fly", a->fly, "start in fly mode")->excludes(orbit);
+  app.add_flag("--grid", a->grid, "start with the ground grid and axes shown (G)");
+  app.add_flag("--frustums", a->frustums, "start with the training cameras drawn as frustums");
+  app.add_flag("--help-window", a->help_window, "start with the shortcut table open (F1)");
+  app.add_option("--compare-view", a->compare_view, "what a comparison shows: numbers, split or difference")
+      ->check(CLI::IsMember({"numbers", "split", "difference"}));
+  const auto choice = CLI::Validator([](std::string& text) {
+    if (compare_choice_from_name(text) >= 0) return std::string();
+    std::string names;
+    for (int c = 0; c < compare_choice_count(); ++c) names += (c ? ", " : "") + compare_choice_name(c);
+    return "\"" + text + "\" is not a configuration (" + names + ")";
+  }, "CONFIG");
+  app.add_option("--compare-left", a->compare_left, "the comparison's left side (default baseline)")->check(choice);
+  app.add_option("--compare-right", a->compare_right, "the comparison's right side (default current)")->check(choice);
+  app.add_option("--split-at", a->split_at, "the split view's divider, a fraction of the width")
+      ->check(finite_in(ValueRange{0.02f, 0.98f}));
+  app.add_flag("--screenshot-overlay", a->screenshot_overlay,
+               "screenshots include the heat map (at the window's size) as the window shows it");
+  app.add_option("--screenshot-dir", a->screenshot_dir,
+                 "folder for F12's timestamped screenshots (default: the XDG pictures folder, else the working directory)");
+  app.add_option("--export-path", a->export_path,
+                 "scripted: write the camera path as an image sequence (frame_00000.png, ...) into this folder, "
+                 "and path.mp4 when ffmpeg is on PATH");
+  app.add_option("--export-frames", a->export_frames, "frames of --export-path (default 120)")->check(CLI::Range(1, 100000));
+  app.add_flag("--no-ui", a->no_ui, "hide the panels (Tab toggles them)");
   app.add_flag("--no-vsync", a->no_vsync, "present without waiting for vertical sync");
   app.add_option("--frames", a->frames, "scripted: render this many frames")->check(CLI::Range(0, 10000000));
   app.add_option("--keys", a->keys,

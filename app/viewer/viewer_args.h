@@ -26,7 +26,17 @@ struct ViewerArgs {
   int sh_degree = 3;
   std::vector<float> background = {0, 0, 0};
   bool heatmap = false;
-  bool orbit = false;
+  bool orbit = false;            // start in orbit mode
+  bool fly = false;              // start in fly mode (neither: orbit for object-sized scenes)
+  bool grid = false, frustums = false;
+  bool help_window = false;      // start with the shortcut table open
+  std::string compare_view = "split";  // numbers | split | difference
+  std::string compare_left = "baseline", compare_right = "current";  // compare_mode.h choice names
+  float split_at = 0.5f;         // the divider, a fraction of the width
+  bool screenshot_overlay = false;  // screenshots show the heat map as the window does
+  std::string screenshot_dir;    // F12's folder; empty: the XDG pictures folder or the working directory
+  std::string export_path;       // scripted: write the camera path as an image sequence into this folder
+  int export_frames = 120;
   bool no_ui = false;
   bool no_vsync = false;
 

@@ -1,4 +1,4 @@
-// ImGui panels: scene, view, rendering options, compare, statistics, heat-map legend.
+// ImGui panels: scene, view, rendering options, compare, statistics; the heat-map legend and comparison labels over the image.
 #include "viewer_panels_ui.h"
 
 #include <algorithm>
@@ -7,6 +7,9 @@
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
+
+#include "heatmap_legend.h"
+#include "help_overlay_ui.h"
 
 namespace flashgs::viewer {
 namespace {
@@ -33,11 +36,20 @@ void scene_panel(const UiModel& m, UiActions& a, std::string& path_buffer) {
   ImGui::Text("%s Gaussians, SH degree %d, %d cameras", human_count(double(m.gaussians)).c_str(), m.sh_degree,
               m.camera_count);
   if (!m.scene_note.empty()) ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.scene_note.c_str());
-  ImGui::SetNextItemWidth(ui(-60));
+  ImGui::SetNextItemWidth(ui(-140));
   const bool enter = ImGui::InputTextWithHint("##open", "PLY path or folder (or drop a file)", &path_buffer,
                                               ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
   if ((ImGui::Button("Open") || enter) && !path_buffer.empty()) a.open_path = path_buffer;
+  ImGui::SameLine();
+  ImGui::BeginDisabled(m.dialog_open);
+  if (ImGui::Button("Browse...")) a.open_dialog = true;
+  ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("the desktop's file dialog (Ctrl+O)");
+  if (m.dialog_open) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("waiting for %s", m.dialog_tool.empty() ? "the file browser" : m.dialog_tool.c_str());
+  }
   if (!m.loading.empty()) {
     ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1), "loading %s ...", m.loading.c_str());
     ImGui::SameLine();
@@ -57,7 +69,9 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   ImGui::SameLine();
   ImGui::RadioButton("Orbit", &mode, 1);
   ImGui::SameLine();
-  ImGui::TextDisabled("(Tab)");
+  ImGui::TextDisabled("(O)");
+  ImGui::SameLine();
+  if (ImGui::Button("Frame scene (F)")) a.frame_scene = true;
   s.mode = mode == 0 ? NavigationMode::fly : NavigationMode::orbit;
   if (m.camera_count > 0) {
     if (ImGui::ArrowButton("##prev", ImGuiDir_Left)) a.previous_camera = true;
@@ -81,12 +95,23 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
                      kClamp | ImGuiSliderFlags_Logarithmic);
   ImGui::SliderFloat("Render scale", &s.render_scale, kRenderScaleRange.min, kRenderScaleRange.max, "%.2f", kClamp);
   ImGui::Checkbox("Fewer pixels while moving (slow backends)", &s.adaptive_resolution);
-  if (ImGui::Checkbox("Flip world up", &s.flip_up)) a.flip_up = true;
+  ImGui::SetNextItemWidth(ui(70));
+  if (ImGui::Combo("Up axis", &s.up_axis, kUpAxisNames, kUpAxisCount)) a.up_changed = true;
+  ImGui::SameLine();
+  if (ImGui::Checkbox("Flip", &s.flip_up)) a.flip_up = true;
   ImGui::SameLine();
   ImGui::TextDisabled("up = (%.2f, %.2f, %.2f)", m.world_up[0], m.world_up[1], m.world_up[2]);
   if (ImGui::Button("Reset view")) a.reset_view = true;
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("position (%.3f, %.3f, %.3f)", m.position[0], m.position[1], m.position[2]);
   ImGui::SameLine();
-  ImGui::TextDisabled("pos (%.2f, %.2f, %.2f)", m.position[0], m.position[1], m.position[2]);
+  ImGui::Checkbox("Grid, axes (G)", &s.show_grid);
+  ImGui::SameLine();
+  ImGui::BeginDisabled(m.camera_count == 0);
+  ImGui::Checkbox("Frustums", &s.show_frustums);
+  ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip(m.camera_count ? "the training cameras; click one to jump to it" : "the scene has no cameras");
 }
 
 // One optimisation switch: a checkbox greyed out where the backend does not honour it, and a
@@ -142,9 +167,33 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
   ImGui::Checkbox("VSync", &s.vsync);
 }
 
-void compare_panel(const UiModel& m, UiActions& a) {
-  if (!ImGui::CollapsingHeader("Compare with baseline", ImGuiTreeNodeFlags_DefaultOpen)) return;
+void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
+  if (!ImGui::CollapsingHeader("Compare", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  // The two sides: any two of the configurations compare_mode.h lists.
+  auto side = [&](const char* label, int* choice) {
+    ImGui::SetNextItemWidth(ui(118));
+    if (ImGui::BeginCombo(label, compare_choice_name(*choice).c_str())) {
+      for (int c = 0; c < compare_choice_count(); ++c)
+        if (ImGui::Selectable(compare_choice_name(c).c_str(), c == *choice)) *choice = c;
+      ImGui::EndCombo();
+    }
+  };
+  side("left", &s.compare_left);
+  ImGui::SameLine();
+  side("right", &s.compare_right);
+  ImGui::BeginDisabled(!m.compare_problem.empty());
   if (ImGui::Button("Compare this view (C)")) a.compare = true;
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  int view = static_cast<int>(s.compare_view);
+  const char* views[] = {"numbers only", "split view", "difference"};
+  ImGui::SetNextItemWidth(ui(120));
+  ImGui::Combo("##view", &view, views, 3);
+  s.compare_view = static_cast<CompareView>(view);
+  if (!m.compare_problem.empty()) {
+    ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.compare_problem.c_str());
+    return;
+  }
   const CompareResult* c = m.compare;
   if (!c || (!c->valid && c->error.empty())) return;
   if (!c->error.empty()) {
@@ -153,46 +202,65 @@ void compare_panel(const UiModel& m, UiActions& a) {
   }
   if (c->stale) {
     ImGui::SameLine();
-    ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "(stale: view changed)");
+    ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "(view changed: C again)");
   }
-  ImGui::Text("%s vs baseline at %dx%d", c->current_label.c_str(), c->width, c->height);
+  ImGui::Text("%s (right) vs %s (left) at %dx%d", c->right_label.c_str(), c->left_label.c_str(), c->width, c->height);
   if (std::isinf(c->difference.psnr_db)) ImGui::Text("PSNR: identical   max abs: 0");
   else ImGui::Text("PSNR %.2f dB   max abs %.5f (%.2f/255)", c->difference.psnr_db, c->difference.max_abs,
                    c->difference.max_abs * 255.0);
   ImGui::Text("pixels off by > 1/255: %.4f%%", 100.0 * c->difference.fraction_over_1_255);
+  if (s.compare_view == CompareView::difference) ImGui::Text("difference image: |error| x %.0f", m.difference_factor);
+  ImGui::Text("speed-up %.2fx   pair reduction %.1f%%", c->speed_up(), 100.0 * c->pair_reduction());
   if (ImGui::BeginTable("cmp", 3, ImGuiTableFlags_BordersInnerH)) {
     ImGui::TableSetupColumn("");
-    ImGui::TableSetupColumn("current");
-    ImGui::TableSetupColumn("baseline");
+    ImGui::TableSetupColumn("left");
+    ImGui::TableSetupColumn("right");
     ImGui::TableHeadersRow();
     ImGui::TableNextRow();
     ImGui::TableNextColumn(); ImGui::Text("frame ms");
-    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->current_ms);
-    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->baseline_ms);
+    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->left_ms);
+    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->right_ms);
     ImGui::TableNextRow();
     ImGui::TableNextColumn(); ImGui::Text("wall ms");
-    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->current_wall_ms);
-    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->baseline_wall_ms);
+    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->left_wall_ms);
+    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->right_wall_ms);
     ImGui::TableNextRow();
     ImGui::TableNextColumn(); ImGui::Text("kv pairs");
-    ImGui::TableNextColumn(); ImGui::Text("%s", human_count(double(c->current_kv)).c_str());
-    ImGui::TableNextColumn(); ImGui::Text("%s", human_count(double(c->baseline_kv)).c_str());
+    ImGui::TableNextColumn(); ImGui::Text("%s", human_count(double(c->left_kv)).c_str());
+    ImGui::TableNextColumn(); ImGui::Text("%s", human_count(double(c->right_kv)).c_str());
     ImGui::EndTable();
   }
 }
 
-void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& shot) {
-  if (!ImGui::CollapsingHeader("Overlay and screenshots", ImGuiTreeNodeFlags_DefaultOpen)) return;
+void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& export_folder) {
+  if (!ImGui::CollapsingHeader("Overlay, screenshots, export", ImGuiTreeNodeFlags_DefaultOpen)) return;
   ImGui::Checkbox("Tile heat map (H)", &s.heatmap);
   ImGui::SameLine();
   ImGui::Checkbox("log", &s.heatmap_log);
+  ImGui::SameLine();
+  ImGui::Checkbox("lock max", &s.heatmap_lock_max);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("keep the scale's maximum while switching configurations, so colours compare");
   ImGui::SetNextItemWidth(ui(120));
   ImGui::SliderFloat("opacity", &s.heatmap_opacity, kHeatmapOpacityRange.min, kHeatmapOpacityRange.max, "%.2f", kClamp);
-  ImGui::SetNextItemWidth(ui(-70));
-  ImGui::InputText("##shot", &shot);
   ImGui::SameLine();
-  if (ImGui::Button("Save") && !shot.empty()) a.screenshot_path = shot;
+  ImGui::Checkbox("in screenshots", &s.screenshot_overlay);
+  ImGui::SetNextItemWidth(ui(-90));
+  ImGui::InputTextWithHint("##shotdir", "screenshot folder", &s.screenshot_folder);
+  ImGui::SameLine();
+  if (ImGui::Button("Save (F12)")) a.screenshot = true;
   if (!m.status.empty()) ImGui::TextWrapped("%s", m.status.c_str());
+  if (m.export_total > 0) {
+    ImGui::ProgressBar(float(m.export_done) / float(m.export_total), ImVec2(ui(-70), 0));
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel##export")) a.cancel_export = true;
+  } else if (m.camera_count > 0) {
+    ImGui::SetNextItemWidth(ui(-90));
+    ImGui::InputTextWithHint("##export", "folder for the path's frames", &export_folder);
+    ImGui::SameLine();
+    if (ImGui::Button("Export path") && !export_folder.empty()) a.export_folder = export_folder;
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("one loop of the camera path as frame_00000.png, ...; also path.mp4 when ffmpeg is on PATH");
+  }
 }
 
 void stats_window(const UiModel& m) {
@@ -238,20 +306,56 @@ void stats_window(const UiModel& m) {
   ImGui::End();
 }
 
-void legend_labels(const UiModel& m) {
+// The legend bar's caption and tick labels (the bar itself is the heat-map shader's, at
+// legend_rect_points).
+void legend_labels(const UiModel& m, const ViewerSettings& s) {
   ImDrawList* draw = ImGui::GetForegroundDrawList();
   const float* r = m.legend_rect_points;
   const ImU32 white = IM_COL32(255, 255, 255, 255);
-  draw->AddRectFilled(ImVec2(r[0] - ui(6), r[1] - ui(22)), ImVec2(r[2] + ui(6), r[1] - 1), IM_COL32(0, 0, 0, 150),
-                      ui(3.0f));
-  char text[64];
-  std::snprintf(text, sizeof text, "pairs per tile: 0 .. %u", m.heatmap_max);
-  draw->AddText(ImVec2(r[0], r[1] - ui(19)), white, text);
+  const float line = ImGui::GetTextLineHeight();
+  // Caption above the bar, tick marks and values below it, each on a dark backing that
+  // leaves the bar's colours (the GL pass under this) untouched.
+  const ImU32 backing = IM_COL32(0, 0, 0, 160);
+  draw->AddRectFilled(ImVec2(r[0] - ui(6), r[1] - line - ui(6)), ImVec2(r[2] + ui(6), r[1]), backing, ui(3.0f));
+  draw->AddRectFilled(ImVec2(r[0] - ui(16), r[3]), ImVec2(r[2] + ui(16), r[3] + line + ui(6)), backing, ui(3.0f));
+  const std::string caption = legend_caption(m.tile_size, s.heatmap_log, s.heatmap_lock_max);
+  draw->AddText(ImVec2(r[0], r[1] - line - ui(3)), white, caption.c_str());
+  for (const LegendTick& t : legend_ticks(m.heatmap_max, s.heatmap_log)) {
+    const float x = r[0] + t.position * (r[2] - r[0]);
+    draw->AddLine(ImVec2(x, r[3]), ImVec2(x, r[3] + ui(4)), white, ui(1.0f));
+    const std::string label = human_count(double(t.value));
+    const float w = ImGui::CalcTextSize(label.c_str()).x;
+    draw->AddText(ImVec2(x - 0.5f * w, r[3] + ui(4)), white, label.c_str());
+  }
+}
+
+// Which configuration is on which side, and the difference image's magnification.
+void compare_labels(const UiModel& m, const ViewerSettings& s) {
+  const CompareResult* c = m.compare;
+  if (!m.compare_shown || !c) return;
+  ImDrawList* draw = ImGui::GetForegroundDrawList();
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  const float y = vp->WorkPos.y + vp->WorkSize.y - ImGui::GetTextLineHeight() - ui(40);
+  auto label = [&](float x, const std::string& text) {
+    const ImVec2 size = ImGui::CalcTextSize(text.c_str());
+    draw->AddRectFilled(ImVec2(x - ui(4), y - ui(2)), ImVec2(x + size.x + ui(4), y + size.y + ui(2)),
+                        IM_COL32(0, 0, 0, 170), ui(3));
+    draw->AddText(ImVec2(x, y), IM_COL32(255, 255, 255, 255), text.c_str());
+  };
+  char text[160];
+  if (s.compare_view == CompareView::difference) {
+    std::snprintf(text, sizeof text, "|%s - %s| x %.0f", c->right_label.c_str(), c->left_label.c_str(), m.difference_factor);
+    label(vp->WorkPos.x + ui(12), text);
+    return;
+  }
+  const float at = vp->WorkPos.x + m.divider * vp->WorkSize.x;
+  label(at - ui(12) - ImGui::CalcTextSize(c->left_label.c_str()).x, c->left_label);
+  label(at + ui(12), c->right_label);
 }
 
 }  // namespace
 
-void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer, std::string& shot) {
+void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer, std::string& export_folder) {
   g_ui = m.ui_scale;
   ImGui::SetNextWindowPos(ImVec2(ui(10), ui(10)), ImGuiCond_FirstUseEver);
   const ImGuiViewport* vp = ImGui::GetMainViewport();
@@ -263,19 +367,22 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   scene_panel(m, a, path_buffer);
   view_panel(m, s, a);
   render_panel(m, s);
-  compare_panel(m, a);
-  overlay_panel(m, s, a, shot);
-  if (ImGui::CollapsingHeader("Keys")) {
-    ImGui::TextWrapped("Fly: WASD move, Q/E down/up, right-drag look, wheel speed, Shift fast. "
-                       "Orbit: left-drag rotate, right-drag (or Shift+left) pan, wheel or W/S zoom. "
-                       "N/P next/previous camera, Space play path, Tab fly/orbit, B baseline/flash, "
-                       "H heat map, C compare, F12 screenshot (Shift+F12: the whole window), F1 hide panels. "
-                       "Drop a PLY to open it.");
-  }
+  compare_panel(m, s, a);
+  overlay_panel(m, s, a, export_folder);
+  if (ImGui::Button("Keys and mouse (F1)")) s.show_help = !s.show_help;
+  ImGui::SameLine();
+  ImGui::TextDisabled("Tab hides the panels");
   ImGui::PopItemWidth();
   ImGui::End();
   stats_window(m);
-  if (s.heatmap) legend_labels(m);
+}
+
+void draw_overlays(const UiModel& m, ViewerSettings& s) {
+  g_ui = m.ui_scale;
+  if (s.heatmap && !m.compare_shown) legend_labels(m, s);
+  compare_labels(m, s);
+  draw_help_window(&s.show_help, m.ui_scale);
+  if (!s.show_ui) draw_hidden_panels_hint(m.ui_scale);
 }
 
 }  // namespace flashgs::viewer

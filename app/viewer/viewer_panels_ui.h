@@ -4,6 +4,7 @@
 #include <string>
 
 #include "compare_mode.h"
+#include "heatmap_legend.h"
 #include "flashgs/stats.h"
 #include "stats_history.h"
 #include "viewer_settings.h"
@@ -29,7 +30,15 @@ struct UiModel {
   const FrameStats* stats = nullptr;
   const StatsHistory* history = nullptr;
   const CompareResult* compare = nullptr;
-  std::uint32_t heatmap_max = 0;
+  std::uint32_t heatmap_max = 0;  // the scale's top (locked or this frame's)
+  int tile_size = 16;
+  bool compare_shown = false;     // the split or difference image is on screen
+  float divider = 0.5f;           // the split's divider, fraction of the width
+  float difference_factor = 1.0f;
+  std::string compare_problem;    // why the chosen sides cannot be compared (same configuration)
+  int export_done = 0, export_total = 0;  // path export progress (total 0: none running)
+  std::string dialog_tool;        // the desktop file dialog in use ("zenity"), empty: in-app browser
+  bool dialog_open = false;
   float legend_rect_points[4] = {0, 0, 0, 0};  // where the legend bar is drawn, window points
   float ui_scale = 1.0f;          // widget size multiplier (high-DPI screens)
   std::string status;             // last screenshot / action message
@@ -46,13 +55,21 @@ struct UiActions {
   bool flip_up = false;
   bool reset_view = false;
   bool compare = false;
-  std::string screenshot_path;    // non-empty: save the rendered image here
+  bool frame_scene = false;       // F: look at the whole scene
+  bool up_changed = false;        // the up-axis choice changed
+  bool open_dialog = false;       // the file dialog (desktop or in-app)
+  std::string export_folder;      // non-empty: export the camera path into this folder
+  bool cancel_export = false;
+  bool screenshot = false;        // save the rendered image under a timestamped name in the folder
 };
 
 // Draws every panel for this frame (the caller puts typed values back in range afterwards:
-// keep_settings_valid). `path_buffer` and `screenshot_buffer` hold the text fields'
-// contents between frames.
+// keep_settings_valid). `path_buffer` and `export_buffer` hold the text fields' contents
+// between frames.
 void draw_panels(const UiModel& model, ViewerSettings& settings, UiActions& actions, std::string& path_buffer,
-                 std::string& screenshot_buffer);
+                 std::string& export_buffer);
+// What stays on screen with the panels hidden too: the heat-map legend, the comparison's
+// labels, the help window and the hint that the panels are hidden.
+void draw_overlays(const UiModel& model, ViewerSettings& settings);
 
 }  // namespace flashgs::viewer

@@ -22,6 +22,7 @@ void keep_settings_valid(ViewerSettings& s, const ViewerSettings& before) {
   o.tau = kTauRange.clamp(o.tau, before.options.tau);
   for (int c = 0; c < 3; ++c) o.background[c] = kBackgroundRange.clamp(o.background[c], before.options.background[c]);
   o.sh_degree_cap = std::clamp(o.sh_degree_cap, 0, kMaxShDegree);
+  s.up_axis = std::clamp(s.up_axis, 0, kUpAxisCount - 1);
 }
 
 }  // namespace flashgs::viewer

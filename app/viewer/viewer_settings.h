@@ -1,11 +1,22 @@
 // ViewerSettings: every user-facing choice of the viewer in one plain struct (the UI and the script both edit it), with the range of each value.
 #pragma once
 
+#include <string>
+
 #include "flashgs/options.h"
 
 namespace flashgs::viewer {
 
 enum class NavigationMode { fly, orbit };
+// What the comparison shows: its numbers only, left | right split at a divider, or the
+// magnified difference image.
+enum class CompareView { numbers, split, difference };
+
+// The up-axis choices of the View panel and --up: 0 is "auto" (guessed from the cameras).
+inline constexpr const char* kUpAxisNames[] = {"auto", "+x", "-x", "+y", "-y", "+z", "-z"};
+inline constexpr int kUpAxisCount = 7;
+// The comparison's two configurations by default: baseline | current (compare_mode.h lists them all).
+inline constexpr int kCompareCurrent = 0, kCompareBaseline = 1;
 
 // The allowed interval of a numeric setting: the sliders, the command line and
 // keep_settings_valid() all use these, so a typed value cannot leave them.
@@ -42,7 +53,16 @@ struct ViewerSettings {
   bool vsync = true;
   bool continuous = true;           // re-render every frame (FPS); off: only when something changed
   bool show_ui = true;
+  bool show_help = false;           // the shortcut table (F1)
   float path_seconds_per_camera = 2.0f;
+  int up_axis = 0;                  // index into kUpAxisNames
+  bool show_grid = false;           // ground grid and axes over the image (G)
+  bool show_frustums = false;       // the training cameras as frustums, clickable
+  bool heatmap_lock_max = false;    // keep the heat map's maximum while switching configurations
+  bool screenshot_overlay = false;  // screenshots show the heat map as the window does
+  std::string screenshot_folder;    // where F12 saves (timestamped names); empty: working directory
+  CompareView compare_view = CompareView::split;
+  int compare_left = kCompareBaseline, compare_right = kCompareCurrent;  // compare_mode.h choices
 };
 
 // Puts every numeric setting back into its range after the panels edited it: a NaN or

@@ -1,0 +1,118 @@
+// Grid, axes and frustum geometry, near-plane clipping and projection with the view camera.
+#include "scene_lines.h"
+
+#include <cmath>
+
+namespace flashgs::viewer {
+namespace {
+
+glm::vec3 to_view(const Camera& c, const glm::vec3& p) {
+  const glm::vec3 d = p - glm::vec3(c.position[0], c.position[1], c.position[2]);
+  const float* r = c.rotation;
+  return glm::vec3(r[0] * d.x + r[1] * d.y + r[2] * d.z, r[3] * d.x + r[4] * d.y + r[5] * d.z,
+                   r[6] * d.x + r[7] * d.y + r[8] * d.z);
+}
+
+glm::vec2 to_pixels(const Camera& c, const glm::vec3& v) {
+  return glm::vec2(c.fx * v.x / v.z + c.cx, c.fy * v.y / v.z + c.cy);
+}
+
+// A world point from a camera's view-space point (the rotation's rows are its axes).
+glm::vec3 from_view(const Camera& c, const glm::vec3& v) {
+  const float* r = c.rotation;
+  return glm::vec3(c.position[0], c.position[1], c.position[2]) + glm::vec3(r[0], r[1], r[2]) * v.x +
+         glm::vec3(r[3], r[4], r[5]) * v.y + glm::vec3(r[6], r[7], r[8]) * v.z;
+}
+
+float round_spacing(float approx) {
+  const float decade = std::pow(10.0f, std::floor(std::log10(approx)));
+  for (float m : {1.0f, 2.0f, 5.0f})
+    if (m * decade >= approx) return m * decade;
+  return 10.0f * decade;
+}
+
+}  // namespace
+
+std::vector<WorldSegment> grid_and_axes(const glm::vec3& centre, float extent, const glm::vec3& up_in) {
+  std::vector<WorldSegment> out;
+  if (!(extent > 0.0f) || !std::isfinite(extent)) return out;
+  const glm::vec3 up = glm::normalize(up_in);
+  const glm::vec3 any = std::abs(up.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, 1);
+  const glm::vec3 u = glm::normalize(glm::cross(up, any)), w = glm::cross(up, u);
+  const float spacing = round_spacing(extent / 5.0f);
+  const int half = 10;
+  // Centred under the scene centre, snapped to the spacing so the lines stay put when it moves.
+  const glm::vec3 foot = centre - up * glm::dot(centre, up);
+  const glm::vec3 o = u * (std::round(glm::dot(foot, u) / spacing) * spacing) +
+                      w * (std::round(glm::dot(foot, w) / spacing) * spacing);
+  const std::array<float, 4> grey{0.7f, 0.7f, 0.7f, 0.45f};
+  for (int i = -half; i <= half; ++i) {
+    const float t = float(i) * spacing, l = float(half) * spacing;
+    out.push_back({o + u * t - w * l, o + u * t + w * l, grey});
+    out.push_back({o + w * t - u * l, o + w * t + u * l, grey});
+  }
+  out.push_back({glm::vec3(0), glm::vec3(extent, 0, 0), {1.0f, 0.25f, 0.25f, 1.0f}});
+  out.push_back({glm::vec3(0), glm::vec3(0, extent, 0), {0.3f, 1.0f, 0.3f, 1.0f}});
+  out.push_back({glm::vec3(0), glm::vec3(0, 0, extent), {0.35f, 0.55f, 1.0f, 1.0f}});
+  return out;
+}
+
+std::vector<WorldSegment> camera_frustums(const std::vector<Camera>& cameras, float depth, int highlighted) {
+  std::vector<WorldSegment> out;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const Camera& c = cameras[i];
+    if (c.fx <= 0.0f || c.fy <= 0.0f) continue;
+    const std::array<float, 4> colour = int(i) == highlighted ? std::array<float, 4>{0.3f, 1.0f, 0.4f, 1.0f}
+                                                              : std::array<float, 4>{1.0f, 0.6f, 0.15f, 0.9f};
+    const glm::vec3 eye(c.position[0], c.position[1], c.position[2]);
+    // The image corners at view depth `depth`: pixel (x, y) is at ((x - cx) / fx, (y - cy) / fy) * depth.
+    auto corner = [&](float x, float y) {
+      return from_view(c, glm::vec3((x - c.cx) / c.fx * depth, (y - c.cy) / c.fy * depth, depth));
+    };
+    const float w = float(c.width), h = float(c.height);
+    const glm::vec3 k[4] = {corner(0, 0), corner(w, 0), corner(w, h), corner(0, h)};
+    for (int j = 0; j < 4; ++j) {
+      out.push_back({eye, k[j], colour});
+      out.push_back({k[j], k[(j + 1) % 4], colour});
+    }
+    // A tick above the top edge: which way is up in the image.
+    out.push_back({corner(0.35f * w, 0), corner(0.5f * w, -0.15f * h), colour});
+    out.push_back({corner(0.5f * w, -0.15f * h), corner(0.65f * w, 0), colour});
+  }
+  return out;
+}
+
+std::vector<ScreenSegment> project_segments(const std::vector<WorldSegment>& segments, const Camera& view,
+                                            float near_depth) {
+  std::vector<ScreenSegment> out;
+  out.reserve(segments.size());
+  for (const WorldSegment& s : segments) {
+    glm::vec3 a = to_view(view, s.a), b = to_view(view, s.b);
+    if (a.z <= near_depth && b.z <= near_depth) continue;
+    // Cut at the near plane: the part behind the camera would project mirrored.
+    if (a.z < near_depth) a = a + (b - a) * ((near_depth - a.z) / (b.z - a.z));
+    if (b.z < near_depth) b = b + (a - b) * ((near_depth - b.z) / (a.z - b.z));
+    const glm::vec2 pa = to_pixels(view, a), pb = to_pixels(view, b);
+    if (!std::isfinite(pa.x + pa.y + pb.x + pb.y)) continue;
+    out.push_back({pa.x, pa.y, pb.x, pb.y, s.rgba});
+  }
+  return out;
+}
+
+int pick_camera(const std::vector<Camera>& cameras, const Camera& view, float x, float y, float radius) {
+  int best = -1;
+  float best_d = radius;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const glm::vec3 v = to_view(view, glm::vec3(cameras[i].position[0], cameras[i].position[1], cameras[i].position[2]));
+    if (v.z <= 0.0f) continue;
+    const glm::vec2 p = to_pixels(view, v);
+    const float d = std::hypot(p.x - x, p.y - y);
+    if (d <= best_d) {
+      best_d = d;
+      best = int(i);
+    }
+  }
+  return best;
+}
+
+}  // namespace flashgs::viewer
