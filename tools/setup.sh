@@ -7,7 +7,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 packages=(build-essential cmake ninja-build pkg-config
           libglm-dev libopenimageio-dev openimageio-tools libcli11-dev nlohmann-json3-dev libgtest-dev
           libglfw3-dev libimgui-dev libgl-dev libx11-dev libxtst-dev xvfb xauth libgl1-mesa-dri
-          libhwy-dev libwebp-dev zlib1g-dev)
+          libhwy-dev libwebp-dev zlib1g-dev libzstd-dev)
 missing=()
 for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then

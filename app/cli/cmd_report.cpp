@@ -125,7 +125,7 @@ void run(const ReportArgs& args) {
   check_output_folder("--output-dir", args.output_dir);
   const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
   const std::string scene_path = args.scene.resolved_scene();
-  auto scene = load_scene_verbose(scene_path);
+  auto scene = load_scene_verbose(scene_path, args.scene.lod);
   const std::string cameras_path = args.scene.resolved_cameras();
   const std::vector<Camera> all_cameras = load_cameras(cameras_path);
   std::vector<int> kept = args.camera_list;

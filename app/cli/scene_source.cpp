@@ -2,9 +2,13 @@
 #include "scene_source.h"
 
 #include <cstdio>
+#include <fstream>
 
+#include "flashgs/compressed_formats.h"
 #include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
+#include "flashgs/file_access.h"
+#include "flashgs/frame_memory.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
 #include "flashgs/scene_formats.h"
@@ -15,10 +19,12 @@ namespace flashgs::cli {
 
 void SceneArgs::add_to(CLI::App* command) {
   m_scene_option = command->add_option("scene", scene_path,
-                                       "scene file (INRIA or PlayCanvas compressed PLY, .splat), a folder holding "
-                                       "point_cloud.ply, or a 3DGS training output folder (default: the bundled "
-                                       "demo scene)");
+                                       "scene file (INRIA or PlayCanvas compressed PLY, .splat, SPZ, SOG meta.json or "
+                                       "lod-meta.json), a folder holding point_cloud.ply or a SOG set, or a 3DGS "
+                                       "training output folder (default: the bundled demo scene)");
   m_cameras_option = command->add_option("--cameras", cameras_path, "cameras.json (default: the scene's own)");
+  command->add_option("--lod", lod, "level of a SOG LOD set, 0 = finest (default: the finest that fits in memory)")
+      ->check(CLI::NonNegativeNumber);
 }
 
 SceneLocation SceneArgs::locate() const {
@@ -35,9 +41,39 @@ SceneLocation SceneArgs::locate() const {
   return location;
 }
 
-std::shared_ptr<const Scene> load_scene_verbose(const std::string& path) {
+namespace {
+
+// Whether the file starts like a SOG lod-meta.json (its first 64 KB are enough).
+bool is_sog_lod_set(const std::string& path) {
+  if (path_kind(path) != PathKind::regular_file) return false;
+  std::ifstream file(path, std::ios::binary);
+  std::string head(64 << 10, '\0');
+  file.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(file.gcount()));
+  return looks_like_sog_lod_meta(head);
+}
+
+Scene load_sog_lod_level(const std::string& path, int lod, LoadReport* report) {
+  const SogLodSet set = describe_sog_lod(path);
+  const AvailableMemory memory = available_host_memory();
+  const int level = lod >= 0 ? lod : choose_sog_lod_level(set, memory.bytes);
+  if (level >= static_cast<int>(set.levels.size()))
+    throw Error("--lod " + std::to_string(lod) + ": " + path + " has levels 0.." + std::to_string(set.levels.size() - 1));
+  const SogLodLevel& chosen = set.levels[static_cast<std::size_t>(level)];
+  std::fprintf(stderr, "%s: LOD level %d of 0..%zu, %zu Gaussians (%s)\n", path.c_str(), level, set.levels.size() - 1,
+               chosen.gaussians,
+               lod >= 0 ? "--lod"
+                        : ("the finest needing at most half of the " + format_bytes(memory.bytes) + " available").c_str());
+  return read_sog_lod(path, level, report);
+}
+
+}  // namespace
+
+std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod) {
   LoadReport report;
-  auto scene = std::make_shared<Scene>(load_scene_file(path, &report));
+  const bool lod_set = is_sog_lod_set(path);
+  if (lod >= 0 && !lod_set) throw Error("--lod: " + path + " is not a SOG LOD set (lod-meta.json)");
+  auto scene = std::make_shared<Scene>(lod_set ? load_sog_lod_level(path, lod, &report) : load_scene_file(path, &report));
   if (report.dropped_non_finite)
     std::fprintf(stderr, "%s: dropped %zu Gaussians with NaN/Inf attributes (or exp(scale) overflow)\n",
                  path.c_str(), report.dropped_non_finite);

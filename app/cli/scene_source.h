@@ -18,6 +18,7 @@ namespace flashgs::cli {
 struct SceneArgs {
   std::string scene_path;    // a PLY or a scene folder; not given: the demo scene
   std::string cameras_path;  // not given: the scene's own cameras.json
+  int lod = -1;              // level of a SOG LOD set; -1: the finest that fits in memory
   void add_to(CLI::App* command);
   // The PLY and cameras.json to use (see locate_scene); throws flashgs::Error for a path given
   // empty, or one that names no usable scene.
@@ -30,8 +31,9 @@ struct SceneArgs {
   CLI::Option* m_cameras_option = nullptr;
 };
 
-// Loads the scene, printing what the loader dropped to stderr.
-std::shared_ptr<const Scene> load_scene_verbose(const std::string& path);
+// Loads the scene, printing what the loader dropped to stderr. A SOG LOD set loads level `lod`
+// (-1: the finest that fits in memory) and says which; `lod` >= 0 for any other scene is an error.
+std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod = -1);
 
 struct RenderArgs {
   std::string algorithm = "flash";

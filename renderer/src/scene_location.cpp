@@ -1,5 +1,5 @@
-// Finding the PLY and cameras.json of a scene named as a file, a scene folder or a 3DGS
-// training output folder.
+// Finding the scene file and cameras.json of a scene named as a file, a scene folder, a SOG
+// folder or a 3DGS training output folder.
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -61,11 +61,14 @@ SceneLocation locate_scene(const std::string& path) {
   if (path.empty()) throw Error("the scene path is empty: name a PLY file or a folder holding point_cloud.ply");
   fs::path ply = path;
   if (path_kind(path) == PathKind::folder) {
+    // A scene folder, a SOG LOD set, one SOG chunk, or a training output, in that order.
     ply = fs::path(path) / "point_cloud.ply";
+    for (const char* sog_file : {"lod-meta.json", "meta.json"})
+      if (!something_at(ply)) ply = fs::path(path) / sog_file;
     if (!something_at(ply)) ply = latest_training_iteration(path);
     if (ply.empty())
       throw Error(path + ": a folder without point_cloud.ply (nor point_cloud/iteration_<N>/point_cloud.ply, "
-                         "as a 3DGS training writes)");
+                         "as a 3DGS training writes, nor a SOG lod-meta.json or meta.json)");
   }
   check_regular_file(ply.string());
   return {ply.string(), default_cameras_path(ply.string())};

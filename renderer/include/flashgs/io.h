@@ -15,7 +15,8 @@ struct SceneLocation {
   std::string ply;
   std::string cameras;  // may not exist
 };
-// `path` is a PLY file, a folder holding point_cloud.ply, or a 3DGS training output folder
+// `path` is a scene file, a folder holding point_cloud.ply, a SOG folder (lod-meta.json of a
+// LOD set, or meta.json of one chunk), or a 3DGS training output folder
 // (point_cloud/iteration_<N>/point_cloud.ply, the highest N). Throws flashgs::Error with one
 // line naming the path and the problem for an empty path, a missing path, a folder holding
 // no scene, or a FIFO, device or link loop where the PLY should be; no file is opened.

@@ -1,0 +1,37 @@
+// SOG v2's meta.json, parsed and checked: counts, ranges, codebooks and texture names.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace flashgs {
+
+// Real meta.json files are a few tens of KB (three 256-entry codebooks).
+constexpr std::size_t kMaxSogJsonBytes = 16 << 20;
+// A texture of 16384 x 16384 lossless pixels compresses to well under this.
+constexpr std::size_t kMaxSogTextureBytes = std::size_t{1} << 30;
+// The most Gaussians one chunk may declare (a 16384 x 16384 texture).
+constexpr std::size_t kMaxSogCount = std::size_t{1} << 28;
+
+struct SogMeta {
+  std::size_t count = 0;
+  std::array<double, 3> means_min{}, means_max{};
+  std::array<std::string, 2> means_files;  // lower bytes, upper bytes
+  std::string scales_file, quats_file, sh0_file;
+  std::vector<float> scales_codebook, sh0_codebook;  // 256 entries each
+  int sh_bands = 0;  // 0 when there is no shN
+  std::size_t sh_palette_size = 0;
+  std::vector<float> sh_codebook;
+  std::array<std::string, 2> sh_files;  // centroids, labels
+};
+
+// Throws flashgs::Error "<name>: ..." for invalid JSON, another version, a missing or
+// mistyped field, a count out of range, a codebook that is not 256 finite floats, or a texture
+// name that is not a plain file name.
+SogMeta parse_sog_meta(const std::string& json_text, const std::string& name);
+// The texture files meta.json names, in decoding order.
+std::vector<std::string> sog_meta_files(const SogMeta& meta);
+
+}  // namespace flashgs

@@ -1,0 +1,110 @@
+// Randomised mutation fuzzing of the SPZ and SOG readers under AddressSanitizer and UBSan:
+// every mutated file must load to finite values or throw flashgs::Error, never crash, read out
+// of bounds or take memory its data cannot justify.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "compressed_builders.h"
+#include "flashgs/compressed_formats.h"
+#include "flashgs/error.h"
+
+namespace flashgs {
+namespace {
+
+bool all_finite(const Scene& scene) {
+  for (const std::vector<float>* values :
+       {&scene.positions, &scene.scales, &scene.rotations, &scene.opacities, &scene.sh_dc, &scene.sh_rest})
+    for (float v : *values)
+      if (!std::isfinite(v)) return false;
+  return true;
+}
+
+// Loads or is refused; counts which, and fails the test on a non-finite value.
+template <typename Parse>
+void expect_clean(Parse parse, int& loaded, int& rejected) {
+  try {
+    const Scene scene = parse();
+    EXPECT_TRUE(all_finite(scene)) << "a loaded file holds a non-finite value";
+    EXPECT_EQ(scene.positions.size(), scene.size() * 3);
+    EXPECT_EQ(scene.sh_rest.size(), scene.size() * static_cast<std::size_t>(scene.sh_rest_per_gaussian()));
+    ++loaded;
+  } catch (const Error&) {
+    ++rejected;
+  }
+}
+
+// Byte flips, truncations, deletions and insertions; half of them in the first `hot` bytes,
+// where the headers are.
+std::string mutate(std::string s, std::mt19937& rng, std::size_t hot) {
+  const int edits = 1 + static_cast<int>(rng() % 4);
+  for (int e = 0; e < edits && !s.empty(); ++e) {
+    const std::size_t span = rng() % 2 ? std::min(hot, s.size()) : s.size();
+    const std::size_t at = rng() % span;
+    switch (rng() % 5) {
+      case 0: s[at] = static_cast<char>(rng()); break;
+      case 1: s.resize(at); break;
+      case 2: s.erase(at, 1 + rng() % 16); break;
+      case 3: s.insert(at, 1 + rng() % 8, static_cast<char>(rng())); break;
+      default: s[at] = static_cast<char>(s[at] ^ (1 << (rng() % 8)));
+    }
+  }
+  return s;
+}
+
+TEST(SpzFuzz, MutatedFilesLoadOrFailCleanly) {
+  std::mt19937 rng(20241201);
+  int loaded = 0, rejected = 0;
+  for (int round = 0; round < 1500; ++round) {
+    const std::uint32_t version = 1 + rng() % 4;
+    const test::SpzContent content = test::random_spz(1 + rng() % 12, static_cast<int>(rng() % 4), version, rng);
+    std::string file;
+    if (version == 4) {
+      file = mutate(test::spz_v4_file(content), rng, 32 + 6 * 16);
+    } else if (rng() % 2) {  // a valid gzip stream around a mutated payload: the header and counts lie
+      file = test::gzip(mutate(test::spz_payload(content), rng, 16));
+    } else {  // the compressed bytes themselves
+      file = mutate(test::spz_gzip_file(content), rng, 24);
+    }
+    std::vector<char> copy(file.begin(), file.end());  // exact size, so ASan sees any overread
+    expect_clean([&] { return parse_spz(copy.data(), copy.size(), "fuzz.spz"); }, loaded, rejected);
+  }
+  std::printf("SPZ fuzz: %d loaded, %d refused\n", loaded, rejected);
+  EXPECT_GT(loaded, 0);
+  EXPECT_GT(rejected, 0);
+}
+
+TEST(SogFuzz, MutatedChunksLoadOrFailCleanly) {
+  std::mt19937 rng(20241202);
+  int loaded = 0, rejected = 0;
+  std::vector<test::SogChunk> seeds;
+  for (int bands = 0; bands <= 3; ++bands) seeds.push_back(test::random_sog_chunk(20 + 7 * bands, bands, rng));
+  for (int round = 0; round < 400; ++round) {
+    test::SogChunk chunk = seeds[rng() % seeds.size()];
+    std::string meta = chunk.meta.dump();
+    switch (rng() % 3) {
+      case 0: meta = mutate(meta, rng, 200); break;  // the JSON text
+      case 1: {                                     // one texture's bytes
+        auto it = chunk.files.begin();
+        std::advance(it, rng() % chunk.files.size());
+        const std::string bytes = mutate(std::string(it->second.begin(), it->second.end()), rng, 40);
+        it->second.assign(bytes.begin(), bytes.end());
+        break;
+      }
+      default: {  // one texture in another's place
+        auto a = chunk.files.begin(), b = chunk.files.begin();
+        std::advance(a, rng() % chunk.files.size());
+        std::advance(b, rng() % chunk.files.size());
+        a->second = b->second;
+      }
+    }
+    expect_clean([&] { return parse_sog(meta, chunk.source(), "fuzz/meta.json"); }, loaded, rejected);
+  }
+  std::printf("SOG fuzz: %d loaded, %d refused\n", loaded, rejected);
+  EXPECT_GT(loaded, 0);
+  EXPECT_GT(rejected, 0);
+}
+
+}  // namespace
+}  // namespace flashgs
