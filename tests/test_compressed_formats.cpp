@@ -172,6 +172,16 @@ TEST(Spz, DecodesHandCheckedValuesInPlyAxes) {
   }
 }
 
+TEST(Spz, IsRecognisedByItsMagicInsideTheGzipStream) {
+  std::mt19937 rng(2);
+  const test::SpzContent c = test::random_spz(3, 0, 3, rng);
+  const std::string spz = test::spz_gzip_file(c), v4 = test::spz_v4_file(c), other_gzip = test::gzip("hello, world");
+  EXPECT_TRUE(looks_like_spz(spz.data(), spz.size()));
+  EXPECT_TRUE(looks_like_spz(v4.data(), v4.size()));
+  EXPECT_FALSE(looks_like_spz(other_gzip.data(), other_gzip.size()));
+  EXPECT_FALSE(looks_like_spz("ply\n", 4));
+}
+
 TEST(Spz, EveryVersionReadsRandomContent) {
   std::mt19937 rng(7);
   for (std::uint32_t version = 1; version <= 4; ++version)

@@ -56,7 +56,7 @@ std::string mutate(std::string s, std::mt19937& rng, std::size_t hot) {
 TEST(SpzFuzz, MutatedFilesLoadOrFailCleanly) {
   std::mt19937 rng(20241201);
   int loaded = 0, rejected = 0;
-  for (int round = 0; round < 1500; ++round) {
+  for (int round = 0; round < 4000; ++round) {
     const std::uint32_t version = 1 + rng() % 4;
     const test::SpzContent content = test::random_spz(1 + rng() % 12, static_cast<int>(rng() % 4), version, rng);
     std::string file;
@@ -80,7 +80,7 @@ TEST(SogFuzz, MutatedChunksLoadOrFailCleanly) {
   int loaded = 0, rejected = 0;
   std::vector<test::SogChunk> seeds;
   for (int bands = 0; bands <= 3; ++bands) seeds.push_back(test::random_sog_chunk(20 + 7 * bands, bands, rng));
-  for (int round = 0; round < 400; ++round) {
+  for (int round = 0; round < 1000; ++round) {
     test::SogChunk chunk = seeds[rng() % seeds.size()];
     std::string meta = chunk.meta.dump();
     switch (rng() % 3) {

@@ -13,9 +13,11 @@ void register_info(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("info", "summarise a scene: count, SH degree, bounds, statistics");
   args->add_to(sub);
   sub->callback([args] {
+    const std::string path = args->resolved_scene();
     LoadReport report;
-    const Scene scene = load_scene_file(args->resolved_scene(), &report);
+    const Scene scene = load_scene_at_level(path, args->lod, &report);
     std::printf("%s", summarize_scene(scene, &report).c_str());
+    std::printf("%s", describe_lod_levels(path).c_str());
   });
 }
 

@@ -69,11 +69,32 @@ Scene load_sog_lod_level(const std::string& path, int lod, LoadReport* report) {
 
 }  // namespace
 
-std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod) {
-  LoadReport report;
+Scene load_scene_at_level(const std::string& path, int lod, LoadReport* report) {
   const bool lod_set = is_sog_lod_set(path);
   if (lod >= 0 && !lod_set) throw Error("--lod: " + path + " is not a SOG LOD set (lod-meta.json)");
-  auto scene = std::make_shared<Scene>(lod_set ? load_sog_lod_level(path, lod, &report) : load_scene_file(path, &report));
+  return lod_set ? load_sog_lod_level(path, lod, report) : load_scene_file(path, report);
+}
+
+std::string describe_lod_levels(const std::string& path) {
+  if (!is_sog_lod_set(path)) return "";
+  const SogLodSet set = describe_sog_lod(path);
+  std::string text = "SOG LOD set: " + std::to_string(set.levels.size()) + " levels (--lod N), bounds [" +
+                     std::to_string(set.bounds_min[0]) + ", " + std::to_string(set.bounds_min[1]) + ", " +
+                     std::to_string(set.bounds_min[2]) + "] .. [" + std::to_string(set.bounds_max[0]) + ", " +
+                     std::to_string(set.bounds_max[1]) + ", " + std::to_string(set.bounds_max[2]) + "]\n";
+  for (const SogLodLevel& level : set.levels) {
+    char line[160];
+    std::snprintf(line, sizeof line, "  level %d: %zu Gaussians, SH degree %d, %s to decode, %zu chunk file%s\n",
+                  level.level, level.gaussians, level.sh_degree, format_bytes(sog_lod_level_bytes(level)).c_str(),
+                  level.files.size(), level.files.size() == 1 ? "" : "s");
+    text += line;
+  }
+  return text;
+}
+
+std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod) {
+  LoadReport report;
+  auto scene = std::make_shared<Scene>(load_scene_at_level(path, lod, &report));
   if (report.dropped_non_finite)
     std::fprintf(stderr, "%s: dropped %zu Gaussians with NaN/Inf attributes (or exp(scale) overflow)\n",
                  path.c_str(), report.dropped_non_finite);

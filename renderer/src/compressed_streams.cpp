@@ -99,6 +99,21 @@ void GzipReader::expect_end(const std::string& expected_total) {
     fail(s.name, std::to_string(s.stream.avail_in) + " bytes follow the gzip stream (a second stream or junk)");
 }
 
+std::vector<std::uint8_t> gzip_peek(const unsigned char* data, std::size_t size, std::size_t n) {
+  std::vector<std::uint8_t> out(n);
+  z_stream stream{};
+  if (inflateInit2(&stream, 16 + MAX_WBITS) != Z_OK) return {};
+  stream.next_in = const_cast<Bytef*>(data);
+  stream.avail_in = static_cast<uInt>(std::min<std::size_t>(size, UINT_MAX));
+  stream.next_out = out.data();
+  stream.avail_out = static_cast<uInt>(n);
+  while (stream.avail_out > 0 && inflate(&stream, Z_NO_FLUSH) == Z_OK) {
+  }
+  out.resize(n - stream.avail_out);
+  inflateEnd(&stream);
+  return out;
+}
+
 bool have_gzip_support() { return true; }
 
 #else
@@ -110,6 +125,7 @@ GzipReader::GzipReader(const unsigned char*, std::size_t, const std::string& nam
 GzipReader::~GzipReader() = default;
 void GzipReader::read(std::size_t, std::vector<std::uint8_t>&, const std::string&) {}
 void GzipReader::expect_end(const std::string&) {}
+std::vector<std::uint8_t> gzip_peek(const unsigned char*, std::size_t, std::size_t) { return {}; }
 bool have_gzip_support() { return false; }
 
 #endif

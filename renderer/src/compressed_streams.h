@@ -32,6 +32,10 @@ class GzipReader {
   std::unique_ptr<State> m_state;
 };
 
+// Up to the first `n` bytes a gzip stream inflates to (fewer when it is corrupt or shorter);
+// empty without zlib. For recognising a file by what its stream starts with.
+std::vector<std::uint8_t> gzip_peek(const unsigned char* data, std::size_t size, std::size_t n);
+
 // Decompresses one zstd frame to exactly `expected` bytes; throws flashgs::Error naming
 // `name` and `what` when it is corrupt, shorter, or would grow past `expected`.
 std::vector<std::uint8_t> zstd_decompress_exact(const unsigned char* data, std::size_t size, std::size_t expected,

@@ -10,10 +10,12 @@
 #include <string_view>
 #include <vector>
 
+#include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
 #include "flashgs/io.h"
 #include "format_readers.h"
+#include "sog_meta.h"
 
 namespace flashgs {
 namespace {
@@ -74,10 +76,30 @@ Scene parse_inria_ply(const char* data, std::size_t size, const std::string& nam
   return parse_ply(data, size, name, &report, progress);
 }
 
+bool is_spz(const FileStart& f) { return looks_like_spz(f.bytes.data(), f.bytes.size()); }
+
+Scene parse_spz_file(const char* data, std::size_t size, const std::string& name, LoadReport& report,
+                     LoadProgress* progress) {
+  return parse_spz(data, size, name, &report, progress);
+}
+
+// A SOG meta.json (one chunk) or lod-meta.json (a LOD set), by their keys.
+bool is_sog(const FileStart& f) {
+  const std::string text(f.bytes);
+  return looks_like_sog_meta(text) || looks_like_sog_lod_meta(text);
+}
+
+Scene read_sog_file(const std::string& path, LoadReport& report, LoadProgress* progress) {
+  const std::vector<char> text = read_regular_file(path, kMaxSogJsonBytes);
+  return parse_sog_file(text.data(), text.size(), path, &report, progress);
+}
+
 // In order: formats with a magic number or header first, extension-only formats last.
 const FormatReader kReaders[] = {
     {SceneFormat::compressed_ply, is_compressed_ply, parse_compressed_ply},
     {SceneFormat::inria_ply, is_ply, parse_inria_ply},
+    {SceneFormat::spz, is_spz, parse_spz_file},
+    {SceneFormat::sog, is_sog, nullptr, read_sog_file},
     {SceneFormat::splat, is_splat, parse_splat},
 };
 

@@ -13,6 +13,7 @@
 #include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
+#include "flashgs/frame_memory.h"
 #include "sog_meta.h"
 
 #ifdef FLASHGS_HAVE_WEBP
@@ -123,6 +124,14 @@ Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const 
   const std::size_t n = meta.count;
   report->vertices_in_file = n;
   report->sh_degree_in_file = meta.sh_bands;
+  // The scene and the decoded textures, refused before any is allocated when they cannot fit
+  // (a tiny lossless WebP may claim 16384 x 16384 pixels).
+  const std::uint64_t need = n * (sizeof(float) * (14 + 3 * std::uint64_t(sh_coefficient_count(meta.sh_bands) - 1)) +
+                                  4 * sog_meta_files(meta).size());
+  const AvailableMemory available = available_host_memory();
+  if (available.bytes > 0 && need > available.bytes)
+    fail(name, "meta.json declares " + std::to_string(n) + " Gaussians, " + format_bytes(need) +
+                   " to decode, but only " + format_bytes(available.bytes) + " of memory is available");
 
   const Texture means_l = load_texture(files, meta.means_files[0], name, n, nullptr, progress);
   const Texture means_u = load_texture(files, meta.means_files[1], name, n, nullptr, progress);

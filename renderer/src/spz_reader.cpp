@@ -263,7 +263,13 @@ Scene unpack(const Packed& packed, const Header& header, const std::string& name
 
 bool looks_like_spz(const char* data, std::size_t size) {
   const auto* bytes = reinterpret_cast<const unsigned char*>(data);
-  if (size >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b) return true;
+  if (size >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b) {
+    // Any gzip file starts so: the SPZ magic must open the stream as well. Without zlib a
+    // gzip file is taken for SPZ, whose reader then says zlib is missing.
+    if (!have_gzip_support()) return true;
+    const std::vector<std::uint8_t> start = gzip_peek(bytes, size, 4);
+    return start.size() == 4 && read_u32(start.data()) == kSpzMagic;
+  }
   return size >= 8 && read_u32(bytes) == kSpzMagic;
 }
 

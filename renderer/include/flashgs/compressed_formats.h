@@ -16,8 +16,8 @@ namespace flashgs {
 
 // ---- SPZ ----
 
-// Whether `data` starts like an SPZ file: a gzip stream (versions 1-3; the SPZ magic is inside
-// it, so only the gzip magic can be seen here) or the bare "NGSP" magic of version 4.
+// Whether `data` is an SPZ file: a gzip stream that inflates to the "NGSP" magic (versions
+// 1-3), or that magic bare (version 4).
 bool looks_like_spz(const char* data, std::size_t size);
 // Reads an SPZ file (versions 1-4: gzip, or zstd streams with a table of contents). Every
 // count is checked against what the file can hold before memory is taken. Throws
