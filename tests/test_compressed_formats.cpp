@@ -400,6 +400,29 @@ TEST(Sog, ReadsRandomChunksOfEveryBandCount) {
   }
 }
 
+// A chunk on disk: progress counts its texture bytes and Gaussians, and a cancel request stops it.
+TEST(Sog, ReportsProgressAndStopsWhenCancelled) {
+  std::mt19937 rng(17);
+  const test::SogChunk chunk = test::random_sog_chunk(70000, 1, rng);
+  const fs::path folder = fs::path(FLASHGS_TEST_OUTPUT_DIR) / "sog_progress";
+  fs::create_directories(folder);
+  std::ofstream(folder / "meta.json") << chunk.meta.dump();
+  std::uint64_t texture_bytes = 0;
+  for (const auto& [name, bytes] : chunk.files) {
+    std::ofstream(folder / name, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    texture_bytes += bytes.size();
+  }
+  LoadProgress progress;
+  EXPECT_EQ(read_sog(folder.string(), nullptr, &progress).size(), 70000u);
+  EXPECT_EQ(progress.bytes_total.load(), texture_bytes);
+  EXPECT_EQ(progress.bytes_done.load(), texture_bytes);
+  EXPECT_EQ(progress.gaussians_total.load(), 70000u);
+  EXPECT_EQ(progress.gaussians_done.load(), 70000u);
+  LoadProgress cancelled;
+  cancelled.cancel_requested = true;
+  EXPECT_THROW(read_sog(folder.string(), nullptr, &cancelled), LoadCancelled);
+}
+
 // ---------------------------------------------------------------- SOG hostile input
 
 TEST(Sog, HostileChunksGetOneClearMessage) {

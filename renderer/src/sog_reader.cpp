@@ -219,16 +219,17 @@ Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const 
   return scene;
 }
 
-Scene read_sog(const std::string& path, LoadReport* report, LoadProgress* progress) {
-  const fs::path meta_path = path_kind(path) == PathKind::folder ? fs::path(path) / "meta.json" : fs::path(path);
-  const std::string meta_name = meta_path.string();
-  const std::vector<char> text = read_regular_file(meta_name, kMaxSogJsonBytes);
-  const fs::path folder = meta_path.parent_path();
+namespace {
+
+// A chunk whose meta.json text was read from `meta_name`: its textures lie beside it.
+Scene read_sog_chunk(const std::string& text, const std::string& meta_name, LoadReport* report,
+                     LoadProgress* progress) {
+  const fs::path folder = fs::path(meta_name).parent_path();
   if (progress) {
     // The textures' sizes on disk, for a progress bar in bytes (missing files are reported later).
     std::uint64_t total = 0;
     std::error_code error;
-    for (const std::string& file : sog_meta_files(parse_sog_meta(std::string(text.begin(), text.end()), meta_name))) {
+    for (const std::string& file : sog_meta_files(parse_sog_meta(text, meta_name))) {
       const auto bytes = fs::file_size(folder / file, error);
       if (!error) total += bytes;
     }
@@ -237,7 +238,26 @@ Scene read_sog(const std::string& path, LoadReport* report, LoadProgress* progre
   const SogFileSource files = [&folder](const std::string& file) {
     return read_regular_file((folder / file).string(), kMaxSogTextureBytes);
   };
-  return parse_sog(std::string(text.begin(), text.end()), files, meta_name, report, progress);
+  return parse_sog(text, files, meta_name, report, progress);
+}
+
+}  // namespace
+
+Scene read_sog(const std::string& path, LoadReport* report, LoadProgress* progress) {
+  const fs::path meta_path = path_kind(path) == PathKind::folder ? fs::path(path) / "meta.json" : fs::path(path);
+  const std::vector<char> text = read_regular_file(meta_path.string(), kMaxSogJsonBytes);
+  return read_sog_chunk(std::string(text.begin(), text.end()), meta_path.string(), report, progress);
+}
+
+Scene parse_sog_file(const char* data, std::size_t size, const std::string& path, LoadReport* report,
+                     LoadProgress* progress) {
+  if (size > kMaxSogJsonBytes)
+    throw Error(path + ": " + std::to_string(size) + " bytes is more than a SOG JSON file may have");
+  const std::string text(data, size);
+  if (looks_like_sog_lod_meta(text))
+    return read_sog_lod(path, choose_sog_lod_level(describe_sog_lod(path), available_host_memory().bytes), report,
+                        progress);
+  return read_sog_chunk(text, path, report, progress);
 }
 
 }  // namespace flashgs

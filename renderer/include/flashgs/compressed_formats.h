@@ -41,6 +41,11 @@ using SogFileSource = std::function<std::vector<char>(const std::string& file_na
 Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const std::string& name,
                 LoadReport* report = nullptr, LoadProgress* progress = nullptr);
 
+// A SOG meta.json or lod-meta.json whose bytes the caller read from `path` (the textures and
+// chunks are found beside it); a LOD set loads the finest level that fits in memory.
+Scene parse_sog_file(const char* data, std::size_t size, const std::string& path, LoadReport* report = nullptr,
+                     LoadProgress* progress = nullptr);
+
 // ---- SOG LOD set (lod-meta.json: a tree of bounds whose leaves name chunk ranges per level) ----
 
 struct SogLodLevel {
