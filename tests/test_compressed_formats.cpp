@@ -489,7 +489,10 @@ TEST(SogLod, HostileLodMetaGetsOneClearMessage) {
                               {{"lods", {{"0", {{"file", 0}, {"offset", 20}, {"count", 30}}}}}}}}}}};
   const std::string path = (folder / "lod-meta.json").string();
   std::ofstream(path) << good.dump();
-  EXPECT_EQ(read_sog_lod(path, 0).size(), 50u);
+  LoadProgress progress;
+  EXPECT_EQ(read_sog_lod(path, 0, nullptr, &progress).size(), 50u);
+  EXPECT_GT(progress.bytes_total.load(), 0u);
+  EXPECT_EQ(progress.bytes_done.load(), progress.bytes_total.load());
   EXPECT_EQ(describe_sog_lod(folder.string()).levels.at(0).gaussians, 50u);
   struct Case {
     const char* what;

@@ -171,6 +171,12 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
   const LodMeta meta = read_lod_meta(meta_path);
   check_level(meta, level, name);
   const std::vector<Range>& ranges = meta.levels[level];
+  if (progress) {
+    std::uint64_t total = 0;
+    for (int file : level_files(ranges)) total += sog_chunk_texture_bytes((meta.folder / meta.files[file]).string());
+    progress->bytes_done.store(0, std::memory_order_relaxed);
+    progress->bytes_total.store(total, std::memory_order_relaxed);
+  }
   Scene scene;
   LoadReport total;
   total.path = name;
@@ -178,7 +184,7 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
   for (int file : level_files(ranges)) {
     const std::string chunk_name = (meta.folder / meta.files[file]).string();
     LoadReport chunk_report;
-    const Scene chunk = read_sog(chunk_name, &chunk_report, progress);
+    const Scene chunk = read_sog_chunk(chunk_name, &chunk_report, progress);
     if (chunk_report.dropped_non_finite)
       fail(chunk_name, "Gaussians with non-finite values: the level's ranges would no longer line up");
     if (!first && chunk.sh_degree != scene.sh_degree)

@@ -1,10 +1,15 @@
-// SOG v2's meta.json, parsed and checked: counts, ranges, codebooks and texture names.
+// SOG v2's meta.json, parsed and checked (counts, ranges, codebooks and texture names), and
+// the chunk reading the LOD set builds on.
 #pragma once
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
+
+#include "flashgs/load_progress.h"
+#include "flashgs/scene.h"
 
 namespace flashgs {
 
@@ -33,5 +38,11 @@ struct SogMeta {
 SogMeta parse_sog_meta(const std::string& json_text, const std::string& name);
 // The texture files meta.json names, in decoding order.
 std::vector<std::string> sog_meta_files(const SogMeta& meta);
+
+// Bytes on disk of the textures the chunk at `meta_path` names, for progress totals.
+std::uint64_t sog_chunk_texture_bytes(const std::string& meta_path);
+// Reads the chunk at `meta_path`, adding its texture bytes to progress's bytes_done but
+// leaving the totals to the caller (a LOD level sums its chunks).
+Scene read_sog_chunk(const std::string& meta_path, LoadReport* report, LoadProgress* progress);
 
 }  // namespace flashgs

@@ -221,32 +221,55 @@ Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const 
 
 namespace {
 
-// A chunk whose meta.json text was read from `meta_name`: its textures lie beside it.
-Scene read_sog_chunk(const std::string& text, const std::string& meta_name, LoadReport* report,
-                     LoadProgress* progress) {
-  const fs::path folder = fs::path(meta_name).parent_path();
-  if (progress) {
-    // The textures' sizes on disk, for a progress bar in bytes (missing files are reported later).
-    std::uint64_t total = 0;
-    std::error_code error;
-    for (const std::string& file : sog_meta_files(parse_sog_meta(text, meta_name))) {
-      const auto bytes = fs::file_size(folder / file, error);
-      if (!error) total += bytes;
-    }
-    progress->bytes_total.fetch_add(total, std::memory_order_relaxed);  // a LOD level adds its chunks
+// Progress in bytes counts the textures; their sizes on disk (missing files count 0 here and
+// are reported when read).
+std::uint64_t texture_bytes(const SogMeta& meta, const fs::path& folder) {
+  std::uint64_t total = 0;
+  std::error_code error;
+  for (const std::string& file : sog_meta_files(meta)) {
+    const auto bytes = fs::file_size(folder / file, error);
+    if (!error) total += bytes;
   }
+  return total;
+}
+
+// A chunk whose meta.json text was read from `meta_name`: its textures lie beside it.
+Scene read_chunk_text(const std::string& text, const std::string& meta_name, LoadReport* report,
+                      LoadProgress* progress) {
+  const fs::path folder = fs::path(meta_name).parent_path();
   const SogFileSource files = [&folder](const std::string& file) {
     return read_regular_file((folder / file).string(), kMaxSogTextureBytes);
   };
   return parse_sog(text, files, meta_name, report, progress);
 }
 
+std::string read_meta_text(const std::string& meta_path) {
+  const std::vector<char> text = read_regular_file(meta_path, kMaxSogJsonBytes);
+  return std::string(text.begin(), text.end());
+}
+
+void start_progress(LoadProgress* progress, std::uint64_t total_bytes) {
+  if (!progress) return;
+  progress->bytes_done.store(0, std::memory_order_relaxed);
+  progress->bytes_total.store(total_bytes, std::memory_order_relaxed);
+}
+
 }  // namespace
 
+std::uint64_t sog_chunk_texture_bytes(const std::string& meta_path) {
+  return texture_bytes(parse_sog_meta(read_meta_text(meta_path), meta_path), fs::path(meta_path).parent_path());
+}
+
+Scene read_sog_chunk(const std::string& meta_path, LoadReport* report, LoadProgress* progress) {
+  return read_chunk_text(read_meta_text(meta_path), meta_path, report, progress);
+}
+
 Scene read_sog(const std::string& path, LoadReport* report, LoadProgress* progress) {
-  const fs::path meta_path = path_kind(path) == PathKind::folder ? fs::path(path) / "meta.json" : fs::path(path);
-  const std::vector<char> text = read_regular_file(meta_path.string(), kMaxSogJsonBytes);
-  return read_sog_chunk(std::string(text.begin(), text.end()), meta_path.string(), report, progress);
+  const std::string meta_path =
+      path_kind(path) == PathKind::folder ? (fs::path(path) / "meta.json").string() : path;
+  const std::string text = read_meta_text(meta_path);
+  if (progress) start_progress(progress, texture_bytes(parse_sog_meta(text, meta_path), fs::path(meta_path).parent_path()));
+  return read_chunk_text(text, meta_path, report, progress);
 }
 
 Scene parse_sog_file(const char* data, std::size_t size, const std::string& path, LoadReport* report,
@@ -257,7 +280,8 @@ Scene parse_sog_file(const char* data, std::size_t size, const std::string& path
   if (looks_like_sog_lod_meta(text))
     return read_sog_lod(path, choose_sog_lod_level(describe_sog_lod(path), available_host_memory().bytes), report,
                         progress);
-  return read_sog_chunk(text, path, report, progress);
+  if (progress) start_progress(progress, texture_bytes(parse_sog_meta(text, path), fs::path(path).parent_path()));
+  return read_chunk_text(text, path, report, progress);
 }
 
 }  // namespace flashgs

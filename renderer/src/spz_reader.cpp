@@ -279,7 +279,10 @@ Scene parse_spz(const char* data, std::size_t size, const std::string& name, Loa
   if (!report) report = &local_report;
   *report = LoadReport{};
   report->path = name;
-  if (progress) progress->bytes_total.store(size, std::memory_order_relaxed);
+  if (progress) {  // the compressed bytes as they are decompressed
+    progress->bytes_done.store(0, std::memory_order_relaxed);
+    progress->bytes_total.store(size, std::memory_order_relaxed);
+  }
   const auto* bytes = reinterpret_cast<const unsigned char*>(data);
   if (size == 0) fail(name, "not an SPZ file (it is empty)");
   Header header;
