@@ -227,7 +227,7 @@ TEST(FileKindsCli, TheSceneArgumentRefusesWhatIsNotAScene) {
   const OddPaths odd(fresh_dir("cli_scene"));
   const std::vector<std::tuple<fs::path, std::string>> cases = {
       {odd.folder, "a folder without point_cloud.ply (nor point_cloud/iteration_<N>/point_cloud.ply, as a 3DGS "
-                   "training writes)"},
+                   "training writes, nor a SOG lod-meta.json or meta.json)"},
       {odd.fifo, "is a FIFO (named pipe), not a regular file"},
       {odd.device, "is a device, not a regular file"},
       {odd.loop, "cannot open: a loop of symbolic links"},
