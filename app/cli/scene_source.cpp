@@ -1,6 +1,7 @@
 // Scene, camera, option and backend selection shared by the CLI subcommands.
 #include "scene_source.h"
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 
@@ -64,7 +65,12 @@ Scene load_sog_lod_level(const std::string& path, int lod, LoadReport* report) {
                chosen.gaussians,
                lod >= 0 ? "--lod"
                         : ("the finest needing at most half of the " + format_bytes(memory.bytes) + " available").c_str());
-  return read_sog_lod(path, level, report);
+  const auto began = std::chrono::steady_clock::now();
+  Scene scene = read_sog_lod(path, level, report);
+  report->decode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  report->format = std::string(format_name(SceneFormat::sog)) + ", LOD level " + std::to_string(level);
+  report->quantisation = format_quantisation(SceneFormat::sog);
+  return scene;
 }
 
 }  // namespace
