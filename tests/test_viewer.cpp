@@ -99,12 +99,19 @@ const char* const kInputHelper = "";
 //                        sets `closed` (its exit status in `exit_status`)
 // A failing step sets `status`. The script then exits with `crash_status` if the viewer is gone
 // without being closed, else with `status`. Returns its result with the viewer's log appended.
-// `env` (e.g. "PATH=/x:$PATH") is set for the viewer alone.
+// `env` (e.g. "PATH=/x:$PATH") is set for the viewer alone. The viewer keeps its settings in
+// `config_home` (XDG_CONFIG_HOME; empty: a fresh folder of this test's own), never in the user's.
 RunResult run_live_viewer(const std::string& prefix, const std::string& name, const std::string& viewer_args,
-                          const std::string& steps, int crash_status, const std::string& env = "") {
+                          const std::string& steps, int crash_status, const std::string& env = "",
+                          std::string config_home = "") {
   const std::string dir = out_dir(), script = dir + "/" + name + ".sh", log = dir + "/" + name + ".log";
+  if (config_home.empty()) {
+    config_home = dir + "/" + name + "_config";
+    std::filesystem::remove_all(config_home);
+  }
   if (FILE* f = std::fopen(script.c_str(), "w")) {
     std::fputs(("viewer=$1 drop=$2 input=$3 log=$4\n"
+                "export XDG_CONFIG_HOME=\"" + config_home + "\"\n"
                 "cd \"$(dirname \"$log\")\"\n"
                 + (env.empty() ? std::string() : "env " + env + " ") + "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
                 "pid=$!\n"
@@ -925,6 +932,190 @@ TEST(Viewer, AFrameThatRunsOutOfMemoryIsReportedNotFatal) {
   EXPECT_NE(r.output.find("a 12000x12000 frame failed: "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("out of memory"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("flashgs-viewer: error:"), std::string::npos) << r.output;
+}
+
+// The viewer's "NAME: N ms" figure from a log line containing `key`, or -1.
+double logged_ms(const std::string& log, const std::string& key) {
+  const auto at = log.find(key);
+  if (at == std::string::npos) return -1;
+  return std::atof(log.c_str() + at + key.size());
+}
+
+// While the CPU renders a frame of pc_playbot (seconds on a small machine) on the worker
+// thread, a real click (XTEST) on a checkbox is answered: the frames that see the button held
+// are logged while the frame renders, the option changes, and no UI frame in the whole run
+// took 100 ms or more (the viewer measures each from input to swap; before the worker, each
+// took as long as a render).
+TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
+  if (found.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
+  // Without "..": the path stays on one line of the panel, which keeps the layout clicked below.
+  const std::string dir = std::filesystem::canonical(found).string();
+  // H turns the heat map on (a new full frame starts rendering), then the "Tight box" checkbox
+  // (its place in the window at UI scale 1) is clicked while that frame renders. 1024x600: the
+  // sections are open from 600 points up, and the swap (llvmpipe drawing the window, Xvfb
+  // copying it) is most of a UI frame's time here.
+  const std::string steps =
+      "wait_for \"first frame shown\" || status=10\n"
+      "[ $status -eq 0 ] && { hold H \" key72 \" || status=11; }\n"
+      "[ $status -eq 0 ] && { \"$input\" move 27 461 && hold button \" mouse0 \" || status=12; }\n"
+      "[ $status -eq 0 ] && { wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
+      "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "ui_while_rendering",
+                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --size 1024x600 --log-input", steps, 14);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 first frame, 11 H, 12 click, 13 option not changed, 14 crash, 15 close)\n"
+                            << r.output;
+  bool seen_while_rendering = false;  // a held-button line of a frame that began with a render in flight
+  for (std::size_t at = r.output.find("held: mouse0 at 27,461"); at != std::string::npos;
+       at = r.output.find("held: mouse0 at 27,461", at + 1)) {
+    const std::string line = r.output.substr(at, r.output.find('\n', at) - at);
+    seen_while_rendering |= line.find("(a frame is rendering)") != std::string::npos;
+  }
+  EXPECT_TRUE(seen_while_rendering) << "the click was not seen while a frame rendered\n" << r.output;
+  const double worst = logged_ms(r.output, "UI frames while a frame rendered in the background: ");
+  const auto at = r.output.find(", worst ", r.output.find("UI frames while a frame rendered"));
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const double worst_ms = std::atof(r.output.c_str() + at + 8);
+  std::printf("UI frames while rendering: %.0f, worst %.1f ms\n", worst, worst_ms);
+  EXPECT_GE(worst, 2.0);
+  EXPECT_LT(worst_ms, 100.0) << r.output;
+#endif
+}
+
+// The first scene loads beside the window: its progress is on screen within the first second
+// of the load (logged, and in a window screenshot taken through Shift+F12 while it loads), and
+// the picture follows. 7 copies of pc_playbot (3.5 M Gaussians) load for many seconds.
+TEST(Viewer, LoadProgressIsOnScreenInTheFirstSecond) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  if (!flashgs::image_io_has_oiio()) GTEST_SKIP() << "Shift+F12 saves PNG, which needs OpenImageIO";
+  const std::string dir = flashgs::test::shared_scene_dir("pc_playbot");
+  if (dir.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
+  const std::string out = out_dir();
+  const std::string shots = out + "/load_progress_shots";
+  std::filesystem::remove_all(shots);
+  std::filesystem::create_directories(shots);
+  // GLFW key codes: left Shift 340, F12 301. Shift+F12 saves the window, a fresh name in `shots`.
+  const std::string steps =
+      "wait_for \"load progress shown\" || status=10\n"
+      "[ $status -eq 0 ] && { press Shift_L \" key340 \" && hold F12 \" key301 \"; \"$input\" up Shift_L; }\n"
+      "[ $status -eq 0 ] && { wait_for \"saved window \" || status=11; }\n"
+      "[ $status -eq 0 ] && { cp \"$(ls " + shots + "/*.png | head -1)\" loading_window.png; "
+      "grep -q \"load of\" \"$log\" && status=12; }\n"
+      "[ $status -eq 0 ] && { wait_for \"first frame shown\" || status=13; }\n"
+      "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "load_progress",
+                                      "\"" + dir + "/point_cloud.ply\" --tile 7 --backend cpu --size 800x450 --log-input --screenshot-dir " + shots,
+                                      steps, 14);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 no progress, 11 no screenshot, 12 loaded before the screenshot, 13 no "
+                               "frame, 14 crash, 15 close)\n"
+                            << r.output;
+  const double shown_ms = logged_ms(r.output, "load progress shown ");
+  std::printf("load progress shown %.0f ms after the load started\n", shown_ms);
+  EXPECT_GE(shown_ms, 0.0);
+  EXPECT_LT(shown_ms, 1000.0) << r.output;
+  // The progress window at the bottom centre, right of the main panel: its bar (ImGui's blue
+  // frame, filled or swept in orange) is drawn where the window is otherwise dark.
+  const flashgs::Image shot = flashgs::read_image(out + "/loading_window.png");
+  ASSERT_EQ(shot.width, 800);
+  int bar = 0;
+  for (int y = shot.height - 100; y < shot.height - 45; ++y)
+    for (int x = 400; x < 620; ++x) {
+      const float* p = shot.pixel(x, y);
+      const bool orange = p[0] > 0.7f && p[1] > 0.5f && p[2] < 0.2f;
+      const bool frame_blue = p[2] > 0.25f && p[2] > p[0] + 0.1f;
+      bar += orange || frame_blue;
+    }
+  std::printf("progress bar pixels: %d\n", bar);
+  EXPECT_GT(bar, 1500) << "no progress bar in the window while loading";
+#endif
+}
+
+// B (baseline) and then the Flash radio button: one rule, so flash comes back with every
+// optimisation on (before, B had switched them all off and the radio left them so).
+TEST(Viewer, TheBKeyAndTheAlgorithmRadioAgree) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // The Flash radio's place in a 1280x800 window at UI scale 1. GLFW key code: B 66.
+  const std::string steps =
+      "wait_for \"UI ready\" || status=10\n"
+      "[ $status -eq 0 ] && { hold b \" key66 \" && wait_for \"options: baseline\" || status=11; }\n"
+      "[ $status -eq 0 ] && { \"$input\" move 163 396 && hold button \" mouse0 \" || status=12; }\n"
+      "[ $status -eq 0 ] && { wait_count \"options: \" 3 || status=13; }\n"
+      "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "b_and_radio", "--backend cpu --size 1280x800 --log-input", steps, 14);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 B, 12 click, 13 radio did nothing, 14 crash, 15 close)\n"
+                            << r.output;
+  // The option lines in order: flash at start, baseline after B, flash (every switch on) after the radio.
+  std::vector<std::string> lines;
+  for (std::size_t at = r.output.find("options: "); at != std::string::npos; at = r.output.find("options: ", at + 1))
+    lines.push_back(r.output.substr(at, r.output.find('\n', at) - at));
+  ASSERT_GE(lines.size(), 3u) << r.output;
+  EXPECT_EQ(lines[0], "options: flash");
+  EXPECT_EQ(lines[1], "options: baseline");
+  EXPECT_EQ(lines[2], "options: flash") << r.output;
+#endif
+}
+
+// Settings and recent files survive a restart (a private XDG_CONFIG_HOME); a corrupt file is
+// one line and the defaults, never a refusal to start.
+TEST(Viewer, SettingsAndRecentFilesSurviveARestart) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string config = out_dir() + "/restart_config";
+  std::filesystem::remove_all(config);
+  const std::string scene = flashgs::demo_scene_path();
+  // Run 1: the demo scene by name (a recent file), B (baseline), Tab (orbit); closing saves.
+  const std::string first =
+      "wait_for \"first frame shown\" || status=10\n"
+      "[ $status -eq 0 ] && { hold b \" key66 \" && wait_for \"options: baseline\" || status=11; }\n"
+      "[ $status -eq 0 ] && { hold Tab \" key258 \" || status=11; }\n"
+      "[ $status -eq 0 ] && { close_window || status=13; }\n";
+  const RunResult a = run_live_viewer(prefix, "restart_1", "\"" + scene + "\" --backend cpu --size 800x450 --log-input",
+                                      first, 12, "", config);
+  ASSERT_EQ(a.exit_code, 0) << "run 1: step " << a.exit_code << "\n" << a.output;
+  EXPECT_TRUE(std::filesystem::exists(config + "/flashgs/settings.ini")) << a.output;
+  EXPECT_TRUE(std::filesystem::exists(config + "/flashgs/imgui.ini")) << "the panel layout is kept too";
+  // Run 2, no scene named: the settings and the recent file come back.
+  const std::string second = "wait_for \"UI ready\" || status=10\n"
+                             "[ $status -eq 0 ] && { close_window || status=13; }\n";
+  const RunResult b = run_live_viewer(prefix, "restart_2", "--size 800x450", second, 12, "", config);
+  ASSERT_EQ(b.exit_code, 0) << "run 2: step " << b.exit_code << "\n" << b.output;
+  EXPECT_NE(b.output.find("settings from " + config + "/flashgs/settings.ini (1 recent files)"), std::string::npos)
+      << b.output;
+  EXPECT_NE(b.output.find("options: baseline"), std::string::npos) << b.output;
+  EXPECT_NE(b.output.find("frame path: CPU renderer + texture upload (--backend cpu)"), std::string::npos)
+      << "the backend choice is kept\n" << b.output;
+  // Run 3: a corrupt file: one line naming it, the defaults, the viewer runs.
+  if (FILE* f = std::fopen((config + "/flashgs/settings.ini").c_str(), "w")) {
+    std::fputs("render_scale = banana\n", f);
+    std::fclose(f);
+  }
+  const RunResult c = run_live_viewer(prefix, "restart_3", "--backend cpu --size 800x450", second, 12, "", config);
+  ASSERT_EQ(c.exit_code, 0) << "run 3: step " << c.exit_code << "\n" << c.output;
+  EXPECT_NE(c.output.find(config + "/flashgs/settings.ini line 1: \"render_scale = banana\" is not a valid setting: "
+                          "ignored, using the defaults"),
+            std::string::npos)
+      << c.output;
+  EXPECT_NE(c.output.find("options: flash"), std::string::npos) << c.output;
+#endif
 }
 
 }  // namespace

@@ -477,7 +477,7 @@ TEST(ViewerSceneLoader, ABlockedLoadIsAbandonedWithoutWaiting) {
   std::shared_future<void> released = release->get_future().share();
   const int running_before = fv::SceneLoader::running();
   {
-    fv::SceneLoader loader([released](const std::string& path) -> fv::LoadedScene {
+    fv::SceneLoader loader([released](const std::string& path, flashgs::LoadProgress&) -> fv::LoadedScene {
       released.wait();
       throw flashgs::Error(path + ": released");
     });

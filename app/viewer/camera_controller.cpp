@@ -224,13 +224,16 @@ bool is_object_sized(const glm::vec3& centre, float extent, const std::vector<Ca
   return 2 * outside > cameras.size();
 }
 
+bool CameraController::exact_scene_camera(int width, int height, float fov_x_degrees) const {
+  if (!m_snapped_valid || !(std::abs(fov_x_degrees - m_snapped_fov) < 1e-4f) || width <= 0 || height <= 0) return false;
+  const double aspect_scene = double(m_snapped.width) / m_snapped.height;
+  const double aspect_view = double(width) / height;
+  return std::abs(aspect_scene / aspect_view - 1.0) < 1e-3;
+}
+
 Camera CameraController::render_camera(int width, int height, float fov_x_degrees) const {
-  if (m_snapped_valid && std::abs(fov_x_degrees - m_snapped_fov) < 1e-4f) {
-    const double aspect_scene = double(m_snapped.width) / m_snapped.height;
-    const double aspect_view = double(width) / height;
-    // Same aspect: the scene camera resized exactly as `flashgs render -r WxH` does.
-    if (std::abs(aspect_scene / aspect_view - 1.0) < 1e-3) return m_snapped.resized(width, height);
-  }
+  // Same aspect: the scene camera resized exactly as `flashgs render -r WxH` does.
+  if (exact_scene_camera(width, height, fov_x_degrees)) return m_snapped.resized(width, height);
   const float fov = kFovRange.clamp(fov_x_degrees, 60.0f) * float(M_PI / 180.0);
   const float f = 0.5f * float(width) / std::tan(0.5f * fov);
   float c2w[9];

@@ -57,6 +57,9 @@ class CameraController {
   const glm::vec3& pivot() const { return m_pivot; }
   // Whether the camera still sits exactly on the snapped scene camera.
   bool on_scene_camera() const { return m_snapped_valid; }
+  // Whether render_camera(width, height, fov) is the scene camera itself (same field of view
+  // and aspect ratio), not just its pose.
+  bool exact_scene_camera(int width, int height, float fov_x_degrees) const;
 
  private:
   bool apply(const NavigationInput& input, float dt, ViewerSettings& settings);

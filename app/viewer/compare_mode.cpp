@@ -12,6 +12,10 @@ constexpr int kSwitchCount = static_cast<int>(std::size(kRenderSwitches));
 
 RenderOptions untracked(RenderOptions o) {
   o.collect_tile_counts = false;  // not a configuration, only what the heat map needs
+  // The baseline ignores the optimisation switches (switch_algorithm keeps them for flash):
+  // any baseline is the same configuration.
+  if (o.is_baseline())
+    for (const RenderSwitch& sw : kRenderSwitches) o.*(sw.member) = RenderOptions::baseline().*(sw.member);
   return o;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "flashgs/renderer.h"
 #include "flashgs/scene.h"
 #include "flashgs/stats.h"
+#include "render_worker.h"
 
 namespace flashgs::viewer {
 
@@ -39,20 +41,44 @@ class FramePath {
   // Makes the last render the shown texture (waits for nothing on the host: GL orders its
   // use after the render). For frames that render nothing, screenshots and checks.
   virtual void present_latest() {}
-  // Renders into host memory (compare mode, float screenshots).
+  // Renders into host memory (compare mode, float screenshots). Thread-safe on a path that
+  // renders_in_background(): the comparison calls it from a task thread.
   virtual void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) = 0;
+
+  // The viewer's one way to get frames, on every path. A path that renders in the background
+  // (the CPU backend on its worker thread) returns from submit() at once and delivers the frame
+  // later through take_finished(); the others render it in submit() (exceptions propagate:
+  // the caller falls back to the CPU path) and deliver it at the next take_finished().
+  virtual bool renders_in_background() const { return false; }
+  // Asks for the view; `cancel_in_flight`: a background frame rendering now is stopped.
+  virtual void submit(const FrameRequest& request, bool cancel_in_flight);
+  // The frame that reached the texture since the last call: its request, stats and wall time
+  // (the image stays in the path: last_image()). False when none did.
+  virtual bool take_finished(FinishedFrame* frame);
+  // A submitted frame is not yet delivered.
+  virtual bool busy() const { return false; }
+  // Blocks until every submitted frame is delivered (scripted runs time and check it).
+  virtual void wait_until_idle() {}
   // Per-tile pair counts of the last render_to_texture (needs options.collect_tile_counts).
   virtual void tile_counts(const FrameStats& stats, std::vector<std::uint32_t>& out) = 0;
   // The last frame in float if this path keeps one in host memory, else null.
   virtual const Image* last_image() const { return nullptr; }
+
+ private:
+  bool m_has_done = false;  // submit()'s frame, for take_finished() (synchronous paths)
+  FinishedFrame m_done;
 };
 
 class ImagePresenter;
 
-// Any Renderer's float image converted and uploaded with glTexSubImage2D (CPU backend, or the
-// CUDA backend when interop is refused). `label` names the path in the window.
+// Any Renderer's float image converted and uploaded with glTexSubImage2D (the CUDA backend
+// when interop is refused). `label` names the path in the window.
 std::unique_ptr<FramePath> make_upload_path(std::unique_ptr<Renderer> renderer, ImagePresenter* presenter,
                                             std::string label);
+// The same upload, the renders on a RenderWorker thread (the CPU backend): the window never
+// waits for a frame. `wake` runs on the worker after each frame (it wakes the event loop).
+std::unique_ptr<FramePath> make_background_upload_path(std::unique_ptr<Renderer> renderer, ImagePresenter* presenter,
+                                                       std::string label, std::function<void()> wake);
 
 // The CUDA backend writing straight into the GL texture through interop; when interop is
 // refused (Mesa context, GPU not driving the display) the CUDA backend through host memory.

@@ -2,6 +2,8 @@
 #include "imgui_layer_ui.h"
 
 #include <cfloat>
+#include <filesystem>
+#include <system_error>
 
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
@@ -13,12 +15,19 @@
 
 namespace flashgs::viewer {
 
-ImGuiLayer::ImGuiLayer(Window& window, float ui_scale) : m_window(window) {
+ImGuiLayer::ImGuiLayer(Window& window, float ui_scale, std::string ini_path)
+    : m_window(window), m_ini_path(std::move(ini_path)) {
   static_assert(kCursorShapes == ImGuiMouseCursor_COUNT, "one GLFW cursor slot per ImGui cursor shape");
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGuiIO& io = ImGui::GetIO();
-  io.IniFilename = nullptr;  // no imgui.ini beside whatever folder the viewer runs in
+  // Never an imgui.ini beside whatever folder the viewer runs in: the config folder or none.
+  // ImGui skips a file it cannot read or write.
+  if (!m_ini_path.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(std::filesystem::path(m_ini_path).parent_path(), ec);
+  }
+  io.IniFilename = m_ini_path.empty() ? nullptr : m_ini_path.c_str();
   ImGui::StyleColorsDark();
   ImGuiStyle& style = ImGui::GetStyle();
   style.WindowRounding = 4.0f;

@@ -1,6 +1,8 @@
 // ImGuiLayer: Dear ImGui's context with its GLFW and OpenGL 3 backends (init, per-frame begin/end, shutdown).
 #pragma once
 
+#include <string>
+
 struct GLFWcursor;
 
 namespace flashgs::viewer {
@@ -10,8 +12,9 @@ class Window;
 class ImGuiLayer {
  public:
   // `ui_scale` multiplies font and widget sizes (the monitor's content scale on high-DPI screens).
-  // The window must outlive the layer.
-  ImGuiLayer(Window& window, float ui_scale);
+  // The window must outlive the layer. `ini_path`: where ImGui keeps the panel layout (its
+  // folder is created); empty: nowhere.
+  ImGuiLayer(Window& window, float ui_scale, std::string ini_path);
   ~ImGuiLayer();
   ImGuiLayer(const ImGuiLayer&) = delete;
   ImGuiLayer& operator=(const ImGuiLayer&) = delete;
@@ -25,6 +28,7 @@ class ImGuiLayer {
   void update_platform_inputs();
 
   Window& m_window;
+  std::string m_ini_path;  // ImGui keeps the pointer
   double m_last_time = 0;
   int m_cursor_shape = -1;           // the ImGuiMouseCursor last applied
   static constexpr int kCursorShapes = 9;  // ImGuiMouseCursor_COUNT (checked where imgui.h is seen)

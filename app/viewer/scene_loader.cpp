@@ -19,6 +19,7 @@ struct SceneLoader::Job {
   bool done = false;
   LoadedScene scene;
   std::string error;
+  LoadProgress progress;  // written by the thread (atomics), read by the viewer
 };
 
 SceneLoader::SceneLoader(LoadFunction load) : m_load(std::move(load)) {}
@@ -27,18 +28,19 @@ SceneLoader::~SceneLoader() { abandon(); }
 
 int SceneLoader::running() { return g_running.load(); }
 
-bool SceneLoader::start(const std::string& path) {
+bool SceneLoader::start(const std::string& path, LoadFunction load) {
   if (m_job) return false;
+  if (!load) load = m_load;
   auto job = std::make_shared<Job>();
   ++g_running;
   try {
     // Detached: a thread blocked in open() cannot be interrupted, and the viewer must be able
     // to close anyway; the job outlives whichever side lets go of it first.
-    std::thread([job, load = m_load, path] {
+    std::thread([job, load = std::move(load), path] {
       LoadedScene scene;
       std::string error;
       try {
-        scene = load(path);
+        scene = load(path, job->progress);
       } catch (const std::bad_alloc&) {
         error = path + ": out of memory while loading";
       } catch (const std::exception& e) {
@@ -59,7 +61,14 @@ bool SceneLoader::start(const std::string& path) {
   }
   m_job = std::move(job);
   m_path = path;
+  m_started = std::chrono::steady_clock::now();
   return true;
+}
+
+const LoadProgress* SceneLoader::progress() const { return m_job ? &m_job->progress : nullptr; }
+
+double SceneLoader::elapsed_seconds() const {
+  return m_job ? std::chrono::duration<double>(std::chrono::steady_clock::now() - m_started).count() : 0.0;
 }
 
 bool SceneLoader::take(LoadedScene* scene, std::string* error) {
@@ -76,6 +85,7 @@ bool SceneLoader::take(LoadedScene* scene, std::string* error) {
 }
 
 void SceneLoader::abandon() {
+  if (m_job) m_job->progress.cancel_requested = true;
   m_job.reset();
   m_path.clear();
 }

@@ -54,13 +54,18 @@ glm::vec3 guess_up(const std::vector<Camera>& cameras) {
   return up;
 }
 
-LoadedScene load_scene(const std::string& path, const std::string& cameras_path) {
+LoadedScene load_scene(const std::string& path, const std::string& cameras_path, LoadProgress* progress) {
   // A PLY, a folder holding point_cloud.ply or a 3DGS training output (the library's rule, as
   // in the command-line tool); FIFOs and devices are refused before anything is opened.
   const SceneLocation location = locate_scene(path);
   LoadedScene s;
   s.path = location.ply;
-  s.scene = std::make_shared<const Scene>(load_scene_file(location.ply, &s.report));
+  if (progress && progress->bytes_total == 0) {  // the size at least, before the reader says more
+    std::error_code ec;
+    const auto bytes = std::filesystem::file_size(location.ply, ec);
+    if (!ec) progress->bytes_total = bytes;
+  }
+  s.scene = std::make_shared<const Scene>(load_scene_file(location.ply, &s.report, progress));
   if (s.scene->size() == 0) throw Error(location.ply + ": the file holds no usable Gaussians");
   const std::string cameras = cameras_path.empty() ? location.cameras : cameras_path;
   if (!std::filesystem::exists(std::filesystem::symlink_status(cameras))) {

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "flashgs/camera.h"
+#include "flashgs/load_progress.h"
 #include "flashgs/scene.h"
 
 namespace flashgs::viewer {
@@ -18,6 +19,7 @@ struct LoadedScene {
   std::vector<Camera> cameras;          // may be empty
   LoadReport report;
   std::string cameras_note;             // why there are no cameras, if so
+  std::string refused_option;           // a start option the load could not apply (--tile), one line
   glm::vec3 centre{0.0f};               // orbit pivot / default look-at
   float extent = 1.0f;                  // typical size, sets navigation speeds
   glm::vec3 up{0.0f, -1.0f, 0.0f};      // guessed world up
@@ -28,7 +30,8 @@ struct LoadedScene {
 // flashgs::Error naming the file and the problem, before opening anything that is not a
 // regular file (a FIFO would block); a missing, broken or irregular cameras.json is not fatal
 // (noted).
-LoadedScene load_scene(const std::string& path, const std::string& cameras_path = "");
+// `progress` (may be null) gets the file's size at once and whatever the reader reports.
+LoadedScene load_scene(const std::string& path, const std::string& cameras_path = "", LoadProgress* progress = nullptr);
 // The procedural demo scene (`count` Gaussians) with orbit cameras, for runs where no file can travel.
 LoadedScene generate_demo_scene(std::size_t count);
 // `copies` copies of a loaded scene on a grid (large-scene benchmarks); cameras kept.

@@ -25,6 +25,8 @@
 #include "line_overlay_gl.h"
 #include "scene_lines.h"
 #include "split_view_gl.h"
+#include "path_note.h"
+#include "settings_store.h"
 #include "viewer_panels_ui.h"
 #include "window_gl.h"
 
@@ -32,7 +34,14 @@ namespace flashgs::viewer {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr float kScriptDt = 1.0f / 60.0f;  // simulated time per scripted frame: runs are repeatable
+// While the view moves, a slow backend renders fewer pixels: about this long a frame (15 FPS).
+constexpr double kMovingFrameMs = 66.0;
+constexpr float kMinMovingScale = 0.25f;  // at most 1/16 of the pixels
+// The view counts as moving until it has been still this long: a drag's pauses between mouse
+// events do not ask for (and wait on) a full frame each time.
+constexpr double kSettleMs = 200.0;
+
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 bool same_camera(const Camera& a, const Camera& b) {
   if (a.width != b.width || a.height != b.height || a.fx != b.fx || a.fy != b.fy || a.cx != b.cx || a.cy != b.cy)
@@ -57,17 +66,26 @@ std::string size_text(int width, int height) { return std::to_string(width) + "x
 }  // namespace
 
 ViewerApp::ViewerApp(ViewerArgs args) : m_args(std::move(args)) {
+  m_scripted = m_args.scripted();
+  // Interactive runs start from the saved settings, the command line over them; scripted
+  // runs from the defaults and the command line only (repeatable, and they save nothing).
+  m_persist = !m_scripted && !config_dir().empty();
+  if (m_persist) restore_settings();
+  const ViewerArgs defaults;
+  auto given = [&](bool differs) { return m_scripted || differs; };
   RenderOptions& o = m_settings.options;
-  if (m_args.algorithm == "baseline") o = RenderOptions::baseline();
-  o.tau = m_args.tau;
-  o.sh_degree_cap = m_args.sh_degree;
-  for (int c = 0; c < 3; ++c) o.background[c] = m_args.background[c];
-  m_settings.render_scale = m_args.scale;
-  m_good_scale = m_args.scale;
+  if (given(m_args.algorithm != defaults.algorithm))
+    switch_algorithm(o, m_args.algorithm == "baseline" ? Algorithm::baseline : Algorithm::flash);
+  if (given(m_args.tau != defaults.tau)) o.tau = m_args.tau;
+  if (given(m_args.sh_degree != defaults.sh_degree)) o.sh_degree_cap = m_args.sh_degree;
+  if (given(m_args.background != defaults.background))
+    for (int c = 0; c < 3; ++c) o.background[c] = m_args.background[c];
+  if (given(m_args.scale != defaults.scale)) m_settings.render_scale = m_args.scale;
+  m_good_scale = m_settings.render_scale;
   m_settings.forced_width = m_args.render_width;
   m_settings.forced_height = m_args.render_height;
   m_settings.heatmap = m_args.heatmap;
-  m_settings.mode = m_args.orbit ? NavigationMode::orbit : NavigationMode::fly;  // auto: install_scene
+  if (given(m_args.orbit)) m_settings.mode = m_args.orbit ? NavigationMode::orbit : NavigationMode::fly;  // auto: install_scene
   m_settings.show_ui = !m_args.no_ui;
   m_settings.show_help = m_args.help_window;
   m_settings.screenshot_overlay = m_args.screenshot_overlay;
@@ -80,9 +98,53 @@ ViewerApp::ViewerApp(ViewerArgs args) : m_args(std::move(args)) {
   m_settings.compare_right = std::max(0, compare_choice_from_name(m_args.compare_right));
   m_divider.set_fraction(m_args.split_at);
   m_settings.screenshot_folder = m_args.screenshot_dir.empty() ? default_screenshot_folder() : m_args.screenshot_dir;
-  m_scripted = m_args.scripted();
-  m_settings.vsync = !(m_args.no_vsync || m_scripted);
-  if (!m_args.keys.empty()) m_script = KeyScript::parse(m_args.keys);
+  if (m_scripted) m_settings.vsync = false;
+  else if (m_args.no_vsync) m_settings.vsync = false;
+  if (m_persist && m_args.backend == defaults.backend) m_args.backend = m_stored_backend;
+  if (m_scripted) {
+    ScriptedRunPlan plan;
+    plan.keys = m_args.keys;
+    plan.path = m_args.path;
+    plan.frames = m_args.frames;
+    plan.warmup = m_args.warmup;
+    plan.then_open = !m_args.then_open.empty();
+    m_script = std::make_unique<ScriptedRun>(plan);  // throws on a malformed --keys
+  }
+}
+
+std::string ViewerApp::settings_path() const { return config_dir() + "/settings.ini"; }
+
+void ViewerApp::restore_settings() {
+  StoredSettings stored;
+  stored.settings = m_settings;
+  const std::string problem = read_settings_file(settings_path(), stored);
+  if (!problem.empty()) {
+    set_notice(problem);
+    return;
+  }
+  m_settings = stored.settings;
+  m_recent = stored.recent;
+  m_stored_backend = stored.backend;
+  std::error_code ec;
+  if (std::filesystem::exists(settings_path(), ec))  // not on the first run
+    std::fprintf(stderr, "flashgs-viewer: settings from %s (%zu recent files)\n", settings_path().c_str(), m_recent.size());
+}
+
+void ViewerApp::save_settings() {
+  if (!m_persist) return;
+  StoredSettings stored;
+  stored.settings = m_settings;
+  stored.backend = m_args.backend;
+  stored.recent = m_recent;
+  const std::string problem = write_settings_file(settings_path(), stored);
+  if (!problem.empty()) set_notice("settings " + problem);
+  else std::fprintf(stderr, "flashgs-viewer: settings saved to %s\n", settings_path().c_str());
+}
+
+void ViewerApp::remember_recent(const std::string& path) {
+  if (!m_persist || path.empty()) return;
+  add_recent_file(m_recent, path);
+  save_settings();  // now: a crash later keeps the list
 }
 
 ViewerApp::~ViewerApp() {
@@ -95,10 +157,16 @@ ViewerApp::~ViewerApp() {
 }
 
 void ViewerApp::use_cpu_path(const std::string& why) {
-  m_path = make_upload_path(make_cpu_renderer(), m_presenter.get(), "CPU renderer + texture upload");
+  // The worker wakes the event loop when a frame is done: the window shows it at once.
+  m_path = make_background_upload_path(make_cpu_renderer(), m_presenter.get(), "CPU renderer + texture upload",
+                                       [] { glfwPostEmptyEvent(); });
   m_path_is_cpu = true;
-  m_path_note = why;
+  m_path_note = plain_path_note(why);
+  // On the CPU a frame takes long: re-render only when something changes.
+  m_settings.continuous = false;
+  m_have_request = false;
   std::fprintf(stderr, "flashgs-viewer: frame path: %s (%s)\n", m_path->name().c_str(), why.c_str());
+  if (m_scene.scene) m_path->set_scene(m_scene.scene);
 }
 
 void ViewerApp::select_frame_path() {
@@ -119,7 +187,8 @@ void ViewerApp::select_frame_path() {
   }
   m_path = std::move(cuda);
   m_path_is_cpu = false;
-  m_path_note = why;  // empty when interop works; otherwise why the host copy is used
+  m_path_note = plain_path_note(why);  // empty when interop works; otherwise why the host copy is used
+  m_settings.continuous = true;  // GPU paths render every frame and show their FPS
   std::fprintf(stderr, "flashgs-viewer: frame path: %s%s%s%s\n", m_path->name().c_str(), why.empty() ? "" : " (",
                why.c_str(), why.empty() ? "" : ")");
 }
@@ -142,6 +211,7 @@ void ViewerApp::install_scene(LoadedScene scene) {
                  object ? "the cameras look at the scene from outside it" : "the cameras stand inside the scene");
   }
   m_have_frame = false;
+  m_have_request = false;
   std::string note;
   if (m_scene.report.dropped_non_finite)
     note += std::to_string(m_scene.report.dropped_non_finite) + " Gaussians with NaN/Inf dropped. ";
@@ -177,6 +247,7 @@ bool ViewerApp::open_scene(const std::string& path) {
 }
 
 void ViewerApp::request_open(const std::string& path) {
+  m_path_buffer = path;  // the box shows what was asked for, and keeps it when it fails
   if (m_scripted) {  // scripted runs stay deterministic: load in the frame that asks
     open_scene(path);
     return;
@@ -185,6 +256,7 @@ void ViewerApp::request_open(const std::string& path) {
   // current scene; the new one is installed (uploaded) on this thread once it is ready.
   m_path_buffer = path;  // kept in the box when it fails, to be corrected
   if (!m_loader.start(path)) set_notice("still loading " + m_loader.path() + "; " + path + " ignored");
+  m_logged_load_progress = false;
 }
 
 void ViewerApp::finish_pending_load() {
@@ -192,14 +264,24 @@ void ViewerApp::finish_pending_load() {
   LoadedScene scene;
   std::string error;
   if (!m_loader.take(&scene, &error)) return;
+  const bool first = m_first_load_pending;
+  m_first_load_pending = false;
+  std::fprintf(stderr, "flashgs-viewer: load of %s finished after %.0f ms since start\n", path.c_str(), ms_since(m_started));
   if (!error.empty()) {
     report_failed_load(error);
+    if (first && !m_scene.scene) {  // nothing to show: the generated demo scene instead
+      install_scene(generate_demo_scene(30000));
+      m_load_error += "; showing a generated demo scene";
+      std::fprintf(stderr, "flashgs-viewer: showing a generated demo scene instead\n");
+    }
     return;
   }
   try {
     install_scene(std::move(scene));
     m_load_error.clear();
-    m_path_buffer = path;
+    m_path_buffer = first ? m_args.scene : path;
+    if (first) apply_start_options();
+    if (!first || !m_args.scene.empty()) remember_recent(first ? m_args.scene : path);
   } catch (const std::exception& e) {
     report_failed_load(path + ": " + reason(e));
   }
@@ -277,15 +359,8 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
     if (pressed(key)) nav.speed_steps += 1.0f;
   for (int key : {GLFW_KEY_MINUS, GLFW_KEY_KP_SUBTRACT})
     if (pressed(key)) nav.speed_steps -= 1.0f;
-  if (pressed(GLFW_KEY_B)) {
-    const bool to_flash = m_settings.options.is_baseline();
-    RenderOptions& o = m_settings.options;
-    RenderOptions fresh = to_flash ? RenderOptions{} : RenderOptions::baseline();
-    fresh.tau = o.tau;
-    fresh.sh_degree_cap = o.sh_degree_cap;
-    std::copy(o.background, o.background + 3, fresh.background);
-    o = fresh;
-  }
+  if (pressed(GLFW_KEY_B))
+    switch_algorithm(m_settings.options, m_settings.options.is_baseline() ? Algorithm::flash : Algorithm::baseline);
   const bool left_down = m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT);
   if (mouse_free) actions.snap_camera = frustum_under_click(left_down, x, y);
   if (mouse_free || m_divider.dragging()) handle_divider_drag(left_down, x);
@@ -340,8 +415,19 @@ void ViewerApp::apply_actions(const UiActions& a) {
     set_notice("path export cancelled after " + std::to_string(m_export.done_frames()) + " frames");
     m_export.cancel();
   }
-  if (a.screenshot) take_screenshot(next_screenshot_path(m_settings.screenshot_folder, ""));
-  if (a.compare && m_have_frame) run_comparison();
+  if (a.screenshot) {
+    // The picture of the view at full resolution: a scripted run has it now; an interactive
+    // one may still be rendering it (or showing a reduced frame) and saves it once it is shown.
+    const std::string path = next_screenshot_path(m_settings.screenshot_folder, "");
+    if (m_scripted) take_screenshot(path);
+    else m_pending_screenshot = path;
+  }
+  // Asked for before the first frame (the scene still loading or rendering): once it is there.
+  if (a.compare) m_compare_pending = true;
+  if (m_compare_pending && m_have_frame && m_frame_is_full) {
+    m_compare_pending = false;
+    run_comparison();
+  }
 }
 
 void ViewerApp::run_comparison() {
@@ -491,23 +577,86 @@ void ViewerApp::ensure_texture(int width, int height) {
     m_path->attach_textures(textures, width, height);
   } catch (const std::exception& e) {
     use_cpu_path(std::string("interop failed: ") + e.what());
-    m_path->set_scene(m_scene.scene);
-    m_presenter->resize(width, height, m_path->texture_count());
   }
 }
 
-void ViewerApp::render_frame(const Camera& camera) {
-  RenderOptions options = m_settings.options;
-  options.collect_tile_counts = m_settings.heatmap;  // counts cost a copy: only when shown
+void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
+  m_render_call_ms = 0;
+  if (!m_scene.scene) return;
+  // A slow backend renders fewer pixels while the view moves (about kMovingFrameMs a frame),
+  // and the full frame once it stops: the camera then differs, so it is asked for again.
+  float scale = m_settings.render_scale;
+  // A screenshot waits for a full frame: none is reduced (or stopped) until it is taken.
+  const bool shot_pending = !m_pending_screenshot.empty();
+  const bool reduced = !m_scripted && m_settings.adaptive_resolution && moving && m_full_render_ms > kMovingFrameMs &&
+                       !shot_pending;
+  if (reduced) scale *= std::clamp(float(std::sqrt(kMovingFrameMs / m_full_render_ms)), kMinMovingScale, 1.0f);
+  const int wanted_w = m_settings.forced_width > 0 ? m_settings.forced_width : std::max(1, int(std::lround(fb_w * scale)));
+  const int wanted_h = m_settings.forced_height > 0 ? m_settings.forced_height : std::max(1, int(std::lround(fb_h * scale)));
+  int rw = 0, rh = 0;
+  choose_render_size(wanted_w, wanted_h, &rw, &rh);
+  FrameRequest request;
+  request.camera = m_controller.render_camera(rw, rh, m_settings.fov_x_degrees);
+  request.options = m_settings.options;
+  request.options.collect_tile_counts = m_settings.heatmap;  // counts cost a copy: only when shown
+  request.reduced = reduced;
+  const bool changed = !m_have_request || !same_camera(request.camera, m_requested.camera) ||
+                       request.options != m_requested.options;
+  const bool again = m_scripted || (m_settings.continuous && !m_path->busy());
+  if (!changed && !again) return;
+  // While the view moves, a reduced frame in flight may finish (it is quick; cancelling one
+  // every frame would show nothing); a full frame in flight stops for the new view.
+  const bool cancel_in_flight = (!moving || m_requested_full) && !shot_pending;
+  const auto t0 = Clock::now();
   try {
-    m_path->render_to_texture(camera, options, &m_stats);
-  } catch (const std::exception& e) {
-    if (m_path_is_cpu) throw;
-    use_cpu_path(std::string("CUDA frame failed: ") + e.what());
-    m_path->set_scene(m_scene.scene);
-    m_path->render_to_texture(camera, options, &m_stats);
+    if (!m_path->renders_in_background()) ensure_texture(rw, rh);
+    try {
+      m_path->submit(request, cancel_in_flight);
+    } catch (const std::exception& e) {
+      if (m_path_is_cpu) throw;
+      use_cpu_path(std::string("CUDA frame failed: ") + e.what());  // the one fallback
+      m_path->submit(request, true);
+    }
+  } catch (const std::exception& e) {  // out of memory, a texture refused: keep running
+    render_failed(rw, rh, reason(e));
   }
-  if (m_settings.heatmap) {
+  m_requested = request;
+  m_have_request = true;
+  m_requested_full = !reduced;
+  // Scripted runs time and check each frame: they wait for it (an event, not a sleep).
+  if (m_scripted) m_path->wait_until_idle();
+  m_render_call_ms = ms_since(t0);
+}
+
+void ViewerApp::collect_frame() {
+  m_delivered = false;
+  FinishedFrame frame;
+  try {
+    if (!m_path->take_finished(&frame)) return;
+  } catch (const std::exception& e) {  // the upload's texture refused
+    render_failed(frame.request.camera.width, frame.request.camera.height, reason(e));
+    return;
+  }
+  const int width = frame.request.camera.width, height = frame.request.camera.height;
+  if (!frame.error.empty()) {
+    render_failed(width, height, frame.error);
+    return;
+  }
+  m_delivered = true;
+  m_stats = std::move(frame.stats);
+  m_last_camera = frame.request.camera;
+  m_last_options = frame.request.options;
+  m_have_frame = true;
+  m_frame_is_full = !frame.request.reduced;
+  m_last_frame_ms = frame.wall_ms;
+  m_rendered_rate.record(ms_since(m_started) / 1000.0);
+  if (m_frame_is_full) {
+    m_full_render_ms = frame.wall_ms;
+    m_good_scale = m_settings.render_scale;
+  }
+  m_good_width = width;
+  m_good_height = height;
+  if (m_last_options.collect_tile_counts) {
     // The overlay's counts are this frame's: show this frame too, not the one before it.
     m_path->present_latest();
     m_path->tile_counts(m_stats, m_tile_counts);
@@ -519,12 +668,74 @@ void ViewerApp::render_frame(const Camera& camera) {
                                  static_cast<std::uint32_t>(std::min<std::uint64_t>(top, UINT32_MAX)));
     log_legend();
   }
-  m_last_camera = camera;
-  m_last_options = options;
-  m_have_frame = true;
   // Another view or configuration than the comparison's: its images no longer match the frame.
-  if (m_compare.valid && (!same_camera(camera, m_compare_camera) || !(options == m_compare_options)))
+  if (m_compare.valid && (!same_camera(m_last_camera, m_compare_camera) || !(m_last_options == m_compare_options)))
     m_compare.stale = true;
+  if (m_args.log_input)
+    std::fprintf(stderr, "flashgs-viewer: frame shown %dx%d (%s) rendered in %.0f ms\n", width, height,
+                 m_frame_is_full ? "full" : "reduced", frame.wall_ms);
+  if (!m_logged_first_frame && m_frame_is_full) {
+    m_logged_first_frame = true;
+    std::fprintf(stderr, "flashgs-viewer: first frame shown %.0f ms after start (%dx%d, %s)\n", ms_since(m_started),
+                 width, height, m_scene.path.c_str());
+  }
+}
+
+void ViewerApp::legend_rect(int fb_w, int fb_h, float* rect) const {
+  // Bottom right, clear of the main panel (top left) and the statistics (top right).
+  const float u = m_ui_scale * m_window->framebuffer_scale();
+  rect[0] = float(fb_w) - 300.0f * u;
+  // Room below the bar for the tick labels, above it for the caption.
+  rect[1] = float(fb_h) - 46.0f * u;
+  rect[2] = float(fb_w) - 20.0f * u;
+  rect[3] = float(fb_h) - 32.0f * u;
+}
+
+void ViewerApp::draw_and_present(int fb_w, int fb_h) {
+  // Showing the previous frame while this one renders pays only when another frame follows at
+  // once (a GPU path rendering every frame); otherwise the newest is shown.
+  if (!(m_delivered && (m_settings.continuous || m_scripted))) m_path->present_latest();
+  m_presenter->show(m_path->shown_texture());
+  HeatmapView heat;
+  heat.log_scale = m_settings.heatmap_log;
+  heat.opacity = m_settings.heatmap_opacity;
+  legend_rect(fb_w, fb_h, heat.legend_rect);
+  glClearColor(0, 0, 0, 1);
+  glClear(GL_COLOR_BUFFER_BIT);
+  const auto t_draw = Clock::now();
+  // Until the first frame there is no texture: the window shows the panels (and the load's progress).
+  const bool comparing = comparison_shown();
+  if (m_presenter->width() > 0)
+    m_presenter->draw(fb_w, fb_h, m_settings.heatmap && m_have_frame && !comparing ? &heat : nullptr);
+  if (!comparing) draw_guides(fb_w, fb_h);
+  if (comparing)
+    m_split->draw(fb_w, fb_h, m_divider.fraction(), std::max(2.0f, 2.0f * m_ui_scale * m_window->framebuffer_scale()),
+                  m_settings.compare_view == CompareView::difference);
+  if (!m_pending_overlay_shot.empty()) {  // the image as shown, heat map included, panels not
+    save_window_screenshot(m_pending_overlay_shot, fb_w, fb_h);
+    m_status = "saved " + m_pending_overlay_shot + " (heat map included)";
+    m_pending_overlay_shot.clear();
+  }
+  m_ui->end_frame();
+  if (!m_pending_window_shot.empty()) {
+    save_window_screenshot(m_pending_window_shot, fb_w, fb_h);
+    m_pending_window_shot.clear();
+  }
+  // A screenshot asked for interactively: once a full frame of the view is shown (while the
+  // view moves, the first full one; no frame is cancelled meanwhile).
+  if (!m_pending_screenshot.empty() && m_have_frame && m_frame_is_full && (m_delivered || !m_path->busy())) {
+    take_screenshot(m_pending_screenshot);
+    m_pending_screenshot.clear();
+  }
+  const auto t_swap = Clock::now();
+  m_draw_ms = std::chrono::duration<double, std::milli>(t_swap - t_draw).count();
+  m_window->swap(m_settings.vsync);
+  m_swap_ms = ms_since(t_swap);
+  ++m_presented;
+  // ImGui hides a window that sizes itself in its first frame: from the second frame with
+  // panels on, they are all on screen where they stay (tests click them from then on).
+  if (m_settings.show_ui && ++m_ui_frames == 2)
+    std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start\n", ms_since(m_started));
 }
 
 void ViewerApp::log_held_input() {
@@ -543,9 +754,18 @@ void ViewerApp::log_held_input() {
   const glm::vec3 f = p.rotation[2], r = p.rotation[0], pivot = m_controller.pivot();
   std::fprintf(stderr,
                "flashgs-viewer: frame %d held:%s at %.0f,%.0f | camera %.6f %.6f %.6f forward %.6f %.6f %.6f "
-               "right %.6f %.6f %.6f pivot %.6f %.6f %.6f\n",
+               "right %.6f %.6f %.6f pivot %.6f %.6f %.6f%s, HUD %.1f FPS\n",
                m_presented, held.c_str(), x, y, p.position.x, p.position.y, p.position.z, f.x, f.y, f.z, r.x, r.y, r.z,
-               pivot.x, pivot.y, pivot.z);
+               pivot.x, pivot.y, pivot.z, m_path->busy() ? " (a frame is rendering)" : "",
+               m_rendered_rate.rate(ms_since(m_started) / 1000.0));
+}
+
+void ViewerApp::log_option_changes() {
+  // One line per change of the render options (the tests read which configuration is active).
+  if (m_have_logged_options && m_settings.options == m_logged_options) return;
+  m_logged_options = m_settings.options;
+  m_have_logged_options = true;
+  std::fprintf(stderr, "flashgs-viewer: options: %s\n", m_settings.options.label().c_str());
 }
 
 void ViewerApp::set_notice(const std::string& message) {
@@ -682,18 +902,13 @@ void ViewerApp::check_displayed_frame() {
 }
 
 void ViewerApp::finish_script() {
-  if (!m_frame_ms.empty()) {
-    const FrameTimeSummary s = summarize_frame_times(m_frame_ms);
-    std::printf("viewer frames: %zu at %dx%d on %s | mean %.3f ms, median %.3f ms, p95 %.3f ms, min %.3f ms, max %.3f ms | %.1f FPS\n",
-                s.frames, m_presenter->width(), m_presenter->height(), m_path->name().c_str(), s.mean_ms, s.median_ms,
-                s.p95_ms, s.min_ms, s.max_ms, s.fps);
+  if (m_script->timed_any()) {
+    std::printf("%s\n", m_script->frames_report(m_presenter->width(), m_presenter->height(), m_path->name()).c_str());
     std::printf("viewer render: last frame kv pairs %llu, visible %llu of %llu, backend total %.3f ms (project %.3f, emit %.3f, sort %.3f, ranges %.3f, blend %.3f)\n",
                 static_cast<unsigned long long>(m_stats.kv_pairs), static_cast<unsigned long long>(m_stats.visible),
                 static_cast<unsigned long long>(m_stats.gaussians), m_stats.times.total_ms, m_stats.times.project_ms,
                 m_stats.times.emit_ms, m_stats.times.sort_ms, m_stats.times.ranges_ms, m_stats.times.blend_ms);
-    const double n = static_cast<double>(m_frame_ms.size());
-    std::printf("viewer split (mean wall ms): events + panels %.3f, render call %.3f, draw %.3f, swap %.3f\n",
-                m_split_ms[3] / n, m_split_ms[0] / n, m_split_ms[1] / n, m_split_ms[2] / n);
+    std::printf("%s\n", m_script->split_report().c_str());
     const glm::vec3 p = m_controller.pose().position;
     std::printf("viewer camera: position %.6f %.6f %.6f\n", p.x, p.y, p.z);
   }
@@ -725,54 +940,83 @@ void ViewerApp::finish_script() {
   m_settings.vsync = !m_args.no_vsync;
 }
 
-bool ViewerApp::load_first_scene() {
-  // The first scene: generated, the argument, or the demo; interactive runs fall back to a
-  // generated demo scene when it fails.
-  bool loaded = false;
-  if (m_args.generate_demo > 0) {
-    const std::string option = "--generate-demo " + std::to_string(m_args.generate_demo);
+namespace {
+
+// The first scene: generated, the argument or the demo file, tiled when --tile asks (on the
+// loader thread for interactive runs: it only reads `args`, a copy). Throws flashgs::Error
+// naming the option or file; a refused --tile leaves the scene untiled with `refused_option` set.
+LoadedScene load_start_scene(const ViewerArgs& args, LoadProgress* progress) {
+  LoadedScene scene;
+  if (args.generate_demo > 0) {
+    const std::string option = "--generate-demo " + std::to_string(args.generate_demo);
     const int demo_sh_degree = 1;  // what make_demo_scene builds
     const std::string problem =
-        scene_size_problem(scene_bytes(std::uint64_t(m_args.generate_demo), scene_bytes_per_gaussian(demo_sh_degree)),
+        scene_size_problem(scene_bytes(std::uint64_t(args.generate_demo), scene_bytes_per_gaussian(demo_sh_degree)),
                            system_available_memory());
     try {
       if (!problem.empty()) throw Error(problem);
-      install_scene(generate_demo_scene(static_cast<std::size_t>(m_args.generate_demo)));
-      loaded = true;
+      scene = generate_demo_scene(static_cast<std::size_t>(args.generate_demo));
     } catch (const std::exception& e) {
-      report_failed_load(option + ": " + reason(e));
+      throw Error(option + ": " + reason(e));
     }
   } else {
-    loaded = open_scene(m_args.scene.empty() ? demo_scene_path() : m_args.scene);
+    const std::string path = args.scene.empty() ? demo_scene_path() : args.scene;
+    scene = load_scene(path, args.cameras, progress);
   }
-  if (loaded) return true;
-  if (m_scripted) {
+  if (args.tile > 1) {
+    const std::string option = "--tile " + std::to_string(args.tile);
+    const std::uint64_t gaussians = std::uint64_t(scene.scene->size()) * std::uint64_t(args.tile);
+    const std::string problem =
+        scene_size_problem(scene_bytes(gaussians, scene_bytes_per_gaussian(scene.scene->sh_degree)),
+                           system_available_memory());
+    try {
+      if (!problem.empty()) throw Error(problem + " for " + std::to_string(gaussians) + " Gaussians");
+      scene = tile_loaded_scene(scene, args.tile);
+    } catch (const std::exception& e) {
+      scene.refused_option = option + " refused: " + reason(e);
+    }
+  }
+  return scene;
+}
+
+}  // namespace
+
+bool ViewerApp::start_first_scene() {
+  if (!m_scripted) {
+    // The window and panels come up at once; the scene loads beside them with its progress shown.
+    m_first_load_pending = true;
+    const std::string shown = m_args.generate_demo > 0 ? "generated demo scene"
+                              : m_args.scene.empty()   ? demo_scene_path()
+                                                       : m_args.scene;
+    m_loader.start(shown, [args = m_args](const std::string&, LoadProgress& progress) {
+      return load_start_scene(args, &progress);
+    });
+    m_path_buffer = m_args.scene;
+    return true;
+  }
+  // Scripted runs load before their first frame: what they time and save does not depend on
+  // when a thread finishes.
+  try {
+    LoadedScene scene = load_start_scene(m_args, nullptr);
+    const std::string refused = scene.refused_option;
+    install_scene(std::move(scene));
+    m_path_buffer = m_args.scene;
+    if (!refused.empty()) {  // its numbers would be for another scene
+      set_notice(refused);
+      return false;
+    }
+  } catch (const std::exception& e) {
+    report_failed_load(reason(e));
     std::fprintf(stderr, "flashgs-viewer: no scene to run the script on\n");
     return false;
   }
-  install_scene(generate_demo_scene(30000));
-  m_load_error += "; showing a generated demo scene";
-  std::fprintf(stderr, "flashgs-viewer: showing a generated demo scene instead\n");
-  return true;
+  return apply_start_options();
 }
 
 bool ViewerApp::apply_start_options() {
   // Each refusal is one line naming the option; a scripted run stops (its numbers would be
   // for something else), an interactive one goes on without the option.
-  if (m_args.tile > 1) {
-    const std::string option = "--tile " + std::to_string(m_args.tile);
-    const std::uint64_t gaussians = std::uint64_t(m_scene.scene->size()) * std::uint64_t(m_args.tile);
-    const std::string problem =
-        scene_size_problem(scene_bytes(gaussians, scene_bytes_per_gaussian(m_scene.scene->sh_degree)),
-                           system_available_memory());
-    try {
-      if (!problem.empty()) throw Error(problem + " for " + std::to_string(gaussians) + " Gaussians");
-      install_scene(tile_loaded_scene(m_scene, m_args.tile));
-    } catch (const std::exception& e) {
-      set_notice(option + " refused: " + reason(e) + (m_scripted ? "" : "; the scene is shown once"));
-      if (m_scripted) return false;
-    }
-  }
+  if (!m_scene.refused_option.empty()) set_notice(m_scene.refused_option + "; the scene is shown once");
   if (m_settings.forced_width > 0) {
     const std::string problem = frame_size_problem(m_settings.forced_width, m_settings.forced_height,
                                                    m_path->texture_count(), m_max_texture_size, system_available_memory());
@@ -794,17 +1038,18 @@ bool ViewerApp::apply_start_options() {
       snap_to_camera(m_args.camera);
     }
   }
+  if (m_args.fov > 0) m_settings.fov_x_degrees = m_args.fov;
   return true;
 }
 
-int ViewerApp::run() {
+bool ViewerApp::open_window() {
   try {
     m_window = std::make_unique<Window>(m_args.window_width, m_args.window_height, "flashgs-viewer");
     m_presenter = std::make_unique<ImagePresenter>();
     m_presenter->init();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "flashgs-viewer: %s\n", e.what());
-    return 1;
+    return false;
   }
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &m_max_texture_size);
   std::fprintf(stderr, "flashgs-viewer: OpenGL %s, %s, textures up to %d pixels a side\n",
@@ -820,225 +1065,180 @@ int ViewerApp::run() {
   m_ui_scale = std::max(1.0f, xscale / m_window->framebuffer_scale());
   std::fprintf(stderr, "flashgs-viewer: framebuffer %dx%d pixels, content scale %.2f, UI scale %.2f\n", fb_w0, fb_h0,
                xscale, m_ui_scale);
-  m_ui = std::make_unique<ImGuiLayer>(*m_window, m_ui_scale);
-  select_frame_path();
-  // On the CPU a frame takes long: re-render only when something changes, so the panels stay
-  // responsive (GPU paths render every frame and show their FPS).
-  m_settings.continuous = !m_path_is_cpu;
+  // The panel layout is kept beside the settings (interactive runs only).
+  m_ui = std::make_unique<ImGuiLayer>(*m_window, m_ui_scale, m_persist ? config_dir() + "/imgui.ini" : "");
+  return true;
+}
 
-  if (!load_first_scene()) return 2;
-  if (!apply_start_options()) return 2;
-  if (m_args.fov > 0) m_settings.fov_x_degrees = m_args.fov;
-  if (m_args.path && m_args.frames <= 0) m_args.frames = 120;
+bool ViewerApp::begin_frame(int* fb_w, int* fb_h, float* dt) {
+  // Waits for events only when nothing moves or renders every frame; a frame finished on the
+  // worker wakes the loop (glfwPostEmptyEvent), and a load in progress redraws its bar.
+  const bool idle = !m_scripted && !m_settings.continuous && !m_playing && !m_moving;
+  double wait_s = !idle ? 0.0 : m_loader.busy() ? 0.1 : 0.5;
+  const double settle_left_ms = kSettleMs - ms_since(m_last_motion);
+  if (wait_s > 0 && settle_left_ms > 0) wait_s = std::min(wait_s, settle_left_ms / 1000.0 + 0.001);  // then the full frame
+  m_window->poll(wait_s);
+  m_frame_start = Clock::now();
+  m_window->framebuffer_size(fb_w, fb_h);
+  // Clamped so that a stall (a scene upload) does not turn into one huge step.
+  *dt = m_scripted ? ScriptedRun::kFrameSeconds : std::min(0.5f, std::chrono::duration<float>(m_frame_start - m_last_frame_start).count());
+  m_last_frame_start = m_frame_start;
+  if (*fb_w > 0 && *fb_h > 0) return true;
+  if (!m_scripted) glfwWaitEventsTimeout(0.1);  // minimised: nothing to draw into
+  return false;
+}
+
+void ViewerApp::apply_script_step(NavigationInput& nav) {
+  // While the key script runs it is the input; after it, the window's.
+  if (!m_scripted || !m_script->has_input()) return;
+  const ScriptFrame step = m_script->next_input();
+  nav = step.nav;
+  if (step.resize_width > 0) m_window->resize(step.resize_width, step.resize_height);
+}
+
+void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
+  m_ui->begin_frame();  // every frame: the legend, help and hint show with the panels hidden too
+  UiModel model;
+  model.frame_path = m_path->name();
+  model.frame_path_note = m_path_note;
+  model.backend = m_path_is_cpu ? Backend::cpu : Backend::cuda;
+  model.scene_path = m_scene.path;
+  model.gaussians = m_scene.scene ? m_scene.scene->size() : 0;
+  model.sh_degree = m_scene.scene ? m_scene.scene->sh_degree : 0;
+  model.camera_count = static_cast<int>(m_scene.cameras.size());
+  model.scene_note = m_scene.cameras_note;
+  model.load_error = m_load_error;
+  model.loading = m_loader.path();
+  if (const LoadProgress* p = m_loader.progress()) {
+    model.load.bytes_done = p->bytes_done;
+    model.load.bytes_total = p->bytes_total;
+    model.load.gaussians_done = p->gaussians_done;
+    model.load.gaussians_total = p->gaussians_total;
+    model.load.elapsed_s = m_loader.elapsed_seconds();
+  }
+  model.recent = &m_recent;
+  model.current_camera = m_camera_index;
+  model.on_scene_camera = m_controller.on_scene_camera() && m_have_frame &&
+                          m_controller.exact_scene_camera(m_last_camera.width, m_last_camera.height,
+                                                          m_settings.fov_x_degrees);
+  model.playing = m_playing;
+  model.render_width = m_presenter->width();
+  model.render_height = m_presenter->height();
+  model.fps = m_rendered_rate.rate(ms_since(m_started) / 1000.0);
+  model.last_frame_ms = m_last_frame_ms;
+  model.rendering = m_path->busy();
+  model.stats = m_have_frame ? &m_stats : nullptr;
+  model.history = &m_history;
+  model.compare = &m_compare;
+  model.heatmap_max = m_presenter->heatmap_max();
+  model.tile_size = gm::kTileSize;
+  model.compare_shown = comparison_shown();
+  model.divider = m_divider.fraction();
+  model.difference_factor = m_difference_factor;
+  model.compare_problem = same_configuration_problem(compare_choice_options(m_settings.compare_left, m_settings.options),
+                                                     compare_choice_options(m_settings.compare_right, m_settings.options));
+  model.export_done = m_export.done_frames();
+  model.export_total = m_export.active() ? m_export.total_frames() : 0;
+  model.dialog_tool = m_dialog.tool();
+  model.dialog_open = m_dialog.busy() || m_browser.is_open();
+  float legend_px[4];
+  legend_rect(fb_w, fb_h, legend_px);
+  for (int k = 0; k < 4; ++k) model.legend_rect_points[k] = legend_px[k] / m_window->framebuffer_scale();
+  model.status = m_status;
+  model.ui_scale = m_ui_scale;
+  const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
+  for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
+  const ViewerSettings before = m_settings;
+  if (m_settings.show_ui) draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer);
+  draw_overlays(model, m_settings);
+  if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
+  keep_settings_valid(m_settings, before);
+  if (const std::string chosen = m_dialog.take_choice(); !chosen.empty()) actions.open_path = chosen;
+  if (!model.loading.empty() && !m_logged_load_progress) {
+    m_logged_load_progress = true;
+    std::fprintf(stderr, "flashgs-viewer: load progress shown %.0f ms after the load started, %.0f ms after start (%s)\n",
+                 model.load.elapsed_s * 1000.0, ms_since(m_started), model.loading.c_str());
+  }
+}
+
+bool ViewerApp::advance_camera(const NavigationInput& nav, float dt) {
+  const bool steering = nav.forward || nav.back || nav.left || nav.right || nav.up || nav.down ||
+                        nav.look_dx != 0.0f || nav.look_dy != 0.0f || nav.pan_dx != 0.0f || nav.pan_dy != 0.0f;
+  if (m_playing && steering) m_playing = false;  // taking the controls stops the path
+  if (m_playing && m_camera_path && !m_camera_path->empty()) {
+    m_path_t = m_camera_path->advance(m_path_t, dt, m_settings.path_seconds_per_camera);
+    m_controller.set_pose(m_camera_path->pose_at(m_path_t));
+    m_settings.fov_x_degrees = m_camera_path->fov_at(m_path_t);
+  }
+  bool moving = m_playing;
+  if (!m_playing && m_controller.update(nav, dt, m_settings)) moving = true;
+  if (m_scripted && m_args.path && m_camera_path && !m_camera_path->empty()) {
+    const double t = m_script->path_time();
+    m_controller.set_pose(m_camera_path->pose_at(t));
+    m_settings.fov_x_degrees = m_camera_path->fov_at(t);
+  }
+  return moving;
+}
+
+void ViewerApp::record_frame_times(double frame_ms, double ui_ms, bool rendering) {
+  if (m_delivered) m_history.push(m_path->renders_in_background() ? m_last_frame_ms : frame_ms, m_stats);
+  if (rendering && !m_scripted && m_path->renders_in_background()) {  // scripted frames wait on purpose
+    ++m_ui_frames_while_rendering;
+    m_worst_ui_ms_while_rendering = std::max(m_worst_ui_ms_while_rendering, ui_ms);
+    if (m_args.log_input && ui_ms >= 50.0)  // where a slow one went (tests print it on failure)
+      std::fprintf(stderr, "flashgs-viewer: slow UI frame %d: %.1f ms (events + panels %.1f, frame request %.1f, draw %.1f, swap %.1f%s)\n",
+                   m_presented, ui_ms, m_before_render_ms, m_render_call_ms, m_draw_ms, m_swap_ms,
+                   m_delivered ? ", a frame uploaded" : "");
+  }
+  if (!m_scripted) return;
+  FrameTimes times;
+  times.frame_ms = frame_ms;
+  times.before_render_ms = m_before_render_ms;
+  times.render_call_ms = m_render_call_ms;
+  times.draw_ms = m_draw_ms;
+  times.swap_ms = m_swap_ms;
+  m_script->frame_presented(times);
+  if (m_script->open_then_now()) open_scene(m_args.then_open);  // must fail softly
+  if (m_script->done()) finish_script();
+}
+
+int ViewerApp::run() {
+  if (!open_window()) return 1;
+  select_frame_path();
+  if (!start_first_scene()) return 2;
   m_window->cursor(&m_last_cursor_x, &m_last_cursor_y);
 
-  auto last = Clock::now();
   auto last_swap = Clock::now();
-  auto fps_window_start = Clock::now();
-  int fps_frames = 0;
   while (!m_window->should_close()) {
-    const auto t_loop = Clock::now();
-    const bool idle = !m_scripted && !m_settings.continuous && !m_playing && m_have_frame;
-    m_window->poll(idle);
     int fb_w = 0, fb_h = 0;
-    m_window->framebuffer_size(&fb_w, &fb_h);
-    const auto now = Clock::now();
-    // Clamped so that a stall (a scene load) does not turn into one huge step.
-    float dt = std::min(0.5f, std::chrono::duration<float>(now - last).count());
-    last = now;
-    if (fb_w <= 0 || fb_h <= 0) {  // minimised: nothing to draw into
-      if (!m_scripted) glfwWaitEventsTimeout(0.1);
-      continue;
-    }
-    if (m_scripted) dt = kScriptDt;
-
+    float dt = 0;
+    if (!begin_frame(&fb_w, &fb_h, &dt)) continue;
+    const bool rendering = m_path->busy();  // a background frame in flight as this frame starts
     UiActions actions;
     NavigationInput nav;
     gather_input(nav, actions);
-    if (m_scripted && !m_script.done()) {
-      const ScriptFrame step = m_script.next(dt);
-      nav = step.nav;
-      if (step.resize_width > 0) m_window->resize(step.resize_width, step.resize_height);
-    }
-
-    UiModel model;
-    const float fb_scale = m_window->framebuffer_scale();
-    // Bottom right, clear of the main panel (top left) and the statistics (top right).
-    const float u = m_ui_scale * fb_scale;  // legend sizes in pixels
-    // Room below the bar for the tick labels, above it for the caption.
-    const float legend_px[4] = {float(fb_w) - 300.0f * u, float(fb_h) - 46.0f * u, float(fb_w) - 20.0f * u,
-                                float(fb_h) - 32.0f * u};
-    m_ui->begin_frame();  // every frame: the legend, help and hint show with the panels hidden too
-    {
-      model.frame_path = m_path->name();
-      model.frame_path_note = m_path_note;
-      model.backend = m_path_is_cpu ? Backend::cpu : Backend::cuda;
-      model.scene_path = m_scene.path;
-      model.gaussians = m_scene.scene ? m_scene.scene->size() : 0;
-      model.sh_degree = m_scene.scene ? m_scene.scene->sh_degree : 0;
-      model.camera_count = static_cast<int>(m_scene.cameras.size());
-      model.scene_note = m_scene.cameras_note;
-      model.load_error = m_load_error;
-      model.loading = m_loader.path();
-      model.current_camera = m_camera_index;
-      model.on_scene_camera = m_controller.on_scene_camera();
-      model.playing = m_playing;
-      model.render_width = m_presenter->width();
-      model.render_height = m_presenter->height();
-      model.fps = m_fps;
-      model.stats = m_have_frame ? &m_stats : nullptr;
-      model.history = &m_history;
-      model.compare = &m_compare;
-      model.heatmap_max = m_presenter->heatmap_max();
-      model.tile_size = gm::kTileSize;
-      model.compare_shown = comparison_shown();
-      model.divider = m_divider.fraction();
-      model.difference_factor = m_difference_factor;
-      model.compare_problem =
-          same_configuration_problem(compare_choice_options(m_settings.compare_left, m_settings.options),
-                                     compare_choice_options(m_settings.compare_right, m_settings.options));
-      model.export_done = m_export.done_frames();
-      model.export_total = m_export.active() ? m_export.total_frames() : 0;
-      model.dialog_tool = m_dialog.tool();
-      model.dialog_open = m_dialog.busy() || m_browser.is_open();
-      for (int k = 0; k < 4; ++k) model.legend_rect_points[k] = legend_px[k] / fb_scale;
-      model.status = m_status;
-      model.ui_scale = m_ui_scale;
-      const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
-      for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
-      const ViewerSettings before = m_settings;
-      if (m_settings.show_ui) draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer);
-      draw_overlays(model, m_settings);
-      if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
-      keep_settings_valid(m_settings, before);
-    }
-    if (const std::string chosen = m_dialog.take_choice(); !chosen.empty()) actions.open_path = chosen;
+    apply_script_step(nav);
+    build_panels(fb_w, fb_h, actions);
     if (m_args.log_input) log_held_input();
     apply_actions(actions);
+    log_option_changes();
     finish_pending_load();
     if (m_export.active() && !m_scripted) export_step();  // one frame of the export per window frame
-
-    const bool steering = nav.forward || nav.back || nav.left || nav.right || nav.up || nav.down ||
-                          nav.look_dx != 0.0f || nav.look_dy != 0.0f || nav.pan_dx != 0.0f || nav.pan_dy != 0.0f;
-    if (m_playing && steering) m_playing = false;  // taking the controls stops the path
-    if (m_playing && m_camera_path && !m_camera_path->empty()) {
-      m_path_t = m_camera_path->advance(m_path_t, dt, m_settings.path_seconds_per_camera);
-      m_controller.set_pose(m_camera_path->pose_at(m_path_t));
-      m_settings.fov_x_degrees = m_camera_path->fov_at(m_path_t);
-    }
-    bool moving = m_playing;
-    if (!m_playing && m_controller.update(nav, dt, m_settings)) moving = true;
-    if (m_scripted && m_args.path && m_camera_path && !m_camera_path->empty()) {
-      const int timed = std::max(0, m_frame - m_args.warmup);
-      const double t = double(timed) / std::max(1, m_args.frames);
-      m_controller.set_pose(m_camera_path->pose_at(t));
-      m_settings.fov_x_degrees = m_camera_path->fov_at(t);
-    }
-
-    // A slow backend (the CPU) renders fewer pixels while the view moves, aiming at about 30
-    // frames per second, and the full frame as soon as it stops (the camera then differs, so it
-    // is rendered again).
-    float scale = m_settings.render_scale;
-    if (!m_scripted && m_settings.adaptive_resolution && moving && m_full_render_ms > 33.0)
-      scale *= static_cast<float>(std::clamp(std::sqrt(33.0 / m_full_render_ms), 0.25, 1.0));
-    const int wanted_w = m_settings.forced_width > 0 ? m_settings.forced_width
-                                                     : std::max(1, int(std::lround(fb_w * scale)));
-    const int wanted_h = m_settings.forced_height > 0 ? m_settings.forced_height
-                                                      : std::max(1, int(std::lround(fb_h * scale)));
-    int rw = 0, rh = 0;
-    choose_render_size(wanted_w, wanted_h, &rw, &rh);
-    const Camera camera = m_controller.render_camera(rw, rh, m_settings.fov_x_degrees);
-    RenderOptions wanted = m_settings.options;
-    wanted.collect_tile_counts = m_settings.heatmap;
-    const bool changed = !m_have_frame || !same_camera(camera, m_last_camera) || wanted != m_last_options;
-    bool rendered = false;
-    double render_call_ms = 0;
-    const double before_render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_loop).count();
-    if (changed || m_settings.continuous || m_scripted) {
-      const auto t0 = Clock::now();
-      try {
-        ensure_texture(rw, rh);
-        render_frame(camera);
-        rendered = true;
-      } catch (const std::exception& e) {  // out of memory, a texture refused: keep running
-        render_failed(rw, rh, reason(e));
-      }
-      render_call_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-      if (rendered) {
-        if (scale == m_settings.render_scale) {
-          m_full_render_ms = render_call_ms;
-          m_good_scale = m_settings.render_scale;
-        }
-        m_good_width = rw;
-        m_good_height = rh;
-      }
-      // Showing the previous frame while this one renders pays only when another frame
-      // follows at once; a render on demand (the view changed) is shown now.
-      if (!m_settings.continuous && !m_scripted) m_path->present_latest();
-    } else {
-      m_path->present_latest();  // the view rests: show its last frame, not the one before
-    }
-    m_presenter->show(m_path->shown_texture());
-
-    HeatmapView heat;
-    heat.log_scale = m_settings.heatmap_log;
-    heat.opacity = m_settings.heatmap_opacity;
-    std::copy(legend_px, legend_px + 4, heat.legend_rect);
-    glClearColor(0, 0, 0, 1);
-    glClear(GL_COLOR_BUFFER_BIT);
-    const auto t_draw = Clock::now();
-    const bool comparing = comparison_shown();
-    m_presenter->draw(fb_w, fb_h, m_settings.heatmap && !comparing ? &heat : nullptr);
-    if (!comparing) draw_guides(fb_w, fb_h);
-    if (comparing)
-      m_split->draw(fb_w, fb_h, m_divider.fraction(), std::max(2.0f, 2.0f * m_ui_scale * fb_scale),
-                    m_settings.compare_view == CompareView::difference);
-    if (!m_pending_overlay_shot.empty()) {  // the image as shown, heat map included, panels not
-      save_window_screenshot(m_pending_overlay_shot, fb_w, fb_h);
-      m_status = "saved " + m_pending_overlay_shot + " (heat map included)";
-      m_pending_overlay_shot.clear();
-    }
-    m_ui->end_frame();
-    if (!m_pending_window_shot.empty()) {
-      save_window_screenshot(m_pending_window_shot, fb_w, fb_h);
-      m_pending_window_shot.clear();
-    }
-    const auto t_swap = Clock::now();
-    m_window->swap(m_settings.vsync);
-    ++m_presented;
-    // ImGui hides a window that sizes itself in its first frame: from the second frame with
-    // panels on, they are all on screen where they stay (tests click them from then on).
-    if (m_settings.show_ui && ++m_ui_frames == 2) std::fprintf(stderr, "flashgs-viewer: UI ready\n");
-
+    m_moving = advance_camera(nav, dt);
+    if (m_moving) m_last_motion = Clock::now();
+    m_before_render_ms = ms_since(m_frame_start);
+    request_frame(fb_w, fb_h, m_moving || ms_since(m_last_motion) < kSettleMs);
+    collect_frame();
+    draw_and_present(fb_w, fb_h);
     const auto swapped = Clock::now();
     const double frame_ms = std::chrono::duration<double, std::milli>(swapped - last_swap).count();
     last_swap = swapped;
-    if (rendered) m_history.push(frame_ms, m_stats);
-    ++fps_frames;
-    const double window_s = std::chrono::duration<double>(swapped - fps_window_start).count();
-    if (window_s >= 0.5) {
-      m_fps = fps_frames / window_s;
-      fps_frames = 0;
-      fps_window_start = swapped;
-    }
-    if (m_scripted) {
-      // Frame 0 includes setup; warm-up frames are not timed either.
-      if (m_frame >= (m_args.path ? std::max(1, m_args.warmup) : 1)) {
-        m_frame_ms.push_back(frame_ms);
-        // Where the frame's wall time goes (CPU side): events and panel building, the render
-        // call (queues the GPU work, or renders on the CPU), drawing, and the swap (on Xvfb:
-        // waiting for the GPU, then the copy to the server).
-        m_split_ms[3] += before_render_ms;
-        m_split_ms[0] += render_call_ms;
-        m_split_ms[1] += std::chrono::duration<double, std::milli>(t_swap - t_draw).count();
-        m_split_ms[2] += std::chrono::duration<double, std::milli>(swapped - t_swap).count();
-      }
-      ++m_frame;
-      const int needed = m_args.path ? m_args.frames + m_args.warmup : std::max(1, m_args.frames);
-      if (m_frame == 1 && !m_args.then_open.empty()) open_scene(m_args.then_open);  // must fail softly
-      if (m_frame >= needed && m_script.done()) finish_script();
-    }
+    record_frame_times(frame_ms, ms_since(m_frame_start), rendering);
   }
+  save_settings();
+  if (m_ui_frames_while_rendering > 0)
+    std::fprintf(stderr, "flashgs-viewer: UI frames while a frame rendered in the background: %d, worst %.1f ms\n",
+                 m_ui_frames_while_rendering, m_worst_ui_ms_while_rendering);
   if (m_loader.busy())  // its thread may be blocked in open(): closing does not wait for it
     std::fprintf(stderr, "flashgs-viewer: closing without waiting for the load of %s\n", m_loader.path().c_str());
   return m_exit_code;

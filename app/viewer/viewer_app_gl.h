@@ -1,6 +1,7 @@
 // ViewerApp: the viewer's frame loop tying together window, scene, navigation, frame path, presenter and panels.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,10 +14,11 @@
 #include "heatmap_legend.h"
 #include "path_export.h"
 #include "frame_path.h"
-#include "key_script.h"
+#include "scripted_run.h"
 #include "scene_loader.h"
 #include "scene_state.h"
 #include "split_view.h"
+#include "rate_meter.h"
 #include "stats_history.h"
 #include "viewer_args.h"
 #include "viewer_settings.h"
@@ -38,28 +40,51 @@ class ViewerApp {
   int run();
 
  private:
+  // Setup.
+  std::string settings_path() const;
+  void restore_settings();  // from the config folder; a bad file: one line, the defaults
+  void save_settings();     // interactive runs: at exit and when the recent files change
+  void remember_recent(const std::string& path);
+  bool open_window();  // window, GL, presenter, UI; false (message logged) when there is none
   void select_frame_path();
+  // The CPU path (its frames on a worker thread); the one fallback when a GPU path fails.
+  // `why` is logged as it is and shown in plain words.
   void use_cpu_path(const std::string& why);
+  bool start_first_scene();  // scripted: loads now; interactive: starts the load; false: stop
+  bool apply_start_options();  // --tile (scripted), --render-size, --camera; false: a scripted run must stop
+
+  // Scenes.
   bool open_scene(const std::string& path);  // loads now; false (error kept) on failure
   void request_open(const std::string& path);  // loads in the background (interactive runs)
   void finish_pending_load();
   void report_failed_load(const std::string& error);
   void install_scene(LoadedScene scene);
-  bool load_first_scene();  // the generated, given or demo scene; false: none (message logged)
-  bool apply_start_options();  // --tile, --render-size, --camera; false: a scripted run must stop
+  void apply_up_choice();
+  void snap_to_camera(int index);
+
+  // The steps of one frame, in order.
+  bool begin_frame(int* fb_w, int* fb_h, float* dt);  // events, sizes; false: nothing to draw into
+  void gather_input(NavigationInput& nav, UiActions& actions);
+  void apply_script_step(NavigationInput& nav);
+  void build_panels(int fb_w, int fb_h, UiActions& actions);
+  void apply_actions(const UiActions& actions);
+  bool advance_camera(const NavigationInput& nav, float dt);  // true: the view moves this frame
+  void request_frame(int fb_w, int fb_h, bool moving);
+  void collect_frame();  // a finished frame: shown, its statistics kept
+  void draw_and_present(int fb_w, int fb_h);
+  // `rendering`: a background frame was in flight as this frame began (its UI time is tracked).
+  void record_frame_times(double frame_ms, double ui_ms, bool rendering);
+
   // The render size for this frame: `wanted`, or where it does not fit (memory, texture
   // limit) the last size that rendered, with one message logged and shown.
   void choose_render_size(int wanted_width, int wanted_height, int* width, int* height);
   void render_failed(int width, int height, const std::string& why);
   void set_notice(const std::string& message);  // logged once and shown in the panel
+  void log_option_changes();
   void log_held_input();  // --log-input
-  void apply_up_choice();
-  void snap_to_camera(int index);
-  void gather_input(NavigationInput& nav, UiActions& actions);
-  void apply_actions(const UiActions& actions);
   void ensure_texture(int width, int height);
-  void render_frame(const Camera& camera);
   void take_screenshot(const std::string& path);  // the rendered image, or with the heat map (setting)
+  void legend_rect(int fb_w, int fb_h, float* rect) const;  // the heat-map legend, framebuffer pixels
   void save_screenshot(const std::string& path);
   void save_window_screenshot(const std::string& path, int width, int height);
   void run_comparison();
@@ -82,22 +107,34 @@ class ViewerApp {
   std::unique_ptr<LineOverlay> m_lines;
   std::unique_ptr<ImGuiLayer> m_ui;
   std::unique_ptr<FramePath> m_path;
-  std::string m_path_note;
+  std::string m_path_note;  // in plain words (the log has the technical reason)
   bool m_path_is_cpu = true;
 
   LoadedScene m_scene;
   std::string m_load_error;  // the last failed load and what is shown instead
   SceneLoader m_loader;
+  bool m_first_load_pending = false;  // the first scene loads in the background
+  bool m_logged_load_progress = false;
   CameraController m_controller;
   std::unique_ptr<CameraPath> m_camera_path;
   int m_camera_index = -1;
   bool m_playing = false;
   double m_path_t = 0;
 
-  // The last rendered frame, to re-render only when something changed.
+  // The last frame asked for (to ask again only when something changed) and the last shown.
+  FrameRequest m_requested;
+  bool m_have_request = false;
+  bool m_requested_full = false;  // the last request was at the full render scale
+  int m_requested_width = 0, m_requested_height = 0;
   Camera m_last_camera;
   RenderOptions m_last_options;
   bool m_have_frame = false;
+  bool m_frame_is_full = false;  // the shown frame is at the full render scale
+  bool m_logged_first_frame = false;
+  bool m_delivered = false;  // a frame was delivered this loop iteration
+  bool m_moving = false;     // the view moved in the last loop iteration
+  std::chrono::steady_clock::time_point m_last_motion;  // when it last moved
+  std::chrono::steady_clock::time_point m_frame_start, m_last_frame_start;
   FrameStats m_stats;
   StatsHistory m_history;
   std::vector<std::uint32_t> m_tile_counts;
@@ -114,8 +151,12 @@ class ViewerApp {
   FileBrowser m_browser;
   PathExport m_export;
   std::string m_pending_overlay_shot;  // a screenshot of the image with the heat map, taken before the panels are drawn
+  bool m_compare_pending = false;  // asked for before there was a full frame to compare
   std::string m_status;
-  double m_fps = 0;
+  RenderOptions m_logged_options;
+  bool m_have_logged_options = false;
+  RateMeter m_rendered_rate;  // finished frames per second (not loop wake-ups)
+  double m_last_frame_ms = 0;  // wall time of the last finished frame
   float m_ui_scale = 1.0f;
   double m_full_render_ms = 0;  // wall time of the last render at the full render scale
 
@@ -128,22 +169,29 @@ class ViewerApp {
   int m_max_texture_size = 0;                     // GL_MAX_TEXTURE_SIZE
   int m_ui_frames = 0;                            // frames presented with the panels
   int m_presented = 0;                            // frames presented in all
+  // UI frames (input to swap, the wait for events not counted) while a frame rendered in the
+  // background: the worst is logged at exit (the UI must answer within 100 ms).
+  int m_ui_frames_while_rendering = 0;
+  double m_worst_ui_ms_while_rendering = 0;
+
+  // Kept between runs (interactive runs only).
+  bool m_persist = false;
+  std::vector<std::string> m_recent;
+  std::string m_stored_backend = "auto";
 
   // Input state between frames.
   double m_last_cursor_x = 0, m_last_cursor_y = 0;
   std::string m_path_buffer, m_export_buffer;
+  std::string m_pending_screenshot;  // waits for a full-resolution frame of the view
 
-  // Scripted mode.
+  // Scripted mode: the run's driver while it lasts (kept for its report).
   bool m_scripted = false;
-  KeyScript m_script;
-  int m_frame = 0;
-  std::vector<double> m_frame_ms;
-  // Timed frames' wall time: events + building the panels, render call, drawing (image +
-  // ImGui's draw lists), swap.
-  double m_split_ms[4] = {0, 0, 0, 0};
+  std::unique_ptr<ScriptedRun> m_script;
+  double m_render_call_ms = 0, m_before_render_ms = 0, m_draw_ms = 0, m_swap_ms = 0;  // this frame's parts
   int m_exit_code = 0;
   std::string m_pending_window_shot;
   bool m_close_after_shot = false;
+  std::chrono::steady_clock::time_point m_started = std::chrono::steady_clock::now();
 };
 
 }  // namespace flashgs::viewer

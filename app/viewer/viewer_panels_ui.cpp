@@ -19,6 +19,12 @@ namespace {
 float g_ui = 1.0f;
 float ui(float v) { return v * g_ui; }
 
+// The sections below Scene and View start open only in a window tall enough to leave the
+// picture visible beside them (at 800x450 they start folded; ImGui keeps what the user chose).
+ImGuiTreeNodeFlags open_if_roomy() {
+  return ImGui::GetMainViewport()->WorkSize.y >= ui(600) ? ImGuiTreeNodeFlags_DefaultOpen : 0;
+}
+
 std::string human_count(double v) {
   char text[32];
   if (v >= 1e6) std::snprintf(text, sizeof text, "%.2fM", v / 1e6);
@@ -30,13 +36,112 @@ std::string human_count(double v) {
 // Every slider clamps what is typed into it (Ctrl+click) to its range, not just what is dragged.
 constexpr ImGuiSliderFlags kClamp = ImGuiSliderFlags_AlwaysClamp;
 
+std::string megabytes(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.0f MB", double(bytes) / 1e6);
+  return text;
+}
+
+// A progress bar; with `fraction` < 0 (not known) a block sliding along it, so that the
+// window visibly works while a reader reports nothing.
+void progress_bar(float fraction, const std::string& overlay, double elapsed_s) {
+  if (fraction >= 0.0f) {
+    ImGui::ProgressBar(std::min(fraction, 1.0f), ImVec2(-1, 0), overlay.c_str());
+    return;
+  }
+  const ImVec2 size(ImGui::GetContentRegionAvail().x, ImGui::GetFrameHeight());
+  const ImVec2 p = ImGui::GetCursorScreenPos();
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  draw->AddRectFilled(p, ImVec2(p.x + size.x, p.y + size.y), ImGui::GetColorU32(ImGuiCol_FrameBg),
+                      ImGui::GetStyle().FrameRounding);
+  const float block = size.x * 0.25f;
+  const float t = float(std::fmod(elapsed_s / 1.5, 1.0));  // one sweep every 1.5 s
+  const float x0 = p.x + (size.x - block) * (t < 0.5f ? 2 * t : 2 - 2 * t);
+  draw->AddRectFilled(ImVec2(x0, p.y), ImVec2(x0 + block, p.y + size.y), ImGui::GetColorU32(ImGuiCol_PlotHistogram),
+                      ImGui::GetStyle().FrameRounding);
+  const ImVec2 text_size = ImGui::CalcTextSize(overlay.c_str());
+  draw->AddText(ImVec2(p.x + (size.x - text_size.x) * 0.5f, p.y + (size.y - text_size.y) * 0.5f),
+                ImGui::GetColorU32(ImGuiCol_Text), overlay.c_str());
+  ImGui::Dummy(size);
+}
+
+// The background load: file, bar, bytes, Gaussians, elapsed time and Cancel, in a small window
+// at the bottom centre (on screen from the window's first frame, panels open or folded).
+void load_window(const UiModel& m, UiActions& a) {
+  if (m.loading.empty()) return;
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x * 0.5f, vp->WorkPos.y + vp->WorkSize.y - ui(40)),
+                          ImGuiCond_Always, ImVec2(0.5f, 1.0f));
+  ImGui::SetNextWindowSize(ImVec2(std::min(ui(460), vp->WorkSize.x - ui(20)), 0), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.9f);
+  ImGui::Begin("Loading###load", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoFocusOnAppearing);
+  ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1), "Loading %s", m.loading.c_str());
+  const LoadView& l = m.load;
+  float fraction = -1.0f;
+  if (l.bytes_total > 0 && l.bytes_done > 0) fraction = float(double(l.bytes_done) / double(l.bytes_total));
+  else if (l.gaussians_total > 0 && l.gaussians_done > 0) fraction = float(double(l.gaussians_done) / double(l.gaussians_total));
+  char elapsed[32];
+  std::snprintf(elapsed, sizeof elapsed, "%.1f s", l.elapsed_s);
+  progress_bar(fraction, elapsed, l.elapsed_s);
+  std::string detail;
+  if (l.bytes_total > 0)
+    detail = (l.bytes_done > 0 ? megabytes(l.bytes_done) + " of " : std::string()) + megabytes(l.bytes_total);
+  if (l.gaussians_done > 0 || l.gaussians_total > 0) {
+    if (!detail.empty()) detail += ", ";
+    detail += human_count(double(l.gaussians_done)) +
+              (l.gaussians_total > 0 ? " of " + human_count(double(l.gaussians_total)) : std::string()) + " Gaussians";
+  }
+  if (!detail.empty()) ImGui::TextUnformatted(detail.c_str());
+  if (!detail.empty()) ImGui::SameLine();
+  if (ImGui::SmallButton("Cancel")) a.cancel_load = true;
+  if (!m.scene_path.empty()) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("(the current scene stays until it is ready)");
+  }
+  ImGui::End();
+}
+
+// One line over the picture: rendered frames per second, time per frame, pairs, backend, and
+// whether a frame is on its way (the picture shown is then the previous one).
+void hud_line(const UiModel& m, float panel_right) {
+  const char* backend = m.backend == Backend::cpu ? "CPU" : "CUDA";
+  const char* busy = m.rendering ? " | rendering..." : "";
+  char rate[64], size[32];
+  if (m.fps > 0) std::snprintf(rate, sizeof rate, "%.1f FPS | %.0f ms/frame", m.fps, m.last_frame_ms);
+  else std::snprintf(rate, sizeof rate, "idle | last frame %.0f ms", m.last_frame_ms);
+  std::snprintf(size, sizeof size, " | %dx%d", m.render_width, m.render_height);
+  const std::string pairs = m.stats ? human_count(double(m.stats->kv_pairs)) + " kv pairs" : std::string();
+  const std::string full = m.stats ? std::string(rate) + " | " + pairs + " | " + backend + size + busy
+                                   : std::string("no frame yet | ") + backend + busy;
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  // Centred, but right of the main panel where the window is narrow (the panel stays
+  // readable); the render size goes first, then the pairs, where it would not fit.
+  const float room = vp->WorkPos.x + vp->WorkSize.x - std::max(vp->WorkPos.x, panel_right + ui(12)) - ui(10);
+  std::string text = full;
+  if (m.stats && ImGui::CalcTextSize(text.c_str()).x > room) text = std::string(rate) + " | " + pairs + " | " + backend + busy;
+  if (m.stats && ImGui::CalcTextSize(text.c_str()).x > room) text = std::string(rate) + " | " + backend + busy;
+  const ImVec2 extent = ImGui::CalcTextSize(text.c_str());
+  const float x = std::max(vp->WorkPos.x + (vp->WorkSize.x - extent.x) * 0.5f, panel_right + ui(12));
+  const ImVec2 at(x, vp->WorkPos.y + vp->WorkSize.y - extent.y - ui(8));
+  ImDrawList* draw = ImGui::GetForegroundDrawList();
+  draw->AddRectFilled(ImVec2(at.x - ui(6), at.y - ui(3)), ImVec2(at.x + extent.x + ui(6), at.y + extent.y + ui(3)),
+                      IM_COL32(0, 0, 0, 160), ui(3.0f));
+  draw->AddText(at, m.rendering ? IM_COL32(255, 220, 120, 255) : IM_COL32(255, 255, 255, 255), text.c_str());
+}
+
 void scene_panel(const UiModel& m, UiActions& a, std::string& path_buffer) {
   if (!ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) return;
-  ImGui::TextWrapped("%s", m.scene_path.c_str());
-  ImGui::Text("%s Gaussians, SH degree %d, %d cameras", human_count(double(m.gaussians)).c_str(), m.sh_degree,
-              m.camera_count);
+  if (m.scene_path.empty()) {
+    ImGui::TextDisabled(m.loading.empty() ? "no scene loaded" : "no scene yet: loading (below)");
+  } else {
+    ImGui::TextWrapped("%s", m.scene_path.c_str());
+    ImGui::Text("%s Gaussians, SH degree %d, %d cameras", human_count(double(m.gaussians)).c_str(), m.sh_degree,
+                m.camera_count);
+  }
   if (!m.scene_note.empty()) ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.scene_note.c_str());
-  ImGui::SetNextItemWidth(ui(-140));
+  ImGui::SetNextItemWidth(ui(-170));
   const bool enter = ImGui::InputTextWithHint("##open", "PLY path or folder (or drop a file)", &path_buffer,
                                               ImGuiInputTextFlags_EnterReturnsTrue);
   ImGui::SameLine();
@@ -50,11 +155,20 @@ void scene_panel(const UiModel& m, UiActions& a, std::string& path_buffer) {
     ImGui::SameLine();
     ImGui::TextDisabled("waiting for %s", m.dialog_tool.empty() ? "the file browser" : m.dialog_tool.c_str());
   }
-  if (!m.loading.empty()) {
-    ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1), "loading %s ...", m.loading.c_str());
-    ImGui::SameLine();
-    if (ImGui::SmallButton("Cancel")) a.cancel_load = true;
+  // The recent scenes behind an arrow on the same row: the panel's layout does not move.
+  ImGui::SameLine();
+  const bool any_recent = m.recent && !m.recent->empty();
+  ImGui::BeginDisabled(!any_recent);
+  if (ImGui::BeginCombo("##recent", nullptr, ImGuiComboFlags_NoPreview | ImGuiComboFlags_PopupAlignLeft)) {
+    ImGui::TextDisabled("recent scenes");
+    if (any_recent)
+      for (const std::string& r : *m.recent)
+        if (ImGui::Selectable(r.c_str())) a.open_path = r;
+    ImGui::EndCombo();
   }
+  ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip(any_recent ? "recently opened scenes" : "no recent scenes yet");
   if (!m.load_error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1));
     ImGui::TextWrapped("%s", m.load_error.c_str());
@@ -86,8 +200,9 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
     ImGui::SetNextItemWidth(ui(140));
     ImGui::SliderFloat("s per camera", &s.path_seconds_per_camera, kPathSecondsRange.min, kPathSecondsRange.max, "%.1f",
                        kClamp | ImGuiSliderFlags_Logarithmic);
-    ImGui::Text(m.on_scene_camera ? "on camera %d (exact)" : "free view (last camera %d)", m.current_camera);
-  } else {
+    if (m.current_camera < 0) ImGui::TextUnformatted("free view");
+    else ImGui::Text(m.on_scene_camera ? "on camera %d (exact)" : "free view (last camera %d)", m.current_camera);
+  } else if (!m.scene_path.empty()) {
     ImGui::TextDisabled("no cameras.json: free navigation");
   }
   ImGui::SliderFloat("FOV (deg)", &s.fov_x_degrees, kFovRange.min, kFovRange.max, "%.1f", kClamp);
@@ -130,7 +245,7 @@ void switch_checkbox(const RenderSwitch& sw, RenderOptions& o, Backend backend) 
 }
 
 void render_panel(const UiModel& m, ViewerSettings& s) {
-  if (!ImGui::CollapsingHeader("Rendering", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (!ImGui::CollapsingHeader("Rendering", open_if_roomy())) return;
   RenderOptions& o = s.options;
   int algo = o.is_baseline() ? 0 : 1;
   ImGui::RadioButton("Baseline (3DGS)", &algo, 0);
@@ -138,7 +253,7 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
   ImGui::RadioButton("Flash", &algo, 1);
   ImGui::SameLine();
   ImGui::TextDisabled("(B)");
-  o.algorithm = algo == 0 ? Algorithm::baseline : Algorithm::flash;
+  switch_algorithm(o, algo == 0 ? Algorithm::baseline : Algorithm::flash);
   ImGui::BeginDisabled(o.is_baseline());
   // Two columns: the switches that change the Gaussian-tile pairs (geometry) and those that
   // only change how fast the kernels make and blend them.
@@ -168,7 +283,7 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
 }
 
 void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
-  if (!ImGui::CollapsingHeader("Compare", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (!ImGui::CollapsingHeader("Compare", open_if_roomy())) return;
   // The two sides: any two of the configurations compare_mode.h lists.
   auto side = [&](const char* label, int* choice) {
     ImGui::SetNextItemWidth(ui(118));
@@ -233,7 +348,7 @@ void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
 }
 
 void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& export_folder) {
-  if (!ImGui::CollapsingHeader("Overlay, screenshots, export", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (!ImGui::CollapsingHeader("Overlay, screenshots, export", open_if_roomy())) return;
   ImGui::Checkbox("Tile heat map (H)", &s.heatmap);
   ImGui::SameLine();
   ImGui::Checkbox("log", &s.heatmap_log);
@@ -265,42 +380,48 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
 
 void stats_window(const UiModel& m) {
   const ImGuiViewport* vp = ImGui::GetMainViewport();
+  // Starts top right; it can be moved (and the place is kept with the layout).
   ImGui::SetNextWindowPos(ImVec2(vp->WorkPos.x + vp->WorkSize.x - ui(10), vp->WorkPos.y + ui(10)),
-                          ImGuiCond_Always, ImVec2(1, 0));  // anchored top right as it grows and shrinks
+                          ImGuiCond_FirstUseEver, ImVec2(1, 0));
   // In a small window the panels would cover the picture: statistics start folded there.
   ImGui::SetNextWindowCollapsed(vp->WorkSize.x < ui(1000), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.75f);
-  // The title keeps the active path and the frame rate in view when the window is folded.
+  // The title keeps the frame rate in view when the window is folded.
   char title[256];
-  std::snprintf(title, sizeof title, "%.1f FPS | %s###Statistics", m.fps, m.frame_path.c_str());
-  ImGui::SetNextWindowSizeConstraints(ImVec2(ui(380), 0), ImVec2(vp->WorkSize.x, vp->WorkSize.y));
-  ImGui::Begin(title, nullptr, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
+  if (m.fps > 0) std::snprintf(title, sizeof title, "%.1f FPS | %s###Statistics", m.fps, m.frame_path.c_str());
+  else std::snprintf(title, sizeof title, "idle | %s###Statistics", m.frame_path.c_str());
+  // A fixed width: the anchor above places its right edge from the first frame on.
+  ImGui::SetNextWindowSizeConstraints(ImVec2(ui(330), 0), ImVec2(ui(330), vp->WorkSize.y));
+  ImGui::Begin(title, nullptr, ImGuiWindowFlags_AlwaysAutoResize);
   ImGui::TextColored(ImVec4(0.5f, 0.9f, 0.6f, 1), "%s", m.frame_path.c_str());
-  if (!m.frame_path_note.empty()) ImGui::TextDisabled("%s", m.frame_path_note.c_str());
-  ImGui::Text("%.1f FPS   render %dx%d", m.fps, m.render_width, m.render_height);
+  if (!m.frame_path_note.empty()) ImGui::TextWrapped("%s", m.frame_path_note.c_str());
+  ImGui::Text("rendered: %.1f FPS   render %dx%d", m.fps, m.render_width, m.render_height);
   if (const FrameStats* st = m.stats) {
-    ImGui::Text("kv pairs %s   visible %s / %s", human_count(double(st->kv_pairs)).c_str(),
+    ImGui::Separator();
+    ImGui::TextDisabled("last frame");
+    ImGui::Text("%.1f ms   kv pairs %s   visible %s / %s", m.last_frame_ms, human_count(double(st->kv_pairs)).c_str(),
                 human_count(double(st->visible)).c_str(), human_count(double(st->gaussians)).c_str());
-    ImGui::Text("culled: near %s  off-screen %s  low-opacity %s  degenerate %s",
-                human_count(double(st->culled_near)).c_str(), human_count(double(st->culled_offscreen)).c_str(),
-                human_count(double(st->culled_low_opacity)).c_str(), human_count(double(st->culled_degenerate)).c_str());
+    ImGui::Text("culled: near %s  off-screen %s", human_count(double(st->culled_near)).c_str(),
+                human_count(double(st->culled_offscreen)).c_str());
+    ImGui::Text("        low-opacity %s  degenerate %s", human_count(double(st->culled_low_opacity)).c_str(),
+                human_count(double(st->culled_degenerate)).c_str());
     if (st->device_peak_bytes > 0)
       ImGui::Text("device memory %.1f MB (peak %.1f MB)", st->device_memory_bytes / 1e6, st->device_peak_bytes / 1e6);
-    else
-      ImGui::TextDisabled("device memory: none (CPU backend)");
-    ImGui::Text("project %.2f  emit %.2f  sort %.2f  ranges %.2f  blend %.2f ms", st->times.project_ms,
-                st->times.emit_ms, st->times.sort_ms, st->times.ranges_ms, st->times.blend_ms);
+    ImGui::Text("project %.1f  emit %.1f  sort %.1f ms", st->times.project_ms, st->times.emit_ms, st->times.sort_ms);
+    ImGui::Text("ranges %.1f  blend %.1f ms", st->times.ranges_ms, st->times.blend_ms);
   }
   if (const StatsHistory* h = m.history) {
-    const StatsHistory::Series shown[] = {StatsHistory::kFrame, StatsHistory::kRender, StatsHistory::kProject,
-                                          StatsHistory::kEmit, StatsHistory::kSort, StatsHistory::kBlend};
-    for (StatsHistory::Series s : shown) {
-      int count = 0, offset = 0;
-      const float* values = h->series(s, &count, &offset);
-      char overlay[64];
-      std::snprintf(overlay, sizeof overlay, "%s %.2f ms (max %.2f)", StatsHistory::name(s), h->mean(s), h->max(s));
-      ImGui::PlotLines("##h", values, count, offset, overlay, 0.0f, float(h->max(s) * 1.1 + 1e-3),
-                       ImVec2(ui(260), ui(s == StatsHistory::kFrame ? 40 : 24)));
+    if (ImGui::CollapsingHeader("mean and max over recent frames")) {
+      const StatsHistory::Series shown[] = {StatsHistory::kFrame, StatsHistory::kRender, StatsHistory::kProject,
+                                            StatsHistory::kEmit, StatsHistory::kSort, StatsHistory::kBlend};
+      for (StatsHistory::Series s : shown) {
+        int count = 0, offset = 0;
+        const float* values = h->series(s, &count, &offset);
+        char overlay[64];
+        std::snprintf(overlay, sizeof overlay, "%s mean %.2f ms (max %.2f)", StatsHistory::name(s), h->mean(s), h->max(s));
+        ImGui::PlotLines("##h", values, count, offset, overlay, 0.0f, float(h->max(s) * 1.1 + 1e-3),
+                         ImVec2(ui(260), ui(s == StatsHistory::kFrame ? 40 : 24)));
+      }
     }
   }
   ImGui::End();
@@ -363,6 +484,7 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   ImGui::SetNextWindowSize(ImVec2(ui(380), 0), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("flashgs-viewer");
+  const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
   ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels
   scene_panel(m, a, path_buffer);
   view_panel(m, s, a);
@@ -375,6 +497,8 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   ImGui::PopItemWidth();
   ImGui::End();
   stats_window(m);
+  load_window(m, a);
+  hud_line(m, panel_right);
 }
 
 void draw_overlays(const UiModel& m, ViewerSettings& s) {

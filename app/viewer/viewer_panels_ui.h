@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "compare_mode.h"
 #include "heatmap_legend.h"
@@ -10,6 +11,13 @@
 #include "viewer_settings.h"
 
 namespace flashgs::viewer {
+
+// A background load's progress as the panels show it (totals of 0: not known yet).
+struct LoadView {
+  std::uint64_t bytes_done = 0, bytes_total = 0;
+  std::uint64_t gaussians_done = 0, gaussians_total = 0;
+  double elapsed_s = 0;
+};
 
 struct UiModel {
   std::string frame_path;         // the active presentation path
@@ -22,11 +30,15 @@ struct UiModel {
   std::string scene_note;         // loader report / cameras problem
   std::string load_error;         // the last failed load and what is shown instead, one sentence
   std::string loading;            // the file being loaded in the background, if any
+  LoadView load;                  // its progress
+  const std::vector<std::string>* recent = nullptr;  // recently opened scenes, newest first
   int current_camera = -1;        // the scene camera the view sits on, -1 when moved
   bool on_scene_camera = false;
   bool playing = false;
   int render_width = 0, render_height = 0;
-  double fps = 0;
+  double fps = 0;                 // finished frames per second over the last second (0: idle)
+  double last_frame_ms = 0;       // wall time of the last finished frame
+  bool rendering = false;         // a frame (or comparison) is being rendered in the background
   const FrameStats* stats = nullptr;
   const StatsHistory* history = nullptr;
   const CompareResult* compare = nullptr;

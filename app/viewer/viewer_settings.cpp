@@ -25,4 +25,6 @@ void keep_settings_valid(ViewerSettings& s, const ViewerSettings& before) {
   s.up_axis = std::clamp(s.up_axis, 0, kUpAxisCount - 1);
 }
 
+void switch_algorithm(RenderOptions& options, Algorithm to) { options.algorithm = to; }
+
 }  // namespace flashgs::viewer

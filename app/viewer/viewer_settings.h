@@ -70,4 +70,9 @@ struct ViewerSettings {
 // in `before`, anything else is clamped.
 void keep_settings_valid(ViewerSettings& settings, const ViewerSettings& before);
 
+// The one rule for switching between the baseline and flash (the B key, the radio buttons and
+// --algorithm): only the algorithm changes. The baseline ignores the optimisation switches, so
+// they stay as they were and come back with flash.
+void switch_algorithm(RenderOptions& options, Algorithm to);
+
 }  // namespace flashgs::viewer

@@ -86,8 +86,8 @@ void Window::resize(int width, int height) {
   query_sizes_and_cursor();
 }
 
-void Window::poll(bool wait_for_events) {
-  if (wait_for_events) glfwWaitEventsTimeout(0.25);
+void Window::poll(double max_wait_seconds) {
+  if (max_wait_seconds > 0) glfwWaitEventsTimeout(max_wait_seconds);
   else glfwPollEvents();
 }
 

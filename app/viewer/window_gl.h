@@ -29,7 +29,9 @@ class Window {
   // Asks for a new window size in screen points (the framebuffer follows once the window
   // system has done it).
   void resize(int width, int height);
-  void poll(bool wait_for_events);
+  // Handles pending events; with `max_wait_seconds` > 0 first waits up to that long for one
+  // (glfwPostEmptyEvent from another thread ends the wait).
+  void poll(double max_wait_seconds);
   // Framebuffer size in pixels (zero while minimised) and its ratio to window points (high DPI).
   // Sizes and the cursor are kept from GLFW's callbacks: querying them is an X server round
   // trip each (about 0.25 ms a frame on Xvfb for the four the frame loop needs).

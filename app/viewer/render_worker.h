@@ -1,0 +1,89 @@
+// RenderWorker: a thread that renders the newest requested view with a slow backend (the CPU), cancelling and restarting when the view changes, so the UI thread never waits for a frame.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "flashgs/camera.h"
+#include "flashgs/image.h"
+#include "flashgs/options.h"
+#include "flashgs/renderer.h"
+#include "flashgs/scene.h"
+#include "flashgs/stats.h"
+
+namespace flashgs::viewer {
+
+struct FrameRequest {
+  Camera camera;
+  RenderOptions options;
+  bool reduced = false;  // fewer pixels than the full frame (the view is moving)
+};
+
+struct FinishedFrame {
+  FrameRequest request;
+  Image image;
+  FrameStats stats;
+  double wall_ms = 0;  // the render's wall time on the worker
+  std::uint64_t id = 0;  // request() numbers its requests from 1
+  std::string error;  // non-empty: the render threw (out of memory, ...); image and stats are empty
+};
+
+class RenderWorker {
+ public:
+  // `on_finished` runs on the worker thread after each finished frame (the viewer wakes its
+  // event loop with it); it must not call back into the worker.
+  RenderWorker(std::unique_ptr<Renderer> renderer, std::function<void()> on_finished);
+  // Cancels the frame in flight and joins the thread.
+  ~RenderWorker();
+  RenderWorker(const RenderWorker&) = delete;
+  RenderWorker& operator=(const RenderWorker&) = delete;
+
+  // Asks for a frame; it replaces a request not yet started. With `cancel_in_flight` the frame
+  // rendering now stops early (Renderer::set_cancel_flag) and is dropped; a backend that
+  // cannot stop finishes it, and it is shown. Returns the request's id.
+  std::uint64_t request(const FrameRequest& request, bool cancel_in_flight = true);
+  // The newest finished frame since the last call (older ones are dropped unseen).
+  bool take(FinishedFrame* out);
+  // A frame requested and not yet finished.
+  bool busy() const;
+  // Blocks until no frame is requested or rendering (scripted runs: the frame they time).
+  void wait_until_idle();
+  // Makes `scene` the one rendered from the next frame on without waiting: the frame in flight
+  // stops (where the backend can), the worker sets the scene, then renders what is pending.
+  // A failure comes back from take() as a frame with `error` set.
+  void set_scene(std::shared_ptr<const Scene> scene);
+  // Runs `fn` with the renderer on the calling thread once no frame renders: the one in flight
+  // is cancelled and requested again afterwards. Thread-safe (set_scene from the UI thread,
+  // the comparison's renders from a task thread); exceptions from `fn` propagate.
+  void with_renderer(const std::function<void(Renderer&)>& fn);
+
+ private:
+  void loop();
+
+  std::unique_ptr<Renderer> m_renderer;
+  std::function<void()> m_on_finished;
+  std::mutex m_renderer_mutex;  // held while anything uses m_renderer
+  mutable std::mutex m_mutex;   // guards everything below
+  std::condition_variable m_wake, m_idle;
+  bool m_stop = false;
+  bool m_has_pending = false;
+  std::shared_ptr<const Scene> m_pending_scene;  // set before the next frame
+  FrameRequest m_pending;
+  std::uint64_t m_pending_id = 0, m_next_id = 1;
+  bool m_rendering = false;  // a frame of the worker's own is in flight
+  int m_waiting_users = 0;   // with_renderer() calls waiting or running
+  FrameRequest m_in_flight;
+  std::uint64_t m_in_flight_id = 0;
+  bool m_has_finished = false;
+  FinishedFrame m_finished;
+  std::atomic<bool> m_cancel{false};
+  std::thread m_thread;  // last: starts once everything above exists
+};
+
+}  // namespace flashgs::viewer

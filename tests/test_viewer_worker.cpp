@@ -1,0 +1,236 @@
+// The viewer's background rendering without a window: the render worker (newest request wins, cancel, restart), the rendered-FPS meter, the frame-path notes and the one baseline rule.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <atomic>
+#include <future>
+#include <mutex>
+#include <thread>
+#include <stdexcept>
+#include <vector>
+
+#include "camera_controller.h"
+#include "flashgs/generators.h"
+#include "path_note.h"
+#include "rate_meter.h"
+#include "render_worker.h"
+#include "viewer_settings.h"
+
+namespace fv = flashgs::viewer;
+
+namespace {
+
+// A renderer whose frames block until released (or cancelled through the flag, when it
+// honours it), recording the width of each frame it starts; width 13 throws.
+class GatedRenderer final : public flashgs::Renderer {
+ public:
+  explicit GatedRenderer(bool honours_cancel) : m_honours_cancel(honours_cancel) {}
+  std::string name() const override { return "gated"; }
+  void set_scene(std::shared_ptr<const flashgs::Scene>) override {}
+  void render(const flashgs::Camera& camera, const flashgs::RenderOptions&, flashgs::Image& out,
+              flashgs::FrameStats* stats) override {
+    std::unique_lock<std::mutex> lock(m_mutex);
+    m_started.push_back(camera.width);
+    m_changed.notify_all();
+    if (camera.width == 13) throw std::runtime_error("width 13 refused");
+    while (m_releases == 0) {
+      if (m_honours_cancel && cancel_requested()) {
+        stats->cancelled = true;
+        return;
+      }
+      m_changed.wait_for(lock, std::chrono::milliseconds(1));
+    }
+    --m_releases;
+    out.resize(camera.width, 1);
+  }
+  void release(int frames = 1) {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_releases += frames;
+    m_changed.notify_all();
+  }
+  // Waits (up to 30 s) until `count` frames have started; returns their widths.
+  std::vector<int> wait_started(std::size_t count) {
+    std::unique_lock<std::mutex> lock(m_mutex);
+    m_changed.wait_for(lock, std::chrono::seconds(30), [&] { return m_started.size() >= count; });
+    return m_started;
+  }
+
+ private:
+  bool m_honours_cancel;
+  std::mutex m_mutex;
+  std::condition_variable m_changed;
+  std::vector<int> m_started;
+  int m_releases = 0;
+};
+
+fv::FrameRequest request_of_width(int width) {
+  fv::FrameRequest r;
+  r.camera.width = width;
+  r.camera.height = 1;
+  return r;
+}
+
+}  // namespace
+
+TEST(ViewerRenderWorker, TheNewestRequestWinsAndTheOneInFlightIsCancelled) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  GatedRenderer* gated = owned.get();
+  int wakes = 0;
+  std::mutex wakes_mutex;
+  fv::RenderWorker worker(std::move(owned), [&] {
+    std::lock_guard<std::mutex> lock(wakes_mutex);
+    ++wakes;
+  });
+  worker.request(request_of_width(1));
+  ASSERT_EQ(gated->wait_started(1), std::vector<int>({1}));
+  EXPECT_TRUE(worker.busy());
+  // Two more while 1 renders: 1 is stopped, 2 is replaced before it starts, 3 renders.
+  worker.request(request_of_width(2));
+  const std::uint64_t id3 = worker.request(request_of_width(3));
+  ASSERT_EQ(gated->wait_started(2), std::vector<int>({1, 3}));
+  gated->release();
+  worker.wait_until_idle();
+  EXPECT_FALSE(worker.busy());
+  fv::FinishedFrame frame;
+  ASSERT_TRUE(worker.take(&frame));
+  EXPECT_EQ(frame.id, id3);
+  EXPECT_EQ(frame.image.width, 3);
+  EXPECT_TRUE(frame.error.empty());
+  EXPECT_FALSE(worker.take(&frame)) << "one frame finished, one delivered";
+  std::lock_guard<std::mutex> lock(wakes_mutex);
+  EXPECT_EQ(wakes, 1) << "the cancelled frame must not wake the viewer";
+}
+
+TEST(ViewerRenderWorker, ABackendThatCannotStopStillShowsItsFrame) {
+  auto owned = std::make_unique<GatedRenderer>(false);
+  GatedRenderer* gated = owned.get();
+  fv::RenderWorker worker(std::move(owned), nullptr);
+  worker.request(request_of_width(1));
+  gated->wait_started(1);
+  worker.request(request_of_width(2), /*cancel_in_flight=*/true);
+  gated->release();  // frame 1 completes although asked to stop
+  ASSERT_EQ(gated->wait_started(2), std::vector<int>({1, 2}));
+  fv::FinishedFrame frame;
+  EXPECT_TRUE(worker.take(&frame));
+  EXPECT_EQ(frame.image.width, 1) << "a finished frame is shown while the next one renders";
+  gated->release();
+  worker.wait_until_idle();
+  ASSERT_TRUE(worker.take(&frame));
+  EXPECT_EQ(frame.image.width, 2);
+}
+
+TEST(ViewerRenderWorker, UsingTheRendererMeanwhileRestartsTheFrameInFlight) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  GatedRenderer* gated = owned.get();
+  fv::RenderWorker worker(std::move(owned), nullptr);
+  worker.request(request_of_width(5));
+  gated->wait_started(1);
+  bool ran = false;
+  worker.with_renderer([&](flashgs::Renderer& r) {  // e.g. set_scene: runs once frame 5 stopped
+    EXPECT_EQ(r.name(), "gated");
+    ran = true;
+  });
+  EXPECT_TRUE(ran);
+  ASSERT_EQ(gated->wait_started(2), std::vector<int>({5, 5})) << "the stopped frame is rendered again";
+  gated->release();
+  worker.wait_until_idle();
+  fv::FinishedFrame frame;
+  ASSERT_TRUE(worker.take(&frame));
+  EXPECT_EQ(frame.image.width, 5);
+}
+
+TEST(ViewerRenderWorker, AFailingFrameIsDeliveredWithItsError) {
+  fv::RenderWorker worker(std::make_unique<GatedRenderer>(true), nullptr);
+  worker.request(request_of_width(13));
+  worker.wait_until_idle();
+  fv::FinishedFrame frame;
+  ASSERT_TRUE(worker.take(&frame));
+  EXPECT_EQ(frame.error, "width 13 refused");
+}
+
+TEST(ViewerRenderWorker, DestroyingItStopsTheFrameInFlight) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  GatedRenderer* gated = owned.get();
+  auto worker = std::make_unique<fv::RenderWorker>(std::move(owned), nullptr);
+  worker->request(request_of_width(7));
+  gated->wait_started(1);
+  worker.reset();  // returns: the frame saw the cancel flag (else this test hangs)
+  SUCCEED();
+}
+
+TEST(ViewerRateMeter, CountsEventsPerSecondAndFallsToZero) {
+  fv::RateMeter meter;
+  EXPECT_EQ(meter.rate(0.0), 0.0);
+  for (int i = 0; i <= 10; ++i) meter.record(10.0 + 0.1 * i);  // 10 per second
+  EXPECT_NEAR(meter.rate(11.0), 10.0, 0.01);
+  EXPECT_EQ(meter.rate(12.5), 0.0) << "no frames in the last second: idle, not the old rate";
+}
+
+TEST(ViewerPathNote, TheDriverTextBecomesPlainWords) {
+  EXPECT_EQ(fv::plain_path_note("no usable CUDA device (cudaGetDeviceCount: CUDA driver version is insufficient for "
+                                "CUDA runtime version)"),
+            "no NVIDIA GPU found: rendering on the CPU");
+  EXPECT_EQ(fv::plain_path_note("this build has no CUDA backend"), "built without CUDA: rendering on the CPU");
+  EXPECT_EQ(fv::plain_path_note(""), "");
+  EXPECT_EQ(fv::plain_path_note("something new"), "something new");
+}
+
+// B then the Flash radio (before: B replaced every switch by the baseline's "off", so flash
+// came back with every optimisation off).
+TEST(ViewerSettings, SwitchingToTheBaselineAndBackKeepsTheSwitches) {
+  flashgs::RenderOptions o;
+  o.tight_bbox = false;  // a user's choice
+  const flashgs::RenderOptions before = o;
+  fv::switch_algorithm(o, flashgs::Algorithm::baseline);
+  EXPECT_TRUE(o.is_baseline());
+  EXPECT_FALSE(o.uses_opacity_radius()) << "the baseline uses none of the optimisations";
+  fv::switch_algorithm(o, flashgs::Algorithm::flash);
+  EXPECT_TRUE(o == before);
+}
+
+TEST(ViewerNavigation, ExactOnlyAtTheSceneCamerasAspect) {
+  const float target[3] = {0, 0, 0}, up[3] = {0, 1, 0};
+  const auto cameras = flashgs::make_orbit_cameras(target, up, 3.0f, 1.0f, 4, 1920, 1080, 60.0f);
+  fv::CameraController c;
+  c.reset(glm::vec3(0.0f), 1.0f, glm::vec3(0, 1, 0));
+  c.snap_to(cameras[1]);
+  const float fov = cameras[1].horizontal_fov_degrees();
+  EXPECT_TRUE(c.exact_scene_camera(640, 360, fov));
+  EXPECT_FALSE(c.exact_scene_camera(1280, 800, fov)) << "16:10 is the pose, not the camera";
+  EXPECT_FALSE(c.exact_scene_camera(640, 360, fov + 5.0f));
+}
+
+// A new scene does not wait for the frame in flight, even on a backend that cannot stop it
+// (before, set_scene waited for the renderer: the window froze for a whole CPU frame).
+TEST(ViewerRenderWorker, ANewSceneDoesNotWaitForTheFrameInFlight) {
+  class SceneRecorder final : public flashgs::Renderer {
+   public:
+    std::string name() const override { return "scenes"; }
+    void set_scene(std::shared_ptr<const flashgs::Scene> scene) override { m_scene = scene; }
+    void render(const flashgs::Camera& camera, const flashgs::RenderOptions&, flashgs::Image& out,
+                flashgs::FrameStats*) override {
+      while (!released) std::this_thread::sleep_for(std::chrono::milliseconds(1));  // ignores the cancel flag
+      out.resize(camera.width, m_scene ? int(m_scene->size()) : 0);
+    }
+    std::shared_ptr<const flashgs::Scene> m_scene;
+    std::atomic<bool> released{false};
+  };
+  auto owned = std::make_unique<SceneRecorder>();
+  SceneRecorder* recorder = owned.get();
+  fv::RenderWorker worker(std::move(owned), nullptr);
+  worker.request(request_of_width(4));
+  auto scene = std::make_shared<flashgs::Scene>();
+  scene->opacities.resize(3);  // size() counts opacities
+  auto call = std::async(std::launch::async, [&] { worker.set_scene(scene); });
+  const bool returned = call.wait_for(std::chrono::seconds(5)) == std::future_status::ready;
+  recorder->released = true;
+  call.wait();
+  EXPECT_TRUE(returned) << "set_scene waited for the frame in flight";
+  worker.request(request_of_width(6));
+  worker.wait_until_idle();
+  fv::FinishedFrame frame;
+  ASSERT_TRUE(worker.take(&frame));
+  EXPECT_EQ(frame.image.width, 6);
+  EXPECT_EQ(frame.image.height, 3) << "rendered with the new scene";
+}
