@@ -1,5 +1,10 @@
-// CPU blend stage: front-to-back alpha compositing of each tile's sorted Gaussians.
-#include <cmath>
+// CPU blend stage: schedules the tiles (densest first) over the threads and runs a kernel on each.
+#include <algorithm>
+#include <atomic>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "cpu_frame.h"
 #include "parallel_errors.h"
@@ -8,92 +13,64 @@ namespace flashgs {
 namespace cpu {
 namespace {
 
-constexpr int kTilePixels = gm::kTileSize * gm::kTileSize;
-
-// Composites one tile. Gaussian-outer, pixel-inner: each Gaussian is read once per tile and
-// the pixel loop runs over contiguous arrays. Per pixel the rules are those of 3DGS:
-// alpha = min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4.
-void blend_tile(const Frame& frame, const std::uint64_t* keys, std::uint64_t count, int tile_x,
-                int tile_y, const float background[3], float* rgb) {
-  const int width = frame.camera.width, height = frame.camera.height;
-  const int x_begin = tile_x * gm::kTileSize, y_begin = tile_y * gm::kTileSize;
-  const int tile_w = std::min(gm::kTileSize, width - x_begin);
-  const int tile_h = std::min(gm::kTileSize, height - y_begin);
-  float transmittance[kTilePixels];
-  float color[kTilePixels][3];
-  bool active[kTilePixels];
-  int active_count = tile_w * tile_h;
-  for (int p = 0; p < kTilePixels; ++p) {
-    transmittance[p] = 1.0f;
-    color[p][0] = color[p][1] = color[p][2] = 0.0f;
-    active[p] = true;
-  }
-  for (std::uint64_t k = 0; k < count && active_count > 0; ++k) {
-    const BlendGaussian& g = frame.blend_data[static_cast<std::uint32_t>(keys[k])];
-    // Only the rows, and in each row the pixels, that can reach power_cut; the margins (0.5
-    // in q, one pixel each side) exceed the float rounding of the per-pixel power, so pruning
-    // never changes which pixels pass the exact test below.
-    const float reach_y = g.row_q_coeff > 0.0f ? std::sqrt((g.q_cut + 0.5f) / g.row_q_coeff) + 1.0f : 1e30f;
-    const float local_y = g.mean_y - static_cast<float>(y_begin);
-    const int y_first = static_cast<int>(std::max(0.0f, std::ceil(local_y - reach_y)));
-    const int y_last = static_cast<int>(std::min(static_cast<float>(tile_h - 1), std::floor(local_y + reach_y)));
-    for (int y = y_first; y <= y_last; ++y) {
-      const float dy = static_cast<float>(y_begin + y) - g.mean_y;
-      const float row_q = g.row_q_coeff * dy * dy;
-      if (!(row_q <= g.q_cut + 0.5f)) continue;
-      const float centre = g.mean_x + g.row_slope * dy - static_cast<float>(x_begin);
-      const float half = std::sqrt(std::max(0.0f, g.q_cut + 0.5f - row_q) * g.inv_conic_a) + 1.0f;
-      const float u_row = g.whiten[1] * dy, v_row = g.whiten[3] * dy;
-      const int x0 = static_cast<int>(std::max(0.0f, std::ceil(centre - half)));
-      const int x1 = static_cast<int>(std::min(static_cast<float>(tile_w - 1), std::floor(centre + half)));
-      for (int x = x0; x <= x1; ++x) {
-        const int p = y * gm::kTileSize + x;
-        if (!active[p]) continue;
-        const float dx = static_cast<float>(x_begin + x) - g.mean_x;
-        // Whitened form (gm::Footprint::whiten): q >= 0 by construction and accurate far
-        // along a needle, so 3DGS's "skip power > 0" (which only rounding could trigger, on a
-        // needle's axis, dropping its most opaque pixels) is gone.
-        const float u = g.whiten[0] * dx + u_row, v = g.whiten[2] * dx + v_row;
-        const float power = -0.5f * (u * u + v * v);
-        if (power < g.power_cut) continue;
-        const float alpha = std::min(gm::kAlphaMax, g.opacity * std::exp(power));
-        if (alpha < gm::kAlphaMin) continue;
-        const float next_t = transmittance[p] * (1.0f - alpha);
-        if (next_t < gm::kTransmittanceMin) {
-          active[p] = false;
-          --active_count;
-          continue;
-        }
-        const float weight = alpha * transmittance[p];
-        color[p][0] += g.rgb[0] * weight;
-        color[p][1] += g.rgb[1] * weight;
-        color[p][2] += g.rgb[2] * weight;
-        transmittance[p] = next_t;
-      }
-    }
-  }
-  for (int y = 0; y < tile_h; ++y)
-    for (int x = 0; x < tile_w; ++x) {
-      const int p = y * gm::kTileSize + x;
-      float* out = rgb + (static_cast<std::size_t>(y_begin + y) * width + x_begin + x) * 3;
-      for (int ch = 0; ch < 3; ++ch) out[ch] = color[p][ch] + transmittance[p] * background[ch];
-    }
+// Tiles by pair count, most first (ties by index), so the long tiles start at once and the
+// short ones fill in at the end instead of one core finishing a dense tile alone.
+void order_tiles_by_pairs(Frame& frame, std::size_t tiles) {
+  frame.tile_order.resize(tiles);
+  for (std::size_t i = 0; i < tiles; ++i) frame.tile_order[i] = static_cast<std::uint32_t>(i);
+  const std::uint64_t* start = frame.tile_start.data();
+  std::sort(frame.tile_order.begin(), frame.tile_order.end(), [start](std::uint32_t a, std::uint32_t b) {
+    const std::uint64_t pairs_a = start[a + 1] - start[a], pairs_b = start[b + 1] - start[b];
+    return pairs_a != pairs_b ? pairs_a > pairs_b : a < b;
+  });
 }
 
 }  // namespace
 
-void blend(const RenderOptions& options, Frame& frame, float* rgb) {
+void TileGaussians::grow(std::size_t n) {
+  if (mean_x.size() >= n) return;
+  for (std::vector<float>* v : {&mean_x, &mean_y, &whiten0, &whiten1, &whiten2, &whiten3, &opacity, &red, &green,
+                                &blue, &power_cut, &row_q_coeff, &q_cut, &row_slope, &inv_conic_a})
+    v->resize(n);
+  row_first.resize(n);
+  row_last.resize(n);
+}
+
+bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const std::function<bool()>& cancelled,
+           float* rgb) {
   const int tiles_x = frame.camera.tiles_x;
-  const std::int64_t tiles = static_cast<std::int64_t>(tiles_x) * frame.camera.tiles_y;
+  const std::size_t tiles = static_cast<std::size_t>(tiles_x) * frame.camera.tiles_y;
+  order_tiles_by_pairs(frame, tiles);
+  if (frame.tile_gaussians.size() < static_cast<std::size_t>(frame.threads)) frame.tile_gaussians.resize(frame.threads);
+
+  std::atomic<bool> stop{false};
   ParallelErrors errors;
-#pragma omp parallel for schedule(dynamic, 4) num_threads(frame.threads)
-  for (std::int64_t tile = 0; tile < tiles; ++tile)
+  const std::int64_t count = static_cast<std::int64_t>(tiles);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(frame.threads)
+  for (std::int64_t i = 0; i < count; ++i)
     errors.capture([&] {
+      if (stop.load(std::memory_order_relaxed)) return;
+      if (cancelled && cancelled()) {
+        stop.store(true, std::memory_order_relaxed);
+        return;
+      }
+      const std::uint32_t tile = frame.tile_order[i];
       const std::uint64_t begin = frame.tile_start[tile], end = frame.tile_start[tile + 1];
-      blend_tile(frame, frame.sorted_keys.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
-                 static_cast<int>(tile / tiles_x), options.background, rgb);
+      const TileJob job{frame.sorted_keys.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
+                        static_cast<int>(tile / tiles_x), options.background};
+      if (kernel == BlendKernel::scalar) {
+        blend_tile_scalar(frame, job, rgb);
+      } else {
+#ifdef _OPENMP
+        const int thread = omp_get_thread_num();
+#else
+        const int thread = 0;
+#endif
+        blend_tile_simd(frame, job, frame.tile_gaussians[thread], rgb);
+      }
     });
   errors.rethrow();
+  return !stop.load();
 }
 
 }  // namespace cpu

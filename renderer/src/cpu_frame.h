@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "flashgs/gaussian_math.h"
@@ -29,6 +31,16 @@ struct BlendGaussian {
   float inv_conic_a;
 };
 
+// One tile's Gaussians in blend order as structure of arrays, gathered from blend_data: the
+// SIMD kernel reads each field as a contiguous stream (broadcast per Gaussian) and computes
+// the row range of several Gaussians per vector. One per thread; vectors only grow.
+struct TileGaussians {
+  std::vector<float> mean_x, mean_y, whiten0, whiten1, whiten2, whiten3, opacity, red, green, blue, power_cut,
+      row_q_coeff, q_cut, row_slope, inv_conic_a;
+  std::vector<std::int32_t> row_first, row_last;  // rows of the tile that can reach power_cut
+  void grow(std::size_t n);
+};
+
 // Reused from frame to frame; vectors only grow (high-water mark), nothing is freed.
 struct Frame {
   gm::CameraParams camera{};
@@ -49,13 +61,35 @@ struct Frame {
 
   std::vector<std::uint64_t> tile_start;   // [tiles + 1] offsets into sorted_keys
   std::vector<std::uint64_t> sorted_keys;  // [pairs], tile-major, (depth, id) within a tile
+
+  std::vector<std::uint32_t> tile_order;       // [tiles] the blend's schedule: most pairs first
+  std::vector<TileGaussians> tile_gaussians;   // [threads] the SIMD blend's per-tile gather
+};
+
+// One tile for a blend kernel: its sorted keys and where it lies in the image.
+struct TileJob {
+  const std::uint64_t* keys;
+  std::uint64_t count;
+  int tile_x, tile_y;
+  const float* background;  // [3]
 };
 
 void project(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats);
 void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats);
 // Sorts by tile, then depth, then Gaussian id; fills tile_start (the ranges stage).
 void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms);
-void blend(const RenderOptions& options, Frame& frame, float* rgb);
+// Which kernel composites the tiles.
+enum class BlendKernel { simd, scalar };
+// Blends every tile, densest first. `cancelled` is asked between tiles; once it says yes the
+// remaining tiles are left as they are and blend returns false.
+bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const std::function<bool()>& cancelled,
+           float* rgb);
+// The scalar reference kernel (cpu_blend_scalar.cpp) and the SIMD one (cpu_blend_simd.cpp;
+// without Highway it is the scalar one). Both write the tile's pixels of `rgb`.
+void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb);
+void blend_tile_simd(const Frame& frame, const TileJob& tile, TileGaussians& scratch, float* rgb);
+// The SIMD target blend_tile_simd runs on this CPU ("AVX2", "AVX3", ...; "scalar" without Highway).
+std::string simd_target_name();
 
 }  // namespace cpu
 }  // namespace flashgs

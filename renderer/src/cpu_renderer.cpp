@@ -1,6 +1,7 @@
 // The CPU backend: runs the stages in order, times them, fills FrameStats.
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <new>
 #include <thread>
 
@@ -19,7 +20,9 @@ namespace {
 
 class CpuRenderer final : public Renderer {
  public:
-  explicit CpuRenderer(int threads) {
+  CpuRenderer(int threads, CpuBlend blend)
+      : kernel_(blend == CpuBlend::scalar ? cpu::BlendKernel::scalar : cpu::BlendKernel::simd),
+        kernel_name_(blend == CpuBlend::scalar ? "scalar" : cpu::simd_target_name()) {
 #ifdef _OPENMP
     frame_.threads = threads > 0 ? threads : omp_get_max_threads();
 #else
@@ -27,7 +30,9 @@ class CpuRenderer final : public Renderer {
     frame_.threads = 1;
 #endif
   }
-  std::string name() const override { return "cpu (" + std::to_string(frame_.threads) + " threads)"; }
+  std::string name() const override {
+    return "cpu (" + std::to_string(frame_.threads) + " threads, " + kernel_name_ + " blend)";
+  }
   void set_scene(std::shared_ptr<const Scene> scene) override { scene_ = std::move(scene); }
 
   void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats_out) override {
@@ -62,19 +67,31 @@ class CpuRenderer final : public Renderer {
     stats.tiles_x = frame_.camera.tiles_x;
     stats.tiles_y = frame_.camera.tiles_y;
 
+    // A cancelled frame stops between stages or between tiles and returns what it has.
+    auto finish_cancelled = [&] {
+      stats.cancelled = true;
+      stats.times.total_ms = ms_since(start);
+      if (stats_out) *stats_out = std::move(stats);
+    };
+    const std::function<bool()> cancelled = [this] { return cancel_requested(); };
+
     auto t = Clock::now();
     cpu::project(*scene_, options, frame_, stats);
     stats.times.project_ms = ms_since(t);
+    if (cancelled()) return finish_cancelled();
     t = Clock::now();
     cpu::emit(*scene_, options, frame_, stats);
     stats.times.emit_ms = ms_since(t);
+    if (cancelled()) return finish_cancelled();
     t = Clock::now();
     cpu::sort_by_tile(frame_, stats, &stats.times.ranges_ms);
     stats.times.sort_ms = ms_since(t) - stats.times.ranges_ms;
+    if (cancelled()) return finish_cancelled();
     t = Clock::now();
     if (out.width != camera.width || out.height != camera.height) out.resize(camera.width, camera.height);
-    cpu::blend(options, frame_, out.rgb.data());
+    const bool complete = cpu::blend(options, frame_, kernel_, cancelled, out.rgb.data());
     stats.times.blend_ms = ms_since(t);
+    if (!complete) return finish_cancelled();
     stats.times.total_ms = ms_since(start);
 
     if (options.collect_tile_counts) {
@@ -88,11 +105,15 @@ class CpuRenderer final : public Renderer {
 
  private:
   std::shared_ptr<const Scene> scene_;
+  const cpu::BlendKernel kernel_;
+  const std::string kernel_name_;  // the SIMD target, or "scalar"
   cpu::Frame frame_;
 };
 
 }  // namespace
 
-std::unique_ptr<Renderer> make_cpu_renderer(int threads) { return std::make_unique<CpuRenderer>(threads); }
+std::unique_ptr<Renderer> make_cpu_renderer(int threads, CpuBlend blend) {
+  return std::make_unique<CpuRenderer>(threads, blend);
+}
 
 }  // namespace flashgs

@@ -40,7 +40,11 @@ class Renderer {
   const std::atomic<bool>* m_cancel_flag = nullptr;
 };
 
+// How the CPU backend composites its tiles: SIMD (the widest vectors this CPU has, chosen at
+// run time) or the scalar reference kernel the SIMD one is tested against.
+enum class CpuBlend { simd, scalar };
+
 // The multi-threaded CPU backend; `threads` = 0 uses every core.
-std::unique_ptr<Renderer> make_cpu_renderer(int threads = 0);
+std::unique_ptr<Renderer> make_cpu_renderer(int threads = 0, CpuBlend blend = CpuBlend::simd);
 
 }  // namespace flashgs

@@ -1,0 +1,233 @@
+// CPU blend, SIMD kernel: the scalar kernel's rules on a vector of pixels of one tile row at a
+// time (Google Highway, compiled for every x86 target and dispatched at run time).
+//
+// Per pixel it runs the scalar kernel's operations in the same order, with one exception: the
+// exponential is Highway's (max error 1 ulp; glibc's expf is correctly rounded in practice).
+// Such an ulp can move alpha across 1/255 or T across 1e-4, the same flips as between the CPU
+// and CUDA (see test_cuda_render.cpp), so the images differ from the scalar kernel's by no more
+// than that bound; test_cpu_render.cpp measures it. For a given CPU (target) and any thread
+// count the bytes are the same.
+#include <algorithm>
+#include <cmath>
+
+#include "cpu_frame.h"
+
+#ifdef FLASHGS_HAVE_HWY
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "cpu_blend_simd.cpp"
+#include <hwy/foreach_target.h>  // re-includes this file once per target
+#include <hwy/highway.h>
+#include <hwy/cache_control.h>
+#include <hwy/contrib/math/math-inl.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace flashgs {
+namespace cpu {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+constexpr int kTilePixels = gm::kTileSize * gm::kTileSize;
+// A vector covers consecutive pixels of one tile row: 16 lanes (AVX-512) are a row, 8 (AVX2) half.
+using FloatTag = hn::CappedTag<float, gm::kTileSize>;
+
+// Copies the tile's Gaussians, in blend order, into structure of arrays (prefetching the
+// ones a few keys ahead, which lie anywhere in blend_data), then finds each one's rows: the
+// scalar kernel's y_first / y_last, several Gaussians per vector.
+void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, TileGaussians& g) {
+  const FloatTag d;
+  const hn::RebindToSigned<FloatTag> di;
+  const std::size_t lanes = hn::Lanes(d);
+  const std::size_t count = static_cast<std::size_t>(job.count);
+  const std::size_t padded = (count + lanes - 1) / lanes * lanes;
+  g.grow(padded);
+  constexpr std::size_t kPrefetchAhead = 8;
+  for (std::size_t k = 0; k < padded; ++k) {
+    if (k >= count) {  // the last vector's spare lanes: finite values, results unused
+      g.mean_y[k] = g.row_q_coeff[k] = g.q_cut[k] = 0.0f;
+      continue;
+    }
+    if (k + kPrefetchAhead < count) hwy::Prefetch(&frame.blend_data[static_cast<std::uint32_t>(job.keys[k + kPrefetchAhead])]);
+    const BlendGaussian& b = frame.blend_data[static_cast<std::uint32_t>(job.keys[k])];
+    g.mean_x[k] = b.mean_x;
+    g.mean_y[k] = b.mean_y;
+    g.whiten0[k] = b.whiten[0];
+    g.whiten1[k] = b.whiten[1];
+    g.whiten2[k] = b.whiten[2];
+    g.whiten3[k] = b.whiten[3];
+    g.opacity[k] = b.opacity;
+    g.red[k] = b.rgb[0];
+    g.green[k] = b.rgb[1];
+    g.blue[k] = b.rgb[2];
+    g.power_cut[k] = b.power_cut;
+    g.row_q_coeff[k] = b.row_q_coeff;
+    g.q_cut[k] = b.q_cut;
+    g.row_slope[k] = b.row_slope;
+    g.inv_conic_a[k] = b.inv_conic_a;
+  }
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), half = hn::Set(d, 0.5f);
+  const auto top = hn::Set(d, static_cast<float>(y_begin)), last_row = hn::Set(d, static_cast<float>(tile_h - 1));
+  for (std::size_t k = 0; k < padded; k += lanes) {
+    const auto coeff = hn::LoadU(d, &g.row_q_coeff[k]);
+    const auto q_reach = hn::Add(hn::LoadU(d, &g.q_cut[k]), half);
+    const auto local_y = hn::Sub(hn::LoadU(d, &g.mean_y[k]), top);
+    // As the scalar kernel: reach = sqrt((q_cut + 0.5) / coeff) + 1, or everything when coeff is 0.
+    const auto reach = hn::IfThenElse(hn::Gt(coeff, zero), hn::Add(hn::Sqrt(hn::Div(q_reach, coeff)), one),
+                                      hn::Set(d, 1e30f));
+    auto first = hn::Max(zero, hn::Ceil(hn::Sub(local_y, reach)));
+    auto last = hn::Min(last_row, hn::Floor(hn::Add(local_y, reach)));
+    // q_cut + 0.5 < 0 (opacity < 1/255, drawn by the baseline): no pixel passes, no row.
+    const auto none = hn::Not(hn::Ge(q_reach, zero));
+    first = hn::IfThenElse(none, one, first);
+    last = hn::IfThenElse(none, zero, last);
+    hn::StoreU(hn::ConvertTo(di, first), di, &g.row_first[k]);
+    hn::StoreU(hn::ConvertTo(di, last), di, &g.row_last[k]);
+  }
+}
+
+void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, float* rgb) {
+  const FloatTag d;
+  const std::size_t lanes = hn::Lanes(d);
+  const int groups_per_row = gm::kTileSize / static_cast<int>(lanes);
+  const int width = frame.camera.width, height = frame.camera.height;
+  const int x_begin = job.tile_x * gm::kTileSize, y_begin = job.tile_y * gm::kTileSize;
+  const int tile_w = std::min(gm::kTileSize, width - x_begin);
+  const int tile_h = std::min(gm::kTileSize, height - y_begin);
+
+  // Per pixel: transmittance, colour, and whether it still blends (all bits set) - pixels
+  // outside the image start finished. A lane group (one vector) whose pixels have all finished
+  // is skipped, a row with no live group too, and the tile stops when none is left.
+  HWY_ALIGN float transmittance[kTilePixels], red[kTilePixels], green[kTilePixels], blue[kTilePixels];
+  HWY_ALIGN float active[kTilePixels];
+  bool group_live[kTilePixels];
+  int row_live[gm::kTileSize];
+  int live_groups = 0;
+  const auto tile_width = hn::Set(d, static_cast<float>(tile_w));
+  for (int y = 0; y < gm::kTileSize; ++y) {
+    row_live[y] = 0;
+    for (int v = 0; v < groups_per_row; ++v) {
+      const int p = y * gm::kTileSize + v * static_cast<int>(lanes);
+      const auto inside = hn::And(hn::Lt(hn::Iota(d, static_cast<float>(p - y * gm::kTileSize)), tile_width),
+                                  y < tile_h ? hn::FirstN(d, lanes) : hn::FirstN(d, 0));
+      hn::Store(hn::Set(d, 1.0f), d, transmittance + p);
+      hn::Store(hn::Zero(d), d, red + p);
+      hn::Store(hn::Zero(d), d, green + p);
+      hn::Store(hn::Zero(d), d, blue + p);
+      hn::Store(hn::VecFromMask(d, inside), d, active + p);
+      group_live[y * groups_per_row + v] = !hn::AllFalse(d, inside);
+      row_live[y] += group_live[y * groups_per_row + v];
+    }
+    live_groups += row_live[y];
+  }
+
+  if (job.count > 0) gather(frame, job, y_begin, tile_h, g);
+  const auto one = hn::Set(d, 1.0f), minus_half = hn::Set(d, -0.5f);
+  const auto alpha_max = hn::Set(d, gm::kAlphaMax), alpha_min = hn::Set(d, gm::kAlphaMin);
+  const auto t_min = hn::Set(d, gm::kTransmittanceMin);
+  for (std::uint64_t k = 0; k < job.count && live_groups > 0; ++k) {
+    const int y_first = g.row_first[k], y_last = g.row_last[k];
+    if (y_first > y_last) continue;
+    const float mean_x = g.mean_x[k], mean_y = g.mean_y[k];
+    const float q_reach = g.q_cut[k] + 0.5f;
+    const auto centre_x = hn::Set(d, mean_x), w0 = hn::Set(d, g.whiten0[k]), w2 = hn::Set(d, g.whiten2[k]);
+    const auto opacity = hn::Set(d, g.opacity[k]), power_cut = hn::Set(d, g.power_cut[k]);
+    const auto r = hn::Set(d, g.red[k]), gr = hn::Set(d, g.green[k]), b = hn::Set(d, g.blue[k]);
+    for (int y = y_first; y <= y_last; ++y) {
+      if (row_live[y] == 0) continue;
+      // The scalar kernel's row span, computed the same way.
+      const float dy = static_cast<float>(y_begin + y) - mean_y;
+      const float row_q = g.row_q_coeff[k] * dy * dy;
+      if (!(row_q <= q_reach)) continue;
+      const float centre = mean_x + g.row_slope[k] * dy - static_cast<float>(x_begin);
+      const float half = std::sqrt(std::max(0.0f, q_reach - row_q) * g.inv_conic_a[k]) + 1.0f;
+      const int x0 = static_cast<int>(std::max(0.0f, std::ceil(centre - half)));
+      const int x1 = static_cast<int>(std::min(static_cast<float>(tile_w - 1), std::floor(centre + half)));
+      if (x0 > x1) continue;
+      const auto u_row = hn::Set(d, g.whiten1[k] * dy), v_row = hn::Set(d, g.whiten3[k] * dy);
+      const auto span_lo = hn::Set(d, static_cast<float>(x0)), span_hi = hn::Set(d, static_cast<float>(x1));
+      for (int v = x0 / static_cast<int>(lanes); v <= x1 / static_cast<int>(lanes); ++v) {
+        const int group = y * groups_per_row + v;
+        if (!group_live[group]) continue;
+        const int local_x = v * static_cast<int>(lanes);
+        const int p = y * gm::kTileSize + local_x;
+        const auto x = hn::Iota(d, static_cast<float>(local_x));
+        const auto dx = hn::Sub(hn::Iota(d, static_cast<float>(x_begin + local_x)), centre_x);
+        const auto u = hn::Add(hn::Mul(w0, dx), u_row), w = hn::Add(hn::Mul(w2, dx), v_row);
+        const auto power = hn::Mul(minus_half, hn::Add(hn::Mul(u, u), hn::Mul(w, w)));
+        auto live = hn::MaskFromVec(hn::Load(d, active + p));
+        auto blends = hn::And(hn::And(live, hn::Ge(power, power_cut)),
+                              hn::And(hn::Ge(x, span_lo), hn::Le(x, span_hi)));
+        if (hn::AllFalse(d, blends)) continue;
+        const auto alpha = hn::Min(alpha_max, hn::Mul(opacity, hn::Exp(d, power)));
+        blends = hn::And(blends, hn::Ge(alpha, alpha_min));
+        if (hn::AllFalse(d, blends)) continue;
+        const auto t = hn::Load(d, transmittance + p);
+        const auto next_t = hn::Mul(t, hn::Sub(one, alpha));
+        const auto finished = hn::And(blends, hn::Lt(next_t, t_min));
+        if (!hn::AllFalse(d, finished)) {
+          live = hn::AndNot(finished, live);
+          hn::Store(hn::VecFromMask(d, live), d, active + p);
+          blends = hn::AndNot(finished, blends);
+          if (hn::AllFalse(d, live)) {
+            group_live[group] = false;
+            --row_live[y];
+            --live_groups;
+          }
+        }
+        const auto weight = hn::Mul(alpha, t);
+        const auto red_p = hn::Load(d, red + p), green_p = hn::Load(d, green + p), blue_p = hn::Load(d, blue + p);
+        hn::Store(hn::IfThenElse(blends, hn::Add(red_p, hn::Mul(r, weight)), red_p), d, red + p);
+        hn::Store(hn::IfThenElse(blends, hn::Add(green_p, hn::Mul(gr, weight)), green_p), d, green + p);
+        hn::Store(hn::IfThenElse(blends, hn::Add(blue_p, hn::Mul(b, weight)), blue_p), d, blue + p);
+        hn::Store(hn::IfThenElse(blends, next_t, t), d, transmittance + p);
+      }
+    }
+  }
+  const float* background = job.background;
+  for (int y = 0; y < tile_h; ++y)
+    for (int x = 0; x < tile_w; ++x) {
+      const int p = y * gm::kTileSize + x;
+      float* out = rgb + (static_cast<std::size_t>(y_begin + y) * width + x_begin + x) * 3;
+      out[0] = red[p] + transmittance[p] * background[0];
+      out[1] = green[p] + transmittance[p] * background[1];
+      out[2] = blue[p] + transmittance[p] * background[2];
+    }
+}
+
+const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace cpu
+}  // namespace flashgs
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace flashgs {
+namespace cpu {
+
+HWY_EXPORT(BlendTileSimd);
+HWY_EXPORT(TargetName);
+
+void blend_tile_simd(const Frame& frame, const TileJob& tile, TileGaussians& scratch, float* rgb) {
+  HWY_DYNAMIC_DISPATCH(BlendTileSimd)(frame, tile, scratch, rgb);
+}
+
+std::string simd_target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
+
+}  // namespace cpu
+}  // namespace flashgs
+#endif  // HWY_ONCE
+
+#else  // no Highway: the scalar kernel
+
+namespace flashgs {
+namespace cpu {
+
+void blend_tile_simd(const Frame& frame, const TileJob& tile, TileGaussians&, float* rgb) {
+  blend_tile_scalar(frame, tile, rgb);
+}
+
+std::string simd_target_name() { return "scalar"; }
+
+}  // namespace cpu
+}  // namespace flashgs
+#endif

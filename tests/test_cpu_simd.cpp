@@ -1,0 +1,169 @@
+// The CPU backend's SIMD blend against its scalar reference kernel, cancelling a render from
+// another thread, and rendering at another resolution with the same renderer.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <future>
+#include <thread>
+
+#include "flashgs/generators.h"
+#include "flashgs/renderer.h"
+#include "test_support.h"
+
+namespace flashgs {
+namespace {
+
+// The SIMD kernel runs the scalar kernel's operations except exp (Highway's, 1 ulp, vs
+// glibc's): the same flips of alpha across 1/255 or T across 1e-4 as between the CPU and CUDA
+// backends, hence test_cuda_render.cpp's bound: max 1/64, and 99.99% of the values within 1e-3.
+constexpr double kMaxAbs = 1.0 / 64.0;
+constexpr double kTypicalAbs = 1e-3;
+constexpr double kTypicalFraction = 1e-4;
+
+struct Frame {
+  Image image;
+  FrameStats stats;
+};
+
+Frame render(const std::shared_ptr<const Scene>& scene, const Camera& camera, const RenderOptions& options,
+             CpuBlend blend, int threads = 0) {
+  auto renderer = make_cpu_renderer(threads, blend);
+  renderer->set_scene(scene);
+  Frame f;
+  renderer->render(camera, options, f.image, &f.stats);
+  return f;
+}
+
+double fraction_over(const Image& a, const Image& b, double tol) {
+  std::size_t over = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) over += std::abs(double(a.rgb[i]) - b.rgb[i]) > tol;
+  return a.rgb.empty() ? 0.0 : double(over) / double(a.rgb.size());
+}
+
+void expect_simd_matches_scalar(const std::shared_ptr<const Scene>& scene, const Camera& camera,
+                                const std::string& what) {
+  for (const RenderOptions& options : {RenderOptions{}, RenderOptions::baseline()}) {
+    const Frame scalar = render(scene, camera, options, CpuBlend::scalar);
+    const Frame simd = render(scene, camera, options, CpuBlend::simd);
+    const ImageDifference d = compare_images(scalar.image, simd.image);
+    const double typical = fraction_over(scalar.image, simd.image, kTypicalAbs);
+    std::printf("%-24s %-8s %dx%d: SIMD vs scalar max abs %.2e, PSNR %.1f dB, >1e-3: %.2e\n", what.c_str(),
+                options.label().c_str(), camera.width, camera.height, d.max_abs, d.psnr_db, typical);
+    EXPECT_EQ(simd.stats.kv_pairs, scalar.stats.kv_pairs) << what;
+    EXPECT_EQ(d.non_finite, 0u) << what;
+    EXPECT_LE(d.max_abs, kMaxAbs) << what << " " << options.label();
+    EXPECT_LE(typical, kTypicalFraction) << what << " " << options.label();
+    if (d.max_abs > kMaxAbs || typical > kTypicalFraction)
+      test::dump_images(what + "_" + options.label() + "_simd_vs_scalar", scalar.image, simd.image);
+  }
+}
+
+TEST(CpuSimdBlend, NameSaysWhichKernelBlends) {
+  EXPECT_NE(make_cpu_renderer(1, CpuBlend::scalar)->name().find("scalar blend"), std::string::npos);
+  const std::string simd = make_cpu_renderer(1, CpuBlend::simd)->name();
+  std::printf("%s\n", simd.c_str());
+  EXPECT_NE(simd.find(" blend)"), std::string::npos) << simd;
+}
+
+// An odd size: partial tiles on the right and bottom edges, where lanes lie outside the image.
+TEST(CpuSimdBlend, DemoSceneMatchesTheScalarKernel) {
+  expect_simd_matches_scalar(test::load_demo_scene(), test::load_demo_cameras()[2].resized(333, 187), "demo");
+  expect_simd_matches_scalar(test::load_demo_scene(), test::load_demo_cameras()[5].resized(640, 360), "demo");
+}
+
+TEST(CpuSimdBlend, RealScenesMatchTheScalarKernel) {
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  for (const std::string& name : test::shared_scene_names()) {
+    const Camera camera = test::load_shared_cameras(name)[0];
+    expect_simd_matches_scalar(test::load_shared_scene(name), camera.resized(camera.width / 2, camera.height / 2),
+                               name);
+  }
+}
+
+// The largest scene there is: pc_playbot when present, else the demo scene at 500k Gaussians.
+std::shared_ptr<const Scene> large_scene(Camera& camera) {
+  if (!test::shared_scene_dir("pc_playbot").empty()) {
+    camera = test::load_shared_cameras("pc_playbot")[0].resized(3840, 2160);
+    return test::load_shared_scene("pc_playbot");
+  }
+  camera = test::load_demo_cameras()[0].resized(3840, 2160);
+  return std::make_shared<Scene>(make_demo_scene(500000));
+}
+
+// A flag set by another thread while a long frame renders (4K, scalar blend: seconds) stops
+// it at the next check: the render returns early, says so, and the renderer then renders the
+// next frame completely.
+TEST(CpuCancel, FlagSetFromAnotherThreadStopsTheRender) {
+  Camera camera;
+  const auto scene = large_scene(camera);
+  auto renderer = make_cpu_renderer(0, CpuBlend::scalar);
+  renderer->set_scene(scene);
+  std::atomic<bool> cancel{false};
+  renderer->set_cancel_flag(&cancel);
+
+  Frame full;
+  renderer->render(camera, RenderOptions{}, full.image, &full.stats);
+  ASSERT_FALSE(full.stats.cancelled);
+
+  std::promise<void> started;
+  std::future<void> render_started = started.get_future();
+  Frame cut;
+  std::thread worker([&] {
+    started.set_value();
+    renderer->render(camera, RenderOptions{}, cut.image, &cut.stats);
+  });
+  render_started.wait();
+  cancel.store(true);
+  worker.join();
+  std::printf("complete frame %.0f ms (blend %.0f); cancelled frame returned after %.0f ms\n",
+              full.stats.times.total_ms, full.stats.times.blend_ms, cut.stats.times.total_ms);
+  EXPECT_TRUE(cut.stats.cancelled);
+  EXPECT_LT(cut.stats.times.total_ms, 0.5 * full.stats.times.total_ms);
+
+  cancel.store(false);
+  Frame again;
+  renderer->render(camera, RenderOptions{}, again.image, &again.stats);
+  EXPECT_FALSE(again.stats.cancelled);
+  EXPECT_EQ(again.image.rgb, full.image.rgb);
+}
+
+// A flag already set stops the render at its first check, before the blend.
+TEST(CpuCancel, FlagSetBeforeTheRenderStopsItBeforeTheBlend) {
+  auto renderer = make_cpu_renderer(2);
+  renderer->set_scene(test::load_demo_scene());
+  std::atomic<bool> cancel{true};
+  renderer->set_cancel_flag(&cancel);
+  Frame f;
+  renderer->render(test::load_demo_cameras()[0].resized(320, 180), RenderOptions{}, f.image, &f.stats);
+  EXPECT_TRUE(f.stats.cancelled);
+  EXPECT_EQ(f.stats.times.blend_ms, 0.0);
+  renderer->set_cancel_flag(nullptr);
+  renderer->render(test::load_demo_cameras()[0].resized(320, 180), RenderOptions{}, f.image, &f.stats);
+  EXPECT_FALSE(f.stats.cancelled);
+}
+
+// The viewer's progressive path: a coarse frame (Camera::resized), the full one, a coarse one
+// again, all from one renderer whose buffers grow and are reused: each is the frame a fresh
+// renderer gives.
+TEST(CpuResolution, ReducedAndFullFramesFromOneRendererMatchFreshRenderers) {
+  const auto scene = test::load_demo_scene();
+  const Camera full = test::load_demo_cameras()[4].resized(640, 360);
+  const Camera coarse = full.resized(160, 90);
+  auto renderer = make_cpu_renderer(2);
+  renderer->set_scene(scene);
+  for (const Camera* camera : {&coarse, &full, &coarse}) {
+    Frame reused;
+    renderer->render(*camera, RenderOptions{}, reused.image, &reused.stats);
+    const Frame fresh = render(scene, *camera, RenderOptions{}, CpuBlend::simd, 2);
+    ASSERT_EQ(reused.image.width, camera->width);
+    ASSERT_EQ(reused.image.height, camera->height);
+    EXPECT_EQ(reused.image.rgb, fresh.image.rgb) << camera->width << "x" << camera->height;
+    EXPECT_EQ(reused.stats.kv_pairs, fresh.stats.kv_pairs);
+  }
+}
+
+}  // namespace
+}  // namespace flashgs
