@@ -86,14 +86,14 @@ TEST(CpuSimdBlend, RealScenesMatchTheScalarKernel) {
 // The largest scene there is: pc_playbot when present, else the demo scene at 500k Gaussians.
 std::shared_ptr<const Scene> large_scene(Camera& camera) {
   if (!test::shared_scene_dir("pc_playbot").empty()) {
-    camera = test::load_shared_cameras("pc_playbot")[0].resized(3840, 2160);
+    camera = test::load_shared_cameras("pc_playbot")[0].resized(1920, 1080);
     return test::load_shared_scene("pc_playbot");
   }
-  camera = test::load_demo_cameras()[0].resized(3840, 2160);
+  camera = test::load_demo_cameras()[0].resized(1920, 1080);
   return std::make_shared<Scene>(make_demo_scene(500000));
 }
 
-// A flag set by another thread while a long frame renders (4K, scalar blend: seconds) stops
+// A flag set by another thread while a long frame renders (1080p, scalar blend: about a second) stops
 // it at the next check: the render returns early, says so, and the renderer then renders the
 // next frame completely.
 TEST(CpuCancel, FlagSetFromAnotherThreadStopsTheRender) {

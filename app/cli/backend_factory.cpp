@@ -11,7 +11,7 @@
 
 namespace flashgs::cli {
 
-std::unique_ptr<Renderer> create_backend(const std::string& which) {
+std::unique_ptr<Renderer> create_backend(const std::string& which, int cpu_threads, CpuBlend cpu_blend) {
 #ifdef FLASHGS_HAVE_CUDA
   if (which == "cuda" || which == "auto") {
     std::string why;
@@ -22,7 +22,7 @@ std::unique_ptr<Renderer> create_backend(const std::string& which) {
 #else
   if (which == "cuda") throw Error("this build has no CUDA backend (configure with -DFLASHGS_WITH_CUDA=ON)");
 #endif
-  return make_cpu_renderer();
+  return make_cpu_renderer(cpu_threads, cpu_blend);
 }
 
 }  // namespace flashgs::cli

@@ -31,6 +31,8 @@ struct BenchArgs {
   std::vector<std::string> resolutions = {"1920x1080", "3840x2160"};
   std::vector<std::string> configs = {"all"};
   std::vector<int> cameras;  // empty: 0, 2, ..., 34 (the 18 views of ANCHORS.md)
+  int threads = 0;                 // CPU backend: 0 = every core
+  std::string cpu_blend = "simd";  // CPU backend: simd or scalar (the reference kernel)
   int warmup = 3;
   int repeat = 10;
   int copies = 1;  // --tile: the scene copied on a grid in memory (scale benchmarks)
@@ -127,7 +129,8 @@ void run(const BenchArgs& args) {
     for (int i = 0; i <= 34; i += 2) camera_ids.push_back(i);
   check_camera_indices(args.cameras.empty() ? "the default --camera-list" : "--camera-list", camera_ids,
                        all_cameras.size(), cameras_path);
-  auto probe = create_backend(args.backend);
+  const CpuBlend cpu_blend = args.cpu_blend == "scalar" ? CpuBlend::scalar : CpuBlend::simd;
+  auto probe = create_backend(args.backend, args.threads, cpu_blend);
   for (const Resolution& size : resolutions)
     check_frame_fits(*probe, all_cameras[camera_ids.front()].resized(size.width, size.height), scene->size(),
                      "--resolutions");
@@ -165,7 +168,7 @@ void run(const BenchArgs& args) {
       ConfigRun r;
       r.name = name;
       r.options = options;
-      r.renderer = create_backend(args.backend);
+      r.renderer = create_backend(args.backend, args.threads, cpu_blend);
       const auto upload_start = std::chrono::steady_clock::now();
       r.renderer->set_scene(scene);
       r.upload_ms = ms_since(upload_start);
@@ -270,6 +273,9 @@ void register_bench(CLI::App& app) {
   sub->add_option("--resolutions,-r", args->resolutions, "WxH list (comma separated)")->delimiter(',');
   sub->add_option("--configs", args->configs, "all, or names:" + known_config_names())->delimiter(',');
   sub->add_option("--camera-list", args->cameras, "camera indices (default 0,2,...,34)")->delimiter(',');
+  sub->add_option("--threads", args->threads, "CPU backend threads (0: every core)")->check(CLI::Range(0, 1024));
+  sub->add_option("--cpu-blend", args->cpu_blend, "CPU backend blend kernel: simd, or scalar (the reference)")
+      ->check(CLI::IsMember({"simd", "scalar"}));
   sub->add_option("--warmup", args->warmup, "untimed frames per camera and config")->check(CLI::NonNegativeNumber);
   sub->add_option("--repeat", args->repeat, "timed frames per camera and config")->check(CLI::PositiveNumber);
   sub->add_option("--tile", args->copies, "render this many copies of the scene on a grid (scale runs)")

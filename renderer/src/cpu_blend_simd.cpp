@@ -40,7 +40,7 @@ void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, Til
   const std::size_t count = static_cast<std::size_t>(job.count);
   const std::size_t padded = (count + lanes - 1) / lanes * lanes;
   g.grow(padded);
-  constexpr std::size_t kPrefetchAhead = 8;
+  constexpr std::size_t kPrefetchAhead = 16;
   for (std::size_t k = 0; k < padded; ++k) {
     if (k >= count) {  // the last vector's spare lanes: finite values, results unused
       g.mean_y[k] = g.row_q_coeff[k] = g.q_cut[k] = 0.0f;
@@ -84,6 +84,17 @@ void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, Til
   }
 }
 
+// std::max(a, x) and std::min(a, x) lane by lane, NaN included ((a < x) ? x : a), so that the
+// spans are those of the scalar kernel for any input.
+template <class V>
+HWY_INLINE V max_like_std(V a, V x) {
+  return hn::IfThenElse(hn::Lt(a, x), x, a);
+}
+template <class V>
+HWY_INLINE V min_like_std(V a, V x) {
+  return hn::IfThenElse(hn::Lt(x, a), x, a);
+}
+
 void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, float* rgb) {
   const FloatTag d;
   const std::size_t lanes = hn::Lanes(d);
@@ -120,7 +131,10 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   }
 
   if (job.count > 0) gather(frame, job, y_begin, tile_h, g);
-  const auto one = hn::Set(d, 1.0f), minus_half = hn::Set(d, -0.5f);
+  // Each row's span [first, last] of pixels that can reach power_cut, for the current Gaussian.
+  HWY_ALIGN float span_first[gm::kTileSize], span_last[gm::kTileSize];
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), minus_half = hn::Set(d, -0.5f);
+  const auto tile_left = hn::Set(d, static_cast<float>(x_begin)), tile_right = hn::Set(d, static_cast<float>(tile_w - 1));
   const auto alpha_max = hn::Set(d, gm::kAlphaMax), alpha_min = hn::Set(d, gm::kAlphaMin);
   const auto t_min = hn::Set(d, gm::kTransmittanceMin);
   for (std::uint64_t k = 0; k < job.count && live_groups > 0; ++k) {
@@ -131,19 +145,30 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
     const auto centre_x = hn::Set(d, mean_x), w0 = hn::Set(d, g.whiten0[k]), w2 = hn::Set(d, g.whiten2[k]);
     const auto opacity = hn::Set(d, g.opacity[k]), power_cut = hn::Set(d, g.power_cut[k]);
     const auto r = hn::Set(d, g.red[k]), gr = hn::Set(d, g.green[k]), b = hn::Set(d, g.blue[k]);
+    // The scalar kernel's row spans, computed the same way for a vector of rows at a time.
+    const auto q_reach_v = hn::Set(d, q_reach), coeff = hn::Set(d, g.row_q_coeff[k]);
+    const auto slope = hn::Set(d, g.row_slope[k]), inv_conic_a = hn::Set(d, g.inv_conic_a[k]);
+    const auto mean_y_v = hn::Set(d, mean_y);
+    for (int row = y_first / static_cast<int>(lanes) * static_cast<int>(lanes); row <= y_last;
+         row += static_cast<int>(lanes)) {
+      const auto dy = hn::Sub(hn::Iota(d, static_cast<float>(y_begin + row)), mean_y_v);
+      const auto row_q = hn::Mul(hn::Mul(coeff, dy), dy);
+      const auto centre = hn::Sub(hn::Add(centre_x, hn::Mul(slope, dy)), tile_left);
+      const auto half = hn::Add(hn::Sqrt(hn::Mul(max_like_std(zero, hn::Sub(q_reach_v, row_q)), inv_conic_a)), one);
+      auto first = max_like_std(zero, hn::Ceil(hn::Sub(centre, half)));
+      auto last = min_like_std(tile_right, hn::Floor(hn::Add(centre, half)));
+      const auto reached = hn::Le(row_q, q_reach_v);  // false for NaN, as the scalar !(row_q <= ...)
+      first = hn::IfThenElse(reached, first, one);
+      last = hn::IfThenElse(reached, last, zero);
+      hn::Store(first, d, span_first + row);
+      hn::Store(last, d, span_last + row);
+    }
     for (int y = y_first; y <= y_last; ++y) {
-      if (row_live[y] == 0) continue;
-      // The scalar kernel's row span, computed the same way.
+      if (row_live[y] == 0 || span_first[y] > span_last[y]) continue;
       const float dy = static_cast<float>(y_begin + y) - mean_y;
-      const float row_q = g.row_q_coeff[k] * dy * dy;
-      if (!(row_q <= q_reach)) continue;
-      const float centre = mean_x + g.row_slope[k] * dy - static_cast<float>(x_begin);
-      const float half = std::sqrt(std::max(0.0f, q_reach - row_q) * g.inv_conic_a[k]) + 1.0f;
-      const int x0 = static_cast<int>(std::max(0.0f, std::ceil(centre - half)));
-      const int x1 = static_cast<int>(std::min(static_cast<float>(tile_w - 1), std::floor(centre + half)));
-      if (x0 > x1) continue;
+      const int x0 = static_cast<int>(span_first[y]), x1 = static_cast<int>(span_last[y]);
       const auto u_row = hn::Set(d, g.whiten1[k] * dy), v_row = hn::Set(d, g.whiten3[k] * dy);
-      const auto span_lo = hn::Set(d, static_cast<float>(x0)), span_hi = hn::Set(d, static_cast<float>(x1));
+      const auto span_lo = hn::Set(d, span_first[y]), span_hi = hn::Set(d, span_last[y]);
       for (int v = x0 / static_cast<int>(lanes); v <= x1 / static_cast<int>(lanes); ++v) {
         const int group = y * groups_per_row + v;
         if (!group_live[group]) continue;
@@ -157,9 +182,9 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         auto blends = hn::And(hn::And(live, hn::Ge(power, power_cut)),
                               hn::And(hn::Ge(x, span_lo), hn::Le(x, span_hi)));
         if (hn::AllFalse(d, blends)) continue;
+        // (No test for "all below 1/255" here: power_cut leaves almost none, the branch cost more.)
         const auto alpha = hn::Min(alpha_max, hn::Mul(opacity, hn::Exp(d, power)));
         blends = hn::And(blends, hn::Ge(alpha, alpha_min));
-        if (hn::AllFalse(d, blends)) continue;
         const auto t = hn::Load(d, transmittance + p);
         const auto next_t = hn::Mul(t, hn::Sub(one, alpha));
         const auto finished = hn::And(blends, hn::Lt(next_t, t_min));

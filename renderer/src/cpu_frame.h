@@ -14,8 +14,8 @@
 namespace flashgs {
 namespace cpu {
 
-// What the blend stage reads per Gaussian, packed so one cache line serves one Gaussian.
-struct BlendGaussian {
+// What the blend stage reads per Gaussian: 16 floats on one cache line (aligned to it).
+struct alignas(64) BlendGaussian {
   float mean_x, mean_y;
   float whiten[4];  // q = (w0 dx + w1 dy)^2 + (w2 dx + w3 dy)^2 (gm::Footprint::whiten)
   float opacity;

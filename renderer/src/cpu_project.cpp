@@ -61,15 +61,21 @@ void project(const Scene& scene, const RenderOptions& options, Frame& frame, Fra
     case 2: project_all<2>(scene, frame); break;
     default: project_all<3>(scene, frame); break;
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    switch (frame.cull[i]) {
-      case gm::kCulledNear: stats.culled_near++; break;
-      case gm::kCulledOffscreen: stats.culled_offscreen++; break;
-      case gm::kCulledLowOpacity: stats.culled_low_opacity++; break;
-      case gm::kCulledDegenerate: stats.culled_degenerate++; break;
-      default: break;
-    }
+  std::uint64_t near = 0, offscreen = 0, low_opacity = 0, degenerate = 0;
+  const std::int64_t count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) num_threads(frame.threads) \
+    reduction(+ : near, offscreen, low_opacity, degenerate)
+  for (std::int64_t i = 0; i < count; ++i) {
+    const std::uint8_t reason = frame.cull[i];
+    near += reason == gm::kCulledNear;
+    offscreen += reason == gm::kCulledOffscreen;
+    low_opacity += reason == gm::kCulledLowOpacity;
+    degenerate += reason == gm::kCulledDegenerate;
   }
+  stats.culled_near += near;
+  stats.culled_offscreen += offscreen;
+  stats.culled_low_opacity += low_opacity;
+  stats.culled_degenerate += degenerate;
 }
 
 }  // namespace cpu
