@@ -93,9 +93,9 @@ std::shared_ptr<const Scene> large_scene(Camera& camera) {
   return std::make_shared<Scene>(make_demo_scene(500000));
 }
 
-// A flag set by another thread while a long frame renders (1080p, scalar blend: about a second) stops
-// it at the next check: the render returns early, says so, and the renderer then renders the
-// next frame completely.
+// A flag set by another thread while a long frame renders (1080p, scalar blend: about a
+// second) stops it at the next check: the render returns early, says so, and the renderer
+// then renders the next frame completely.
 TEST(CpuCancel, FlagSetFromAnotherThreadStopsTheRender) {
   Camera camera;
   const auto scene = large_scene(camera);

@@ -41,7 +41,8 @@ bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const
   const int tiles_x = frame.camera.tiles_x;
   const std::size_t tiles = static_cast<std::size_t>(tiles_x) * frame.camera.tiles_y;
   order_tiles_by_pairs(frame, tiles);
-  if (frame.tile_gaussians.size() < static_cast<std::size_t>(frame.threads)) frame.tile_gaussians.resize(frame.threads);
+  if (frame.tile_gaussians.size() < static_cast<std::size_t>(frame.threads))
+    frame.tile_gaussians.resize(frame.threads);
 
   std::atomic<bool> stop{false};
   ParallelErrors errors;

@@ -21,6 +21,7 @@
 #     ninja -C build-viewer-dev flashgs-viewer
 #     mkdir -p .devgl/bin .devgl/lib && strip -o .devgl/bin/flashgs-viewer build-viewer-dev/app/flashgs-viewer
 #     cp -L /usr/lib/x86_64-linux-gnu/libgomp.so.1 .devgl/lib/   # OpenMP runtime, if the machine lacks it
+#     cp -L /usr/lib/x86_64-linux-gnu/libhwy.so.1 .devgl/lib/    # Highway (the CPU blend's SIMD dispatch)
 # The call sends at most 64 MiB in all: debs + binary + the working tree must fit. They may not
 # (debs ~60 MiB, tree ~4-8 MiB, binary ~3 MiB). Carried paths that a later call does not name
 # stay on a warm machine (so the device tool says; not tried here), so the carry can be split
