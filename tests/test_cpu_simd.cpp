@@ -9,6 +9,10 @@
 #include <future>
 #include <thread>
 
+#ifdef FLASHGS_HAVE_HWY
+#include <hwy/targets.h>
+#endif
+
 #include "flashgs/generators.h"
 #include "flashgs/renderer.h"
 #include "test_support.h"
@@ -72,6 +76,24 @@ TEST(CpuSimdBlend, NameSaysWhichKernelBlends) {
 TEST(CpuSimdBlend, DemoSceneMatchesTheScalarKernel) {
   expect_simd_matches_scalar(test::load_demo_scene(), test::load_demo_cameras()[2].resized(333, 187), "demo");
   expect_simd_matches_scalar(test::load_demo_scene(), test::load_demo_cameras()[5].resized(640, 360), "demo");
+}
+
+// Each SIMD target this CPU can run (e.g. SSSE3 and SSE4 with 4 lanes, AVX2 with 8, and
+// AVX-512 with 16 where present), forced one at a time, against the scalar kernel.
+TEST(CpuSimdBlend, EveryTargetThisCpuRunsMatchesTheScalarKernel) {
+#ifdef FLASHGS_HAVE_HWY
+  const auto scene = test::load_demo_scene();
+  const Camera camera = test::load_demo_cameras()[2].resized(333, 187);
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    const std::string name = make_cpu_renderer(1, CpuBlend::simd)->name();
+    EXPECT_NE(name.find(hwy::TargetName(target)), std::string::npos) << name;
+    expect_simd_matches_scalar(scene, camera, std::string("demo ") + hwy::TargetName(target));
+  }
+  hwy::SetSupportedTargetsForTest(0);  // back to what the CPU supports
+#else
+  GTEST_SKIP() << "built without Highway: the scalar kernel only";
+#endif
 }
 
 TEST(CpuSimdBlend, RealScenesMatchTheScalarKernel) {
