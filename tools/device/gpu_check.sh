@@ -8,7 +8,7 @@
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
 # cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
 # there; `build` builds everything on the machine instead, into build-dev) and sysroot/usr with
-# Debian's Highway (include/hwy, lib/x86_64-linux-gnu/{libhwy.so*,cmake/hwy}).
+# Debian's Highway (include/hwy, lib/x86_64-linux-gnu/{libhwy*.so*,cmake/hwy}).
 set -u
 ROOT=$(pwd)
 OUT=${OUT:-$ROOT/out}
