@@ -763,3 +763,29 @@ TEST(ViewerFiles, PathExportNumbersFramesAndFindsFfmpegAtRunTime) {
   EXPECT_NE(e.video_command(30).find("path.mp4"), std::string::npos);
   setenv("PATH", old_path.c_str(), 1);
 }
+
+// A SOG LOD set opens at the level asked for and lists every level (the viewer's LOD
+// selector); a file that is not a LOD set refuses a level with one line naming it.
+TEST(ViewerLoad, SogLodSetLoadsTheAskedLevelAndListsTheLevels) {
+  const std::string set = flashgs::test::shared_format_file("playbot_sog");
+  if (set.empty()) GTEST_SKIP() << "../shared/scenes/formats/playbot_sog is absent";
+  const fv::LoadedScene coarse = fv::load_scene(set, "", nullptr, 6);
+  ASSERT_EQ(coarse.lod_gaussians.size(), 7u);
+  EXPECT_EQ(coarse.lod_level, 6);
+  EXPECT_EQ(coarse.scene->size(), coarse.lod_gaussians[6]);
+  EXPECT_LT(coarse.lod_gaussians[6], coarse.lod_gaussians[0]);
+  try {
+    fv::load_scene(set, "", nullptr, 7);
+    ADD_FAILURE() << "level 7 of a 7-level set was accepted";
+  } catch (const flashgs::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("has levels 0..6"), std::string::npos) << e.what();
+  }
+  const std::string ply = flashgs::demo_scene_path();
+  EXPECT_TRUE(fv::load_scene(ply).lod_gaussians.empty());
+  try {
+    fv::load_scene(ply, "", nullptr, 1);
+    ADD_FAILURE() << "a LOD level was accepted for a PLY";
+  } catch (const flashgs::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a SOG LOD set"), std::string::npos) << e.what();
+  }
+}

@@ -44,16 +44,6 @@ SceneLocation SceneArgs::locate() const {
 
 namespace {
 
-// Whether the file starts like a SOG lod-meta.json (its first 64 KB are enough).
-bool is_sog_lod_set(const std::string& path) {
-  if (path_kind(path) != PathKind::regular_file) return false;
-  std::ifstream file(path, std::ios::binary);
-  std::string head(64 << 10, '\0');
-  file.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(file.gcount()));
-  return looks_like_sog_lod_meta(head);
-}
-
 Scene load_sog_lod_level(const std::string& path, int lod, LoadReport* report) {
   const SogLodSet set = describe_sog_lod(path);
   const AvailableMemory memory = available_host_memory();

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <filesystem>
 
+#include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
+#include "flashgs/frame_memory.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
 #include "flashgs/scene_formats.h"
@@ -54,7 +56,8 @@ glm::vec3 guess_up(const std::vector<Camera>& cameras) {
   return up;
 }
 
-LoadedScene load_scene(const std::string& path, const std::string& cameras_path, LoadProgress* progress) {
+LoadedScene load_scene(const std::string& path, const std::string& cameras_path, LoadProgress* progress,
+                       int lod_level) {
   // A PLY, a folder holding point_cloud.ply or a 3DGS training output (the library's rule, as
   // in the command-line tool); FIFOs and devices are refused before anything is opened.
   const SceneLocation location = locate_scene(path);
@@ -65,7 +68,19 @@ LoadedScene load_scene(const std::string& path, const std::string& cameras_path,
     const auto bytes = std::filesystem::file_size(location.ply, ec);
     if (!ec) progress->bytes_total = bytes;
   }
-  s.scene = std::make_shared<const Scene>(load_scene_file(location.ply, &s.report, progress));
+  if (is_sog_lod_set(location.ply)) {
+    const SogLodSet set = describe_sog_lod(location.ply);
+    const int level = lod_level >= 0 ? lod_level : choose_sog_lod_level(set, available_host_memory().bytes);
+    if (level >= static_cast<int>(set.levels.size()))
+      throw Error(location.ply + ": LOD level " + std::to_string(level) + " asked for, the set has levels 0.." +
+                  std::to_string(set.levels.size() - 1));
+    for (const SogLodLevel& l : set.levels) s.lod_gaussians.push_back(l.gaussians);
+    s.lod_level = level;
+    s.scene = std::make_shared<const Scene>(read_sog_lod(location.ply, level, &s.report, progress));
+  } else {
+    if (lod_level >= 0) throw Error(location.ply + ": not a SOG LOD set, it has no levels to choose from");
+    s.scene = std::make_shared<const Scene>(load_scene_file(location.ply, &s.report, progress));
+  }
   if (s.scene->size() == 0) throw Error(location.ply + ": the file holds no usable Gaussians");
   const std::string cameras = cameras_path.empty() ? location.cameras : cameras_path;
   if (!std::filesystem::exists(std::filesystem::symlink_status(cameras))) {

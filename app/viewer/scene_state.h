@@ -23,6 +23,9 @@ struct LoadedScene {
   glm::vec3 centre{0.0f};               // orbit pivot / default look-at
   float extent = 1.0f;                  // typical size, sets navigation speeds
   glm::vec3 up{0.0f, -1.0f, 0.0f};      // guessed world up
+  // A SOG LOD set: the Gaussians of each level (0 the finest) and the level loaded.
+  std::vector<std::size_t> lod_gaussians;
+  int lod_level = -1;
 };
 
 // Loads the scene at `path` (a PLY, a folder holding point_cloud.ply or a 3DGS training
@@ -31,7 +34,9 @@ struct LoadedScene {
 // regular file (a FIFO would block); a missing, broken or irregular cameras.json is not fatal
 // (noted).
 // `progress` (may be null) gets the file's size at once and whatever the reader reports.
-LoadedScene load_scene(const std::string& path, const std::string& cameras_path = "", LoadProgress* progress = nullptr);
+// A SOG LOD set loads level `lod_level` (-1: the finest that fits in host memory).
+LoadedScene load_scene(const std::string& path, const std::string& cameras_path = "", LoadProgress* progress = nullptr,
+                       int lod_level = -1);
 // The procedural demo scene (`count` Gaussians) with orbit cameras, for runs where no file can travel.
 LoadedScene generate_demo_scene(std::size_t count);
 // `copies` copies of a loaded scene on a grid (large-scene benchmarks); cameras kept.

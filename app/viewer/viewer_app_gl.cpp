@@ -195,7 +195,16 @@ void ViewerApp::select_frame_path() {
 
 void ViewerApp::install_scene(LoadedScene scene) {
   m_path->set_scene(scene.scene);  // throws on failure: the old scene stays
+  // Another level of the same LOD set: the same place, seen from where the user stands.
+  const bool same_place = !scene.lod_gaussians.empty() && scene.path == m_scene.path && m_scene.scene;
   m_scene = std::move(scene);
+  if (same_place) {
+    m_compare = {};
+    m_have_request = false;
+    std::fprintf(stderr, "flashgs-viewer: %s: LOD level %d, %zu Gaussians\n", m_scene.path.c_str(), m_scene.lod_level,
+                 m_scene.scene->size());
+    return;
+  }
   m_camera_path = std::make_unique<CameraPath>(m_scene.cameras);
   m_playing = false;
   m_camera_index = -1;
@@ -256,6 +265,24 @@ void ViewerApp::request_open(const std::string& path) {
   // current scene; the new one is installed (uploaded) on this thread once it is ready.
   m_path_buffer = path;  // kept in the box when it fails, to be corrected
   if (!m_loader.start(path)) set_notice("still loading " + m_loader.path() + "; " + path + " ignored");
+  m_logged_load_progress = false;
+}
+
+void ViewerApp::request_lod_level(int level) {
+  const std::string path = m_scene.path, cameras = path == m_args.scene ? m_args.cameras : "";
+  std::fprintf(stderr, "flashgs-viewer: loading LOD level %d of %s\n", level, path.c_str());
+  if (m_scripted) {
+    try {
+      install_scene(load_scene(path, cameras, nullptr, level));
+    } catch (const std::exception& e) {
+      report_failed_load(e.what());
+    }
+    return;
+  }
+  const bool started = m_loader.start(path, [cameras, level](const std::string& p, LoadProgress& progress) {
+    return load_scene(p, cameras, &progress, level);
+  });
+  if (!started) set_notice("still loading " + m_loader.path() + "; LOD level " + std::to_string(level) + " ignored");
   m_logged_load_progress = false;
 }
 
@@ -385,6 +412,7 @@ void ViewerApp::apply_actions(const UiActions& a) {
     m_loader.abandon();
   }
   if (!a.open_path.empty()) request_open(a.open_path);
+  if (a.lod_level >= 0) request_lod_level(a.lod_level);
   if (a.snap_camera >= 0) snap_to_camera(a.snap_camera);
   if (a.next_camera) snap_to_camera(m_camera_index + 1);
   if (a.previous_camera) snap_to_camera(m_camera_index < 0 ? 0 : m_camera_index - 1);
@@ -1105,6 +1133,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.scene_path = m_scene.path;
   model.gaussians = m_scene.scene ? m_scene.scene->size() : 0;
   model.sh_degree = m_scene.scene ? m_scene.scene->sh_degree : 0;
+  model.lod_gaussians = m_scene.lod_gaussians.empty() ? nullptr : &m_scene.lod_gaussians;
+  model.lod_level = m_scene.lod_level;
   model.camera_count = static_cast<int>(m_scene.cameras.size());
   model.scene_note = m_scene.cameras_note;
   model.load_error = m_load_error;

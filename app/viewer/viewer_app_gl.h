@@ -56,6 +56,7 @@ class ViewerApp {
   // Scenes.
   bool open_scene(const std::string& path);  // loads now; false (error kept) on failure
   void request_open(const std::string& path);  // loads in the background (interactive runs)
+  void request_lod_level(int level);  // another level of the SOG LOD set shown, loaded like a new file
   void finish_pending_load();
   void report_failed_load(const std::string& error);
   void install_scene(LoadedScene scene);

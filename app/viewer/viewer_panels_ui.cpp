@@ -140,6 +140,20 @@ void scene_panel(const UiModel& m, UiActions& a, std::string& path_buffer) {
     ImGui::Text("%s Gaussians, SH degree %d, %d cameras", human_count(double(m.gaussians)).c_str(), m.sh_degree,
                 m.camera_count);
   }
+  if (m.lod_gaussians && !m.lod_gaussians->empty()) {
+    // A SOG LOD set: any level, loaded in the background like a new file (the frame time is in the HUD).
+    auto level_name = [&](int level) {
+      return "level " + std::to_string(level) + ": " + human_count(double((*m.lod_gaussians)[level])) + " Gaussians";
+    };
+    ImGui::SetNextItemWidth(ui(260));
+    if (ImGui::BeginCombo("LOD", level_name(m.lod_level).c_str())) {
+      for (int level = 0; level < static_cast<int>(m.lod_gaussians->size()); ++level)
+        if (ImGui::Selectable(level_name(level).c_str(), level == m.lod_level) && level != m.lod_level)
+          a.lod_level = level;
+      ImGui::EndCombo();
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("level 0 is the finest; a coarser level has fewer Gaussians");
+  }
   if (!m.scene_note.empty()) ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.scene_note.c_str());
   ImGui::SetNextItemWidth(ui(-170));
   const bool enter = ImGui::InputTextWithHint("##open", "PLY path or folder (or drop a file)", &path_buffer,

@@ -26,6 +26,8 @@ struct UiModel {
   std::string scene_path;
   std::size_t gaussians = 0;
   int sh_degree = 0;
+  const std::vector<std::size_t>* lod_gaussians = nullptr;  // a SOG LOD set's levels, else null
+  int lod_level = -1;
   int camera_count = 0;
   std::string scene_note;         // loader report / cameras problem
   std::string load_error;         // the last failed load and what is shown instead, one sentence
@@ -60,6 +62,7 @@ struct UiModel {
 
 struct UiActions {
   std::string open_path;          // non-empty: load this scene
+  int lod_level = -1;             // >= 0: load this level of the current SOG LOD set
   bool cancel_load = false;       // stop waiting for the scene being loaded
   int snap_camera = -1;           // >= 0: go to this camera
   bool next_camera = false, previous_camera = false;

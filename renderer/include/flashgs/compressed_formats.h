@@ -59,6 +59,8 @@ struct SogLodSet {
   std::vector<SogLodLevel> levels;
   std::array<float, 3> bounds_min{}, bounds_max{};
 };
+// Whether `path` is a regular file that starts like a SOG lod-meta.json (64 KB are read).
+bool is_sog_lod_set(const std::string& path);
 // Reads lod-meta.json (`path`: the file, or the folder holding it) and each level's chunk
 // meta.json (for the SH degree); decodes no texture.
 SogLodSet describe_sog_lod(const std::string& path);
