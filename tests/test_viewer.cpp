@@ -959,7 +959,8 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
   // H turns the heat map on (a new full frame starts rendering), then the "Tight box" checkbox
   // (its place in the window at UI scale 1) is clicked while that frame renders. 1024x600: the
   // sections are open from 600 points up, and the swap (llvmpipe drawing the window, Xvfb
-  // copying it) is most of a UI frame's time here.
+  // copying it) is most of a UI frame's time here. The frame renders at 2048x1200, four times
+  // the window's pixels: with the SIMD blend a window-sized frame can finish before the click.
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
       "[ $status -eq 0 ] && { hold H \" key72 \" || status=11; }\n"
@@ -967,7 +968,8 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
       "[ $status -eq 0 ] && { wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
       "[ $status -eq 0 ] && { close_window || status=15; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_rendering",
-                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --size 1024x600 --log-input", steps, 14);
+                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --size 1024x600 --render-size 2048x1200 --log-input",
+                                      steps, 14);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 H, 12 click, 13 option not changed, 14 crash, 15 close)\n"
                             << r.output;
@@ -978,6 +980,15 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
     seen_while_rendering |= line.find("(a frame is rendering)") != std::string::npos;
   }
   EXPECT_TRUE(seen_while_rendering) << "the click was not seen while a frame rendered\n" << r.output;
+  // A click on a checkbox is the panel's: the view does not turn (the cursor jumped there).
+  const auto held = r.output.find("held: mouse0 at 27,461");
+  ASSERT_NE(held, std::string::npos) << r.output;
+  const auto last_held = r.output.rfind("held: mouse0 at 27,461");
+  auto forward = [&](std::size_t at) {
+    const auto f = r.output.find(" forward ", at);
+    return r.output.substr(f, r.output.find(" right ", f) - f);
+  };
+  EXPECT_EQ(forward(held), forward(last_held)) << "clicking a checkbox turned the view\n" << r.output;
   const double worst = logged_ms(r.output, "UI frames while a frame rendered in the background: ");
   const auto at = r.output.find(", worst ", r.output.find("UI frames while a frame rendered"));
   ASSERT_NE(at, std::string::npos) << r.output;

@@ -391,10 +391,18 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   const bool left_down = m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT);
   if (mouse_free) actions.snap_camera = frustum_under_click(left_down, x, y);
   if (mouse_free || m_divider.dragging()) handle_divider_drag(left_down, x);
+  // A press belongs to the panel it lands on, but ImGui says so only from the next frame (its
+  // capture is computed after this input), and the cursor may have jumped to the press: the
+  // view is dragged from a drag's second frame on, and only if ImGui did not take the press.
+  const bool right_down = m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT);
+  const bool middle_down = m_window->mouse_down(GLFW_MOUSE_BUTTON_MIDDLE);
+  if (!(left_down || right_down || middle_down)) m_drag_frames = 0;
+  else if (++m_drag_frames == 2) m_drag_on_ui = !mouse_free;
+  const bool view_drag = m_drag_frames >= 2 && !m_drag_on_ui;
   if (mouse_free && !m_divider.dragging()) {
-    const bool left = left_down;
-    const bool right = m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT);
-    const bool middle = m_window->mouse_down(GLFW_MOUSE_BUTTON_MIDDLE);
+    const bool left = left_down && view_drag;
+    const bool right = right_down && view_drag;
+    const bool middle = middle_down && view_drag;
     // As in SIBR, SuperSplat and viser: left-drag looks (fly) or orbits, right/middle-drag
     // (or Shift+left) pans, the wheel dollies and Ctrl+wheel sets the speed.
     if (left && !nav.fast) nav.look_dx = dx, nav.look_dy = dy;

@@ -145,6 +145,8 @@ class ViewerApp {
   float m_difference_factor = 1.0f;  // the difference image's magnification
   SplitDivider m_divider;
   bool m_left_was_down = false;
+  int m_drag_frames = 0;       // frames a mouse button has been held (0: none held)
+  bool m_drag_on_ui = false;   // the held press landed on an ImGui window
   double m_press_x = 0, m_press_y = 0;  // where the left button went down (a click snaps to a frustum)
   HeatScale m_heat_scale;
   std::string m_logged_legend;
