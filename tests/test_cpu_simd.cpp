@@ -21,11 +21,7 @@ namespace flashgs {
 namespace {
 
 // The SIMD kernel runs the scalar kernel's operations except exp (Highway's, 1 ulp, vs
-// glibc's): the same flips of alpha across 1/255 or T across 1e-4 as between the CPU and CUDA
-// backends, hence test_cuda_render.cpp's bound: max 1/64, and 99.99% of the values within 1e-3.
-constexpr double kMaxAbs = 1.0 / 64.0;
-constexpr double kTypicalAbs = 1e-3;
-constexpr double kTypicalFraction = 1e-4;
+// glibc's): the bound is test::kExpUlp*, the one CPU vs CUDA has.
 
 struct Frame {
   Image image;
@@ -41,26 +37,20 @@ Frame render(const std::shared_ptr<const Scene>& scene, const Camera& camera, co
   return f;
 }
 
-double fraction_over(const Image& a, const Image& b, double tol) {
-  std::size_t over = 0;
-  for (std::size_t i = 0; i < a.rgb.size(); ++i) over += std::abs(double(a.rgb[i]) - b.rgb[i]) > tol;
-  return a.rgb.empty() ? 0.0 : double(over) / double(a.rgb.size());
-}
-
 void expect_simd_matches_scalar(const std::shared_ptr<const Scene>& scene, const Camera& camera,
                                 const std::string& what) {
   for (const RenderOptions& options : {RenderOptions{}, RenderOptions::baseline()}) {
     const Frame scalar = render(scene, camera, options, CpuBlend::scalar);
     const Frame simd = render(scene, camera, options, CpuBlend::simd);
     const ImageDifference d = compare_images(scalar.image, simd.image);
-    const double typical = fraction_over(scalar.image, simd.image, kTypicalAbs);
+    const double typical = test::fraction_over(scalar.image, simd.image, test::kExpUlpTypicalAbs);
     std::printf("%-24s %-8s %dx%d: SIMD vs scalar max abs %.2e, PSNR %.1f dB, >1e-3: %.2e\n", what.c_str(),
                 options.label().c_str(), camera.width, camera.height, d.max_abs, d.psnr_db, typical);
     EXPECT_EQ(simd.stats.kv_pairs, scalar.stats.kv_pairs) << what;
     EXPECT_EQ(d.non_finite, 0u) << what;
-    EXPECT_LE(d.max_abs, kMaxAbs) << what << " " << options.label();
-    EXPECT_LE(typical, kTypicalFraction) << what << " " << options.label();
-    if (d.max_abs > kMaxAbs || typical > kTypicalFraction)
+    EXPECT_LE(d.max_abs, test::kExpUlpMaxAbs) << what << " " << options.label();
+    EXPECT_LE(typical, test::kExpUlpTypicalFraction) << what << " " << options.label();
+    if (d.max_abs > test::kExpUlpMaxAbs || typical > test::kExpUlpTypicalFraction)
       test::dump_images(what + "_" + options.label() + "_simd_vs_scalar", scalar.image, simd.image);
   }
 }

@@ -27,16 +27,9 @@ namespace {
     if (!::flashgs::cuda_available(&why)) GTEST_SKIP() << "no CUDA device: " << why; \
   } while (0)
 
-// Image bound CUDA vs CPU. Both run the same operations in the same order (the kernels are
-// built with -fmad=false), except exp: glibc's expf vs CUDA's (2 ulp) in the exact path,
-// exp2 of a pre-scaled form in the exp2 path (a few ulp of alpha). Such an ulp can move an
-// alpha across the 1/255 cut or a transmittance across 1e-4, which changes that pixel by at
-// most alpha * T * colour <= 0.99 * 1e-2 for the T cut and 1/255 * colour for the alpha cut;
-// colours reach ~1.3 on these scenes. Those flips are rare (a few pixels per frame), so the
-// test bounds the max by 1/64 and asks nearly all pixels (99.99%) to be within 1e-3.
-constexpr double kMaxAbs = 1.0 / 64.0;
-constexpr double kTypicalAbs = 1e-3;
-constexpr double kTypicalFraction = 1e-4;
+// Image bound CUDA vs CPU: the same operations in the same order (the kernels are built with
+// -fmad=false) except exp: glibc's expf vs CUDA's (2 ulp) in the exact path, exp2 of a
+// pre-scaled form in the exp2 path (a few ulp of alpha); test::kExpUlp* says what that allows.
 
 struct Result {
   Image image;
@@ -49,35 +42,33 @@ Result render(Renderer& r, const Camera& camera, const RenderOptions& options) {
   return out;
 }
 
-// Fraction of values off by more than `tol`.
-double fraction_over(const Image& a, const Image& b, double tol) {
-  std::size_t over = 0;
-  for (std::size_t i = 0; i < a.rgb.size(); ++i) over += std::abs(double(a.rgb[i]) - b.rgb[i]) > tol;
-  return a.rgb.empty() ? 0.0 : double(over) / double(a.rgb.size());
-}
-
 std::vector<RenderOptions> all_configs() { return single_switch_configs(); }
 
 // The CPU ignores the switches it does not honour: its image for a config is that of the
 // config with those switches at their defaults.
 std::string cpu_key(const RenderOptions& o) { return o.seen_by(Backend::cpu).label(); }
 
+// The same pairs, and every Gaussian culled for the same reason.
+void expect_same_counts(const std::string& what, const FrameStats& a, const FrameStats& b) {
+  EXPECT_EQ(b.kv_pairs, a.kv_pairs) << what;
+  EXPECT_EQ(b.visible, a.visible) << what;
+  EXPECT_EQ(b.culled_near, a.culled_near) << what;
+  EXPECT_EQ(b.culled_offscreen, a.culled_offscreen) << what;
+  EXPECT_EQ(b.culled_low_opacity, a.culled_low_opacity) << what;
+  EXPECT_EQ(b.culled_degenerate, a.culled_degenerate) << what;
+}
+
 void expect_match(const std::string& what, const Result& cpu, const Result& gpu) {
-  EXPECT_EQ(gpu.stats.kv_pairs, cpu.stats.kv_pairs) << what;
-  EXPECT_EQ(gpu.stats.visible, cpu.stats.visible) << what;
-  EXPECT_EQ(gpu.stats.culled_near, cpu.stats.culled_near) << what;
-  EXPECT_EQ(gpu.stats.culled_offscreen, cpu.stats.culled_offscreen) << what;
-  EXPECT_EQ(gpu.stats.culled_low_opacity, cpu.stats.culled_low_opacity) << what;
-  EXPECT_EQ(gpu.stats.culled_degenerate, cpu.stats.culled_degenerate) << what;
+  expect_same_counts(what, cpu.stats, gpu.stats);
   EXPECT_EQ(gpu.stats.max_tile_pairs, cpu.stats.max_tile_pairs) << what << " (without tile counts requested)";
   const ImageDifference d = compare_images(cpu.image, gpu.image);
-  const double typical = fraction_over(cpu.image, gpu.image, kTypicalAbs);
+  const double typical = test::fraction_over(cpu.image, gpu.image, test::kExpUlpTypicalAbs);
   std::printf("%-58s kv %10llu  max abs %.2e  PSNR %6.1f dB  >1e-3: %.2e\n", what.c_str(),
               static_cast<unsigned long long>(gpu.stats.kv_pairs), d.max_abs, d.psnr_db, typical);
   EXPECT_EQ(d.non_finite, 0u) << what;
-  EXPECT_LE(d.max_abs, kMaxAbs) << what;
-  EXPECT_LE(typical, kTypicalFraction) << what;
-  if (d.max_abs > kMaxAbs || typical > kTypicalFraction) {
+  EXPECT_LE(d.max_abs, test::kExpUlpMaxAbs) << what;
+  EXPECT_LE(typical, test::kExpUlpTypicalFraction) << what;
+  if (d.max_abs > test::kExpUlpMaxAbs || typical > test::kExpUlpTypicalFraction) {
     std::string stem = what;
     std::replace_if(stem.begin(), stem.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
     test::dump_images("cuda_" + stem, cpu.image, gpu.image);
@@ -162,12 +153,7 @@ TEST(CudaChunkCull, ChangesNothingButTheWork) {
       const Result a = render(*plain, camera, o);
       const Result b = render(*culling, camera, o);
       EXPECT_TRUE(a.image.rgb == b.image.rgb) << what;
-      EXPECT_EQ(a.stats.kv_pairs, b.stats.kv_pairs) << what;
-      EXPECT_EQ(a.stats.visible, b.stats.visible) << what;
-      EXPECT_EQ(a.stats.culled_near, b.stats.culled_near) << what;
-      EXPECT_EQ(a.stats.culled_offscreen, b.stats.culled_offscreen) << what;
-      EXPECT_EQ(a.stats.culled_low_opacity, b.stats.culled_low_opacity) << what;
-      EXPECT_EQ(a.stats.culled_degenerate, b.stats.culled_degenerate) << what;
+      expect_same_counts(what, a.stats, b.stats);
       EXPECT_EQ(a.stats.culled_by_chunk, 0u) << what;
       if (o.is_baseline()) {
         EXPECT_EQ(b.stats.culled_by_chunk, 0u) << what << ": the baseline culls per Gaussian";

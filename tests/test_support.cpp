@@ -1,6 +1,7 @@
 // Helpers shared by the test suites (see test_support.h).
 #include "test_support.h"
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -60,6 +61,12 @@ void dump_images(const std::string& stem, const Image& expected, const Image& ac
   for (std::size_t i = 0; i < diff.rgb.size() && i < actual.rgb.size(); ++i)
     diff.rgb[i] = std::abs(expected.rgb[i] - actual.rgb[i]) * 10.0f;
   write_pfm(diff, base + "_diff_x10.pfm");
+}
+
+double fraction_over(const Image& a, const Image& b, double tolerance) {
+  std::size_t over = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) over += std::abs(double(a.rgb[i]) - b.rgb[i]) > tolerance;
+  return a.rgb.empty() ? 0.0 : double(over) / double(a.rgb.size());
 }
 
 }  // namespace flashgs::test

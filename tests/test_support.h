@@ -24,6 +24,17 @@ std::vector<Camera> load_shared_cameras(const std::string& name);
 // The bundled demo scene.
 std::shared_ptr<const Scene> load_demo_scene();
 std::vector<Camera> load_demo_cameras();
+// The bound between two renders that run the same operations except exp (CPU vs CUDA: glibc's
+// expf vs CUDA's; SIMD vs scalar CPU blend: Highway's vs glibc's). Such an ulp can move an
+// alpha across the 1/255 cut or a transmittance across 1e-4, which changes that pixel by at
+// most alpha * T * colour <= 0.99 * 1e-2 for the T cut and 1/255 * colour for the alpha cut;
+// colours reach ~1.3 on these scenes. Those flips are rare (a few pixels per frame): the max
+// is bounded by 1/64 and nearly all values (99.99%) must be within 1e-3.
+constexpr double kExpUlpMaxAbs = 1.0 / 64.0;
+constexpr double kExpUlpTypicalAbs = 1e-3;
+constexpr double kExpUlpTypicalFraction = 1e-4;
+// Fraction of the values of `a` and `b` that differ by more than `tolerance`.
+double fraction_over(const Image& a, const Image& b, double tolerance);
 // Writes expected, actual and |difference| x 10 images to the test output folder.
 void dump_images(const std::string& stem, const Image& expected, const Image& actual);
 
