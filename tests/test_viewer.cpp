@@ -128,6 +128,13 @@ RunResult run_live_viewer(const std::string& prefix, const std::string& name, co
                 "  wait_count \"$2\" $((n + 2))\n"
                 "}\n"
                 "hold() { press \"$1\" \"$2\"; r=$?; \"$input\" up \"$1\"; return $r; }\n"
+                // Clicks a widget where the viewer last logged it (--log-input): not a fixed
+                // place, which a longer scene path or another font would move.
+                "click() {\n"
+                "  wait_for \"widget \\\"$1\\\" at \" || return 1\n"
+                "  at=$(grep -F -- \"widget \\\"$1\\\" at \" \"$log\" | tail -n 1 | sed 's/.* at //')\n"
+                "  \"$input\" move \"${at%,*}\" \"${at#*,}\" && hold button \" mouse0 \"\n"
+                "}\n"
                 "close_window() {\n"
                 "  \"$input\" close 20 20 || return 1\n"
                 "  for _ in $(seq 1 1200); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done\n"
@@ -365,9 +372,8 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
 #else
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
-  // The button's place in a 1280x720 window at UI scale 1 (the panel layout is fixed).
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
-                            "[ $status -eq 0 ] && { \"$input\" move 95 673 && hold button \" mouse0 \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { click \"Compare this view (C)\" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=12; }\n";
   const RunResult r = run_live_viewer(prefix, "click", "--backend cpu --size 1280x720 --log-input", steps, 13);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 no comparison, 13 crash)\n"
@@ -459,13 +465,12 @@ TEST(Viewer, CtrlOWithoutADesktopDialogOpensTheInAppBrowser) {
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   for (const char* tool : {"/usr/bin/zenity", "/usr/bin/kdialog", "/bin/zenity", "/bin/kdialog"})
     if (std::filesystem::exists(tool)) GTEST_SKIP() << tool << " is installed: the desktop dialog would open";
-  // The browser sits in the middle of a 1100x700 window (460x420 points at UI scale 1): its
-  // folder's first PLY (the demo's point_cloud.ply) at (380, 222).
+  // The browser opens on the demo's folder: its point_cloud.ply is clicked.
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
                             "[ $status -eq 0 ] && { \"$input\" move 700 500 && press Control_L \" key341 \" && "
                             "\"$input\" down o && \"$input\" up o; r=$?; \"$input\" up Control_L; [ $r -eq 0 ] || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"file dialog: in-app browser\" || status=12; }\n"
-                            "[ $status -eq 0 ] && { \"$input\" move 380 222 && hold button \" mouse0 \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { click \"browser: point_cloud.ply\" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_count \"point_cloud.ply: 30000 Gaussians\" 2 || status=13; }\n"
                             "[ $status -eq 0 ] && { close_window || status=15; }\n";
   const RunResult r = run_live_viewer(prefix, "browser", "--backend cpu --size 1100x700 --log-input", steps, 14,
@@ -954,36 +959,36 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
   if (found.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
-  // Without "..": the path stays on one line of the panel, which keeps the layout clicked below.
   const std::string dir = std::filesystem::canonical(found).string();
   // H turns the heat map on (a new full frame starts rendering), then the "Tight box" checkbox
-  // (its place in the window at UI scale 1) is clicked while that frame renders. 1024x600: the
-  // sections are open from 600 points up, and the swap (llvmpipe drawing the window, Xvfb
-  // copying it) is most of a UI frame's time here. The frame renders at 2048x1200, four times
-  // the window's pixels: with the SIMD blend a window-sized frame can finish before the click.
+  // is clicked while that frame renders. 1024x600: the sections are open from 600 points up,
+  // and the swap (llvmpipe drawing the window, Xvfb copying it) is most of a UI frame's time
+  // here. The frame renders at 2048x1200, four times the window's pixels, on one thread: a
+  // window-sized frame on every core can finish before the click (the SIMD blend), and a free
+  // core keeps this script's steps quick.
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
       "[ $status -eq 0 ] && { hold H \" key72 \" || status=11; }\n"
-      "[ $status -eq 0 ] && { \"$input\" move 27 461 && hold button \" mouse0 \" || status=12; }\n"
+      "[ $status -eq 0 ] && { click \"Tight box\" || status=12; }\n"
       "[ $status -eq 0 ] && { wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
       "[ $status -eq 0 ] && { close_window || status=15; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_rendering",
-                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --size 1024x600 --render-size 2048x1200 --log-input",
+                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size 1024x600 --render-size 2048x1200 --log-input",
                                       steps, 14);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 H, 12 click, 13 option not changed, 14 crash, 15 close)\n"
                             << r.output;
   bool seen_while_rendering = false;  // a held-button line of a frame that began with a render in flight
-  for (std::size_t at = r.output.find("held: mouse0 at 27,461"); at != std::string::npos;
-       at = r.output.find("held: mouse0 at 27,461", at + 1)) {
+  for (std::size_t at = r.output.find("held: mouse0 at "); at != std::string::npos;
+       at = r.output.find("held: mouse0 at ", at + 1)) {
     const std::string line = r.output.substr(at, r.output.find('\n', at) - at);
     seen_while_rendering |= line.find("(a frame is rendering)") != std::string::npos;
   }
   EXPECT_TRUE(seen_while_rendering) << "the click was not seen while a frame rendered\n" << r.output;
   // A click on a checkbox is the panel's: the view does not turn (the cursor jumped there).
-  const auto held = r.output.find("held: mouse0 at 27,461");
+  const auto held = r.output.find("held: mouse0 at ");
   ASSERT_NE(held, std::string::npos) << r.output;
-  const auto last_held = r.output.rfind("held: mouse0 at 27,461");
+  const auto last_held = r.output.rfind("held: mouse0 at ");
   auto forward = [&](std::size_t at) {
     const auto f = r.output.find(" forward ", at);
     return r.output.substr(f, r.output.find(" right ", f) - f);
@@ -1060,11 +1065,11 @@ TEST(Viewer, TheBKeyAndTheAlgorithmRadioAgree) {
 #else
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
-  // The Flash radio's place in a 1280x800 window at UI scale 1. GLFW key code: B 66.
+  // GLFW key code: B 66.
   const std::string steps =
       "wait_for \"UI ready\" || status=10\n"
       "[ $status -eq 0 ] && { hold b \" key66 \" && wait_for \"options: baseline\" || status=11; }\n"
-      "[ $status -eq 0 ] && { \"$input\" move 163 396 && hold button \" mouse0 \" || status=12; }\n"
+      "[ $status -eq 0 ] && { click Flash || status=12; }\n"
       "[ $status -eq 0 ] && { wait_count \"options: \" 3 || status=13; }\n"
       "[ $status -eq 0 ] && { close_window || status=15; }\n";
   const RunResult r = run_live_viewer(prefix, "b_and_radio", "--backend cpu --size 1280x800 --log-input", steps, 14);

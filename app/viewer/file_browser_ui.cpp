@@ -6,6 +6,8 @@
 
 #include <imgui.h>
 
+#include "widget_places_ui.h"
+
 namespace flashgs::viewer {
 
 void FileBrowser::open(const std::string& folder) {
@@ -54,10 +56,14 @@ std::string FileBrowser::draw(float ui_scale) {
     if (!m_error.empty()) ImGui::TextColored(ImVec4(1, 0.45f, 0.4f, 1), "%s", m_error.c_str());
     ImGui::BeginChild("entries", ImVec2(0, 0), true);
     std::string enter;
-    for (const std::string& f : m_folders)
+    for (const std::string& f : m_folders) {
       if (ImGui::Selectable((f + "/").c_str())) enter = f;
-    for (const std::string& f : m_files)
+      note_widget_place(("browser: " + f + "/").c_str());
+    }
+    for (const std::string& f : m_files) {
       if (ImGui::Selectable(f.c_str())) chosen = m_folder + "/" + f;
+      note_widget_place(("browser: " + f).c_str());
+    }
     ImGui::EndChild();
     if (!enter.empty()) list(m_folder + "/" + enter);
   }

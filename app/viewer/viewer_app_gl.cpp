@@ -28,6 +28,7 @@
 #include "path_note.h"
 #include "settings_store.h"
 #include "viewer_panels_ui.h"
+#include "widget_places_ui.h"
 #include "window_gl.h"
 
 namespace flashgs::viewer {
@@ -158,7 +159,7 @@ ViewerApp::~ViewerApp() {
 
 void ViewerApp::use_cpu_path(const std::string& why) {
   // The worker wakes the event loop when a frame is done: the window shows it at once.
-  m_path = make_background_upload_path(make_cpu_renderer(), m_presenter.get(), "CPU renderer + texture upload",
+  m_path = make_background_upload_path(make_cpu_renderer(m_args.cpu_threads), m_presenter.get(), "CPU renderer + texture upload",
                                        [] { glfwPostEmptyEvent(); });
   m_path_is_cpu = true;
   m_path_note = plain_path_note(why);
@@ -768,9 +769,10 @@ void ViewerApp::draw_and_present(int fb_w, int fb_h) {
   m_window->swap(m_settings.vsync);
   m_swap_ms = ms_since(t_swap);
   ++m_presented;
-  // ImGui hides a window that sizes itself in its first frame: from the second frame with
-  // panels on, they are all on screen where they stay (tests click them from then on).
-  if (m_settings.show_ui && ++m_ui_frames == 2)
+  // ImGui hides a window that sizes itself in its first frame and fits a window to new content
+  // a frame late: from the third frame with panels on after the first load ended (the scene's
+  // lines in its panel), they are all on screen where they stay (tests click them from then on).
+  if (m_settings.show_ui && !m_first_load_pending && ++m_ui_frames == 3)
     std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start\n", ms_since(m_started));
 }
 
@@ -1242,6 +1244,7 @@ void ViewerApp::record_frame_times(double frame_ms, double ui_ms, bool rendering
 
 int ViewerApp::run() {
   if (!open_window()) return 1;
+  set_widget_place_logging(m_args.log_input);
   select_frame_path();
   if (!start_first_scene()) return 2;
   m_window->cursor(&m_last_cursor_x, &m_last_cursor_y);

@@ -170,7 +170,7 @@ class ViewerApp {
   int m_checked_width = 0, m_checked_height = 0;  // the last size checked against memory...
   std::string m_checked_problem;                  // ...and why it does not fit (empty: fits)
   int m_max_texture_size = 0;                     // GL_MAX_TEXTURE_SIZE
-  int m_ui_frames = 0;                            // frames presented with the panels
+  int m_ui_frames = 0;                            // frames presented with the panels since the first load
   int m_presented = 0;                            // frames presented in all
   // UI frames (input to swap, the wait for events not counted) while a frame rendered in the
   // background: the worst is logged at exit (the UI must answer within 100 ms).

@@ -48,6 +48,8 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_option("--render-size", render_size, "render at exactly WxH whatever the window size");
   app.add_option("--scale", a->scale, "render resolution = framebuffer size * scale")->check(finite_in(kRenderScaleRange));
   app.add_option("--backend", a->backend, "auto, cpu or cuda")->check(CLI::IsMember({"auto", "cpu", "cuda"}));
+  app.add_option("--threads", a->cpu_threads, "CPU renderer threads (0: every core; fewer leave cores to other work)")
+      ->check(CLI::Range(0, 1024));
   app.add_option("--up", a->up, "world up axis: auto (from the cameras), +x, -x, +y, -y, +z, -z")
       ->check(CLI::IsMember({"auto", "+x", "-x", "+y", "-y", "+z", "-z"}));
   app.add_flag("--flip-up", a->flip_up, "invert the world up axis (scenes that load upside down)");
@@ -108,7 +110,7 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
                "(exit 4 when they differ)");
   app.add_flag("--compare", a->compare, "scripted: compare the last frame with the baseline and print PSNR");
   app.add_flag("--log-input", a->log_input,
-               "log every frame in which a mouse button is held (for tests that click through X)");
+               "log every frame in which a mouse button is held, and where the clickable widgets are (for tests that click through X)");
   try {
     app.parse(argc, argv);
     if (!size.empty()) parse_size("--size", size, &a->window_width, &a->window_height);

@@ -17,6 +17,7 @@ struct ViewerArgs {
   int render_width = 0, render_height = 0;  // > 0: render at exactly this size
   float scale = 1.0f;
   std::string backend = "auto";  // auto | cpu | cuda
+  int cpu_threads = 0;           // CPU renderer threads, 0: every core
   std::string up = "auto";       // auto | +x | -x | +y | -y | +z | -z
   bool flip_up = false;
   int camera = -1;               // snap to this camera at start

@@ -10,6 +10,7 @@
 
 #include "heatmap_legend.h"
 #include "help_overlay_ui.h"
+#include "widget_places_ui.h"
 
 namespace flashgs::viewer {
 namespace {
@@ -249,6 +250,7 @@ void switch_checkbox(const RenderSwitch& sw, RenderOptions& o, Backend backend) 
   const bool honoured = sw.honoured_by(backend);
   ImGui::BeginDisabled(!honoured);
   ImGui::Checkbox(sw.ui_name, &(o.*(sw.member)));
+  note_widget_place(sw.ui_name);
   ImGui::EndDisabled();
   if (!ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) return;
   std::string tip = std::string(sw.help) + "\nFlashGS paper: " + sw.paper + "\nCLI: --no-" + sw.cli_name;
@@ -263,8 +265,10 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
   RenderOptions& o = s.options;
   int algo = o.is_baseline() ? 0 : 1;
   ImGui::RadioButton("Baseline (3DGS)", &algo, 0);
+  note_widget_place("Baseline (3DGS)");
   ImGui::SameLine();
   ImGui::RadioButton("Flash", &algo, 1);
+  note_widget_place("Flash");
   ImGui::SameLine();
   ImGui::TextDisabled("(B)");
   switch_algorithm(o, algo == 0 ? Algorithm::baseline : Algorithm::flash);
@@ -312,6 +316,7 @@ void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   side("right", &s.compare_right);
   ImGui::BeginDisabled(!m.compare_problem.empty());
   if (ImGui::Button("Compare this view (C)")) a.compare = true;
+  note_widget_place("Compare this view (C)");
   ImGui::EndDisabled();
   ImGui::SameLine();
   int view = static_cast<int>(s.compare_view);

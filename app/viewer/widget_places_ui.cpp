@@ -1,0 +1,32 @@
+#include "widget_places_ui.h"
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include <imgui.h>
+
+namespace flashgs::viewer {
+namespace {
+bool g_logging = false;
+std::map<std::string, ImVec2>& last_places() {
+  static std::map<std::string, ImVec2> places;
+  return places;
+}
+}  // namespace
+
+void set_widget_place_logging(bool on) { g_logging = on; }
+
+void note_widget_place(const char* name) {
+  if (!g_logging) return;
+  const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+  // ImGui's points are the window's coordinates: the ones the cursor and XTEST use.
+  const ImVec2 centre(std::round((lo.x + hi.x) * 0.5f), std::round((lo.y + hi.y) * 0.5f));
+  auto [at, inserted] = last_places().try_emplace(name, centre);
+  if (!inserted && at->second.x == centre.x && at->second.y == centre.y) return;
+  at->second = centre;
+  std::fprintf(stderr, "flashgs-viewer: widget \"%s\" at %.0f,%.0f\n", name, centre.x, centre.y);
+}
+
+}  // namespace flashgs::viewer
