@@ -42,19 +42,27 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
       }
     });
     errors.capture([&] {
-      std::vector<std::uint32_t>& out_tiles = frame.thread_tiles[t];
-      std::vector<std::uint64_t>& out_keys = frame.thread_keys[t];
-      std::vector<std::uint32_t>& counts = frame.thread_tile_counts[t];
+      // The outputs as this thread's locals (swapped in and back, capacity kept): the vectors'
+      // headers sit side by side in frame, and a push_back to one would invalidate the cache
+      // line of the others' (false sharing cost more than the work at 2 threads).
+      std::vector<std::uint32_t> out_tiles, counts;
+      std::vector<std::uint64_t> out_keys;
+      out_tiles.swap(frame.thread_tiles[t]);
+      out_keys.swap(frame.thread_keys[t]);
+      counts.swap(frame.thread_tile_counts[t]);
       out_tiles.clear();
       out_keys.clear();
       counts.assign(tiles, 0);
+      std::uint64_t my_visible = 0, my_missed = 0;
+      const gm::Footprint* footprints = frame.footprints.data();
+      std::uint8_t* cull = frame.cull.data();
       const std::int64_t begin = n * t / team, end = n * (t + 1) / team;
       for (std::int64_t i = begin; i < end; ++i) {
-        if (frame.cull[i] != gm::kVisible) continue;
-        const gm::Footprint& f = frame.footprints[i];
+        if (cull[i] != gm::kVisible) continue;
+        const gm::Footprint& f = footprints[i];
         const std::uint64_t key_low =
             (static_cast<std::uint64_t>(gm::depth_bits(f.depth)) << 32) | static_cast<std::uint64_t>(i);
-        bool any = false;
+        const std::size_t emitted_before = out_keys.size();
         for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
           for (int tx = f.tile_x0; tx < f.tile_x1; ++tx) {
             if (exact && !gm::footprint_touches_tile(f, tx, ty, width, height)) continue;
@@ -62,15 +70,19 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
             out_tiles.push_back(tile);
             out_keys.push_back(key_low);
             counts[tile]++;
-            any = true;
           }
-        if (any) {
-          visible++;
+        if (out_keys.size() > emitted_before) {
+          my_visible++;
         } else {  // the box reached the image, the ellipse did not
-          frame.cull[i] = gm::kCulledOffscreen;
-          ellipse_missed++;
+          cull[i] = gm::kCulledOffscreen;
+          my_missed++;
         }
       }
+      visible += my_visible;
+      ellipse_missed += my_missed;
+      out_tiles.swap(frame.thread_tiles[t]);
+      out_keys.swap(frame.thread_keys[t]);
+      counts.swap(frame.thread_tile_counts[t]);
     });
   }
   errors.rethrow();
