@@ -106,8 +106,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   const int tile_h = std::min(gm::kTileSize, height - y_begin);
 
   // Per pixel: transmittance, colour, and whether it still blends (all bits set) - pixels
-  // outside the image start finished. A lane group (one vector) whose pixels have all finished
-  // is skipped, a row with no live group too, and the tile stops when none is left.
+  // outside the image start finished. A row whose lane groups (vectors) have all finished is
+  // skipped, and the tile stops when no group is left.
   HWY_ALIGN float transmittance[kTilePixels], red[kTilePixels], green[kTilePixels], blue[kTilePixels];
   HWY_ALIGN float active[kTilePixels];
   bool group_live[kTilePixels];
@@ -171,9 +171,11 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       const int x0 = static_cast<int>(span_first[y]), x1 = static_cast<int>(span_last[y]);
       const auto u_row = hn::Set(d, g.whiten1[k] * dy), v_row = hn::Set(d, g.whiten3[k] * dy);
       const auto span_lo = hn::Set(d, span_first[y]), span_hi = hn::Set(d, span_last[y]);
+      // No early outs per lane group (finished, or no lane above power_cut): the masks below
+      // make those lanes no-ops, and the branches mispredicted more than the work they saved
+      // (callgrind on pc_playbot: 29% fewer mispredicts for 5% more instructions).
       for (int v = x0 / static_cast<int>(lanes); v <= x1 / static_cast<int>(lanes); ++v) {
         const int group = y * groups_per_row + v;
-        if (!group_live[group]) continue;
         const int local_x = v * static_cast<int>(lanes);
         const int p = y * gm::kTileSize + local_x;
         const auto x = hn::Iota(d, static_cast<float>(local_x));
@@ -183,8 +185,6 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         auto live = hn::MaskFromVec(hn::Load(d, active + p));
         auto blends = hn::And(hn::And(live, hn::Ge(power, power_cut)),
                               hn::And(hn::Ge(x, span_lo), hn::Le(x, span_hi)));
-        if (hn::AllFalse(d, blends)) continue;
-        // (No test for "all below 1/255" here: power_cut leaves almost none, the branch cost more.)
         const auto alpha = hn::Min(alpha_max, hn::Mul(opacity, hn::Exp(d, power)));
         blends = hn::And(blends, hn::Ge(alpha, alpha_min));
         const auto t = hn::Load(d, transmittance + p);
