@@ -2,11 +2,59 @@
 #include <algorithm>
 #include <chrono>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "cpu_frame.h"
 #include "parallel_errors.h"
 
 namespace flashgs {
 namespace cpu {
+
+namespace {
+
+// Below this many keys an insertion sort beats the radix passes' bucket tables.
+constexpr std::size_t kInsertionSortBelow = 48;
+
+// Sorts a tile's keys (depth bits << 32 | id) into (depth, id) order. They arrive in ascending
+// id order (emit's chunks in thread order, each in id order), so a stable sort by the depth
+// bits alone gives that order: an LSD radix sort on the 4 depth bytes, skipping a byte every
+// key shares (most tiles' depths share their exponent byte). `scratch` only grows.
+void sort_tile_keys(std::uint64_t* keys, std::size_t n, std::vector<std::uint64_t>& scratch) {
+  if (n < kInsertionSortBelow) {
+    for (std::size_t i = 1; i < n; ++i) {
+      const std::uint64_t key = keys[i];
+      std::size_t j = i;
+      for (; j > 0 && keys[j - 1] > key; --j) keys[j] = keys[j - 1];
+      keys[j] = key;
+    }
+    return;
+  }
+  std::uint32_t counts[4][256] = {};
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t depth = static_cast<std::uint32_t>(keys[i] >> 32);
+    for (int b = 0; b < 4; ++b) counts[b][(depth >> (8 * b)) & 255]++;
+  }
+  if (scratch.size() < n) scratch.resize(n);
+  std::uint64_t* from = keys;
+  std::uint64_t* to = scratch.data();
+  for (int b = 0; b < 4; ++b) {
+    const int shift = 32 + 8 * b;
+    if (counts[b][(from[0] >> shift) & 255] == n) continue;  // every key has this byte
+    std::uint32_t start[256];
+    std::uint32_t running = 0;
+    for (int digit = 0; digit < 256; ++digit) {
+      start[digit] = running;
+      running += counts[b][digit];
+    }
+    for (std::size_t i = 0; i < n; ++i) to[start[(from[i] >> shift) & 255]++] = from[i];
+    std::swap(from, to);
+  }
+  if (from != keys) std::copy(from, from + n, keys);
+}
+
+}  // namespace
 
 void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms) {
   using Clock = std::chrono::steady_clock;
@@ -45,10 +93,19 @@ void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms) {
   errors.rethrow();
   // The key holds the Gaussian id below the depth, so equal depths sort by id: the order,
   // and the image, do not depend on how the work was split.
+  if (frame.sort_scratch.size() < static_cast<std::size_t>(frame.threads)) frame.sort_scratch.resize(frame.threads);
   const std::int64_t tile_count = static_cast<std::int64_t>(tiles);
 #pragma omp parallel for schedule(dynamic, 16) num_threads(frame.threads)
   for (std::int64_t tile = 0; tile < tile_count; ++tile)
-    errors.capture([&] { std::sort(sorted + frame.tile_start[tile], sorted + frame.tile_start[tile + 1]); });
+    errors.capture([&] {
+#ifdef _OPENMP
+      const int thread = omp_get_thread_num();
+#else
+      const int thread = 0;
+#endif
+      const std::uint64_t begin = frame.tile_start[tile], end = frame.tile_start[tile + 1];
+      sort_tile_keys(sorted + begin, end - begin, frame.sort_scratch[thread]);
+    });
   errors.rethrow();
 
   stats.max_tile_pairs = 0;

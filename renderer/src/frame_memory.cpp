@@ -73,11 +73,12 @@ FrameMemory estimate_frame_memory(BackendKind backend, std::size_t gaussians, in
   m.image = pixels * 3 * sizeof(float);
   if (backend == BackendKind::cpu) {
     // cpu::Frame: footprints, cull flags and blend data per Gaussian; tile_start and each
-    // thread's tile histogram per tile; per pair the emitted (tile, key) and the sorted key.
+    // thread's tile histogram per tile; per pair the emitted (tile, key), the sorted key and,
+    // at most, the per-tile sort's scratch copy (all of it when one tile holds every pair).
     m.per_gaussian = n * (sizeof(gm::Footprint) + sizeof(std::uint8_t) + sizeof(cpu::BlendGaussian));
     m.per_tile = (tiles + 1) * sizeof(std::uint64_t) + static_cast<std::uint64_t>(std::max(threads, 1)) * tiles *
                                                            sizeof(std::uint32_t);
-    m.pairs = pairs * (sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t));
+    m.pairs = pairs * (sizeof(std::uint32_t) + 3 * sizeof(std::uint64_t));
     m.host = m.image + m.per_gaussian + m.per_tile + m.pairs;
   } else {
     // The CUDA pipeline's buffers: footprints, pair counts and offsets, blend data per
