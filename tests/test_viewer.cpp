@@ -130,11 +130,12 @@ RunResult run_live_viewer(const std::string& prefix, const std::string& name, co
                 "hold() { press \"$1\" \"$2\"; r=$?; \"$input\" up \"$1\"; return $r; }\n"
                 // Clicks a widget where the viewer last logged it (--log-input): not a fixed
                 // place, which a longer scene path or another font would move.
-                "click() {\n"
+                "move_to() {\n"
                 "  wait_for \"widget \\\"$1\\\" at \" || return 1\n"
                 "  at=$(grep -F -- \"widget \\\"$1\\\" at \" \"$log\" | tail -n 1 | sed 's/.* at //')\n"
-                "  \"$input\" move \"${at%,*}\" \"${at#*,}\" && hold button \" mouse0 \"\n"
+                "  \"$input\" move \"${at%,*}\" \"${at#*,}\"\n"
                 "}\n"
+                "click() { move_to \"$1\" && hold button \" mouse0 \"; }\n"
                 "close_window() {\n"
                 "  \"$input\" close 20 20 || return 1\n"
                 "  for _ in $(seq 1 1200); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done\n"
@@ -589,21 +590,21 @@ TEST(Viewer, TypedSliderValuesAreClampedToTheirRanges) {
   const std::string dir = out_dir();
   for (const auto& e : std::filesystem::directory_iterator(dir))
     if (e.path().filename().string().rfind("flashgs_20", 0) == 0) std::filesystem::remove(e.path());
-  // Slider places in a 640x720 window at UI scale 1 (the panel layout is fixed): "s per
-  // camera" at (100, 196), "Render scale" at (110, 281). GLFW key codes: Ctrl 341, Enter 257, Space 32.
-  auto typed = [](int x, int y, const std::string& text) {
-    return "press Control_L \" key341 \" && \"$input\" move " + std::to_string(x) + " " +
-           std::to_string(y) + " && hold button \" mouse0 \" && \"$input\" up Control_L && \"$input\" type " + text +
+  // Ctrl+click on a slider (where the viewer logged it) types into it. GLFW key codes: Ctrl
+  // 341, Enter 257, Space 32.
+  auto typed = [](const std::string& slider, const std::string& text) {
+    return "press Control_L \" key341 \" && move_to \"" + slider +
+           "\" && hold button \" mouse0 \" && \"$input\" up Control_L && \"$input\" type " + text +
            " && hold Return \" key257 \"";
   };
   const std::string steps =
       "wait_for \"UI ready\" || status=10\n"
-      "[ $status -eq 0 ] && { " + typed(100, 196, "0") + " || status=11; }\n"
+      "[ $status -eq 0 ] && { " + typed("s per camera", "0") + " || status=11; }\n"
       "[ $status -eq 0 ] && { hold space \" key32 \" || status=12; }\n"
       "[ $status -eq 0 ] && { \"$input\" down F12 && \"$input\" up F12 || status=12; }\n"
       "[ $status -eq 0 ] && { wait_for \"saved ./flashgs_20\" || status=13; }\n"
       "[ $status -eq 0 ] && { cp \"$(ls flashgs_20*.png | head -1)\" playing_after_typed_zero.png; hold space \" key32 \" || status=14; }\n"
-      "[ $status -eq 0 ] && { " + typed(110, 281, "40") + " || status=14; }\n"
+      "[ $status -eq 0 ] && { " + typed("Render scale", "40") + " || status=14; }\n"
       "[ $status -eq 0 ] && { \"$input\" down F12 && \"$input\" up F12 || status=14; }\n"
       "[ $status -eq 0 ] && { wait_count \"saved ./flashgs_20\" 2 || status=15; }\n"
       "[ $status -eq 0 ] && { close_window || status=17; }\n";

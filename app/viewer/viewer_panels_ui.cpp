@@ -215,6 +215,7 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
     ImGui::SetNextItemWidth(ui(140));
     ImGui::SliderFloat("s per camera", &s.path_seconds_per_camera, kPathSecondsRange.min, kPathSecondsRange.max, "%.1f",
                        kClamp | ImGuiSliderFlags_Logarithmic);
+    note_widget_place("s per camera");
     if (m.current_camera < 0) ImGui::TextUnformatted("free view");
     else ImGui::Text(m.on_scene_camera ? "on camera %d (exact)" : "free view (last camera %d)", m.current_camera);
   } else if (!m.scene_path.empty()) {
@@ -224,6 +225,7 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   ImGui::SliderFloat("Speed", &s.move_speed, kMoveSpeedRange.min, kMoveSpeedRange.max, "%.3g extents/s",
                      kClamp | ImGuiSliderFlags_Logarithmic);
   ImGui::SliderFloat("Render scale", &s.render_scale, kRenderScaleRange.min, kRenderScaleRange.max, "%.2f", kClamp);
+  note_widget_place("Render scale");
   ImGui::Checkbox("Fewer pixels while moving (slow backends)", &s.adaptive_resolution);
   ImGui::SetNextItemWidth(ui(70));
   if (ImGui::Combo("Up axis", &s.up_axis, kUpAxisNames, kUpAxisCount)) a.up_changed = true;
