@@ -35,8 +35,8 @@ struct alignas(64) BlendGaussian {
 // SIMD kernel reads each field as a contiguous stream (broadcast per Gaussian) and computes
 // the row range of several Gaussians per vector. One per thread; vectors only grow.
 struct TileGaussians {
-  std::vector<float> mean_x, mean_y, whiten0, whiten1, whiten2, whiten3, opacity, red, green, blue, power_cut,
-      row_q_coeff, q_cut, row_slope, inv_conic_a;
+  std::vector<float> mean_x, mean_y, whiten0, whiten1, whiten2, whiten3, opacity, red, green, blue, row_q_coeff,
+      q_cut, row_slope, inv_conic_a;
   std::vector<std::int32_t> row_first, row_last;  // rows of the tile that can reach power_cut
   void grow(std::size_t n);
 };
