@@ -208,7 +208,8 @@ void ViewerApp::install_scene(LoadedScene scene) {
   const bool same_place = !scene.lod_gaussians.empty() && scene.path == m_scene.path && m_scene.scene;
   m_scene = std::move(scene);
   m_compare_task.cancel();  // a comparison of the old scene: dropped when it ends...
-  m_arrived_textures = 0;   // ...or when its textures are still going up
+  m_arrived = {};           // ...or while its textures are going up
+  m_arrived_textures = 0;
   if (same_place) {
     m_compare = {};
     m_have_request = false;
@@ -478,15 +479,15 @@ void ViewerApp::apply_actions(const UiActions& a) {
 }
 
 void ViewerApp::start_comparison() {
+  if (comparing()) {
+    set_notice("still comparing " + m_comparing + ": this request is ignored");
+    return;
+  }
   CompareJob job;
   job.camera = m_last_camera;
   job.left = compare_choice_options(m_settings.compare_left, m_settings.options);
   job.right = compare_choice_options(m_settings.compare_right, m_settings.options);
   job.warm_up = !m_path_is_cpu;
-  if (comparing()) {
-    set_notice("still comparing " + m_comparing + ": this request is ignored");
-    return;
-  }
   m_compare = {};  // the last comparison's images are of another view: the frame shows meanwhile
   m_compare_camera = m_last_camera;
   m_compare_options = m_last_options;
@@ -1336,7 +1337,7 @@ int ViewerApp::run() {
     record_frame_times(frame_ms, ms_since(m_frame_start), rendering);
   }
   save_settings();
-  if (m_compare_task.busy()) {  // quitting does not wait for it: its renders stop at their next check
+  if (m_compare_task.busy()) {  // quitting stops it: its renders end at their next check, before the path goes
     m_compare_task.cancel();
     m_compare_task.wait();
     finish_comparison(/*at_once=*/true);  // logs the cancel
