@@ -50,7 +50,7 @@ class CompareTask {
   double elapsed_seconds() const;
   // The finished comparison, once; false while it runs or when none was started.
   bool take(CompareOutcome* out);
-  // Stops the renders where the path can (the CPU backend between tiles); the comparison then
+  // Stops the renders where the path can (the CPU backend between stages and tiles); it then
   // ends soon, as cancelled, and is taken like any other. Nothing when none runs.
   void cancel();
   // Blocks until the comparison's thread has ended (scripted runs; before the path goes away).
