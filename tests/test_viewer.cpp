@@ -1088,6 +1088,8 @@ TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
   EXPECT_NE(r.output.find("comparison of flash vs baseline at 2048x1200 cancelled after"), std::string::npos)
       << r.output;
   EXPECT_EQ(r.output.find("compare flash vs baseline"), std::string::npos) << "it finished instead\n" << r.output;
+  const auto closed = r.output.find("closed after ");
+  if (closed != std::string::npos) std::printf("%s\n", r.output.substr(closed, r.output.find('\n', closed) - closed).c_str());
 #endif
 }
 
