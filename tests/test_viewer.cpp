@@ -947,6 +947,13 @@ double logged_ms(const std::string& log, const std::string& key) {
   return std::atof(log.c_str() + at + key.size());
 }
 
+// The worst UI frame from the viewer's exit summary, and how many it counted (-1: no summary).
+double worst_ui_frame_ms(const std::string& log, double* frames) {
+  *frames = logged_ms(log, "UI frames while a frame rendered in the background: ");
+  const auto at = log.find(", worst ", log.find("UI frames while a frame rendered"));
+  return at == std::string::npos ? -1 : std::atof(log.c_str() + at + 8);
+}
+
 // While the CPU renders a frame of pc_playbot (seconds on a small machine) on the worker
 // thread, a real click (XTEST) on a checkbox is answered: the frames that see the button held
 // are logged while the frame renders, the option changes, and no UI frame in the whole run
@@ -995,13 +1002,94 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
     return r.output.substr(f, r.output.find(" right ", f) - f);
   };
   EXPECT_EQ(forward(held), forward(last_held)) << "clicking a checkbox turned the view\n" << r.output;
-  const double worst = logged_ms(r.output, "UI frames while a frame rendered in the background: ");
-  const auto at = r.output.find(", worst ", r.output.find("UI frames while a frame rendered"));
-  ASSERT_NE(at, std::string::npos) << r.output;
-  const double worst_ms = std::atof(r.output.c_str() + at + 8);
-  std::printf("UI frames while rendering: %.0f, worst %.1f ms\n", worst, worst_ms);
-  EXPECT_GE(worst, 2.0);
+  double frames = 0;
+  const double worst_ms = worst_ui_frame_ms(r.output, &frames);
+  ASSERT_GE(worst_ms, 0.0) << r.output;
+  std::printf("UI frames while rendering: %.0f, worst %.1f ms\n", frames, worst_ms);
+  EXPECT_GE(frames, 2.0);
   EXPECT_LT(worst_ms, 100.0) << r.output;
+#endif
+}
+
+// "Compare this view" on the CPU path renders two frames of pc_playbot at 2048x1200 on one
+// thread (seconds): they run beside the frame loop. While they do, a second C is refused with
+// a notice and a click changes an option (frames logged as "(comparing)"); then the comparison
+// arrives, stale (the options changed meanwhile), and no UI frame while it ran took 100 ms or
+// more. Before, the window froze for the whole comparison and the second C started another.
+TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
+  if (found.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
+  const std::string dir = std::filesystem::canonical(found).string();
+  // GLFW key code of C: 67.
+  const std::string steps =
+      "wait_for \"first frame shown\" || status=10\n"
+      "[ $status -eq 0 ] && { hold c \" key67 \" || status=11; }\n"
+      "[ $status -eq 0 ] && { wait_for \"comparing flash vs baseline at 2048x1200 in the background\" || status=12; }\n"
+      "[ $status -eq 0 ] && { hold c \" key67 \" && wait_for \"this request is ignored\" || status=13; }\n"
+      "[ $status -eq 0 ] && { click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=14; }\n"
+      "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=15; }\n"
+      "[ $status -eq 0 ] && { close_window || status=17; }\n";
+  const RunResult r = run_live_viewer(prefix, "ui_while_comparing",
+                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size 1024x600 --render-size 2048x1200 --log-input",
+                                      steps, 16);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 first frame, 11 C, 12 not started in the background, 13 second C not "
+                               "refused, 14 click, 15 no comparison, 16 crash, 17 close)\n"
+                            << r.output;
+  const std::string& log = r.output;
+  const auto result = log.find("compare flash vs baseline");
+  // Each answer came while the comparison ran: before its result, from frames that said so.
+  for (const char* answer : {"still comparing flash vs baseline", "options: flash-no_tight_bbox"})
+    EXPECT_LT(log.find(answer), result) << answer << " came after the comparison\n" << log;
+  const auto clicked = log.find("held: mouse0 ");
+  ASSERT_NE(clicked, std::string::npos) << log;
+  EXPECT_NE(log.substr(clicked, log.find('\n', clicked) - clicked).find("(comparing)"), std::string::npos)
+      << "the click was not seen while comparing\n" << log;
+  EXPECT_NE(log.find("the comparison is stale", result), std::string::npos) << "an option changed meanwhile\n" << log;
+  double frames = 0;
+  const double worst_ms = worst_ui_frame_ms(log, &frames);
+  std::printf("UI frames while comparing: %.0f, worst %.1f ms\n", frames, worst_ms);
+  EXPECT_GE(frames, 5.0) << log;
+  ASSERT_GE(worst_ms, 0.0) << log;
+  EXPECT_LT(worst_ms, 100.0) << log;
+#endif
+}
+
+// Closing the window while a comparison renders on the CPU cancels it: the viewer exits
+// cleanly (status 0, the cancel logged) instead of finishing the comparison first.
+TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
+  if (found.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
+  const std::string dir = std::filesystem::canonical(found).string();
+  const std::string steps =
+      "wait_for \"first frame shown\" || status=10\n"
+      "[ $status -eq 0 ] && { hold c \" key67 \" || status=11; }\n"
+      "[ $status -eq 0 ] && { wait_for \"comparing flash vs baseline\" || status=12; }\n"
+      "t0=$(date +%s%N)\n"
+      "[ $status -eq 0 ] && { close_window || status=14; }\n"
+      "echo \"closed after $(( ($(date +%s%N) - t0) / 1000000 )) ms\"\n"
+      "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=15\n";
+  const RunResult r = run_live_viewer(prefix, "close_while_comparing",
+                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size 800x450 --render-size 2048x1200 --log-input",
+                                      steps, 13);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 first frame, 11 C, 12 not started, 13 crash, 14 close, 15 exit status)\n"
+                            << r.output;
+  EXPECT_NE(r.output.find("comparison of flash vs baseline at 2048x1200 cancelled after"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("compare flash vs baseline"), std::string::npos) << "it finished instead\n" << r.output;
+  const auto closed = r.output.find("closed after ");
+  if (closed != std::string::npos) std::printf("%s\n", r.output.substr(closed, r.output.find('\n', closed) - closed).c_str());
 #endif
 }
 

@@ -1,4 +1,4 @@
-// The viewer's background rendering without a window: the render worker (newest request wins, cancel, restart), the rendered-FPS meter, the frame-path notes and the one baseline rule.
+// The viewer's background rendering without a window: the render worker (newest request wins, cancel, restart), the comparison's task, the rendered-FPS meter, the frame-path notes and the one baseline rule.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "camera_controller.h"
+#include "compare_task.h"
 #include "flashgs/generators.h"
 #include "path_note.h"
 #include "rate_meter.h"
@@ -63,6 +64,39 @@ class GatedRenderer final : public flashgs::Renderer {
   std::vector<int> m_started;
   int m_releases = 0;
 };
+
+// A frame path whose host-memory renders go through a RenderWorker, as the CPU path's do
+// (without its GL upload); `background`: it says it renders in the background.
+class WorkerPath final : public fv::FramePath {
+ public:
+  WorkerPath(std::unique_ptr<flashgs::Renderer> renderer, bool background)
+      : m_worker(std::move(renderer), nullptr), m_background(background) {}
+  std::string name() const override { return "worker path"; }
+  void set_scene(std::shared_ptr<const flashgs::Scene>) override {}
+  void attach_textures(const unsigned*, int, int) override {}
+  void release_textures() override {}
+  void render_to_texture(const flashgs::Camera&, const flashgs::RenderOptions&, flashgs::FrameStats*) override {}
+  bool renders_in_background() const override { return m_background; }
+  void render_image(const flashgs::Camera& camera, const flashgs::RenderOptions& options, flashgs::Image& out,
+                    flashgs::FrameStats* stats, const std::atomic<bool>* cancel) override {
+    m_worker.with_renderer([&](flashgs::Renderer& r) { r.render(camera, options, out, stats); }, cancel);
+  }
+  void tile_counts(const flashgs::FrameStats&, std::vector<std::uint32_t>&) override {}
+
+ private:
+  fv::RenderWorker m_worker;
+  bool m_background;
+};
+
+// Baseline (left) against flash (right) at `width` x 1, each side rendered once.
+fv::CompareJob job_of_width(int width) {
+  fv::CompareJob job;
+  job.camera.width = width;
+  job.camera.height = 1;
+  job.left = flashgs::RenderOptions::baseline();
+  job.warm_up = false;
+  return job;
+}
 
 fv::FrameRequest request_of_width(int width) {
   fv::FrameRequest r;
@@ -233,4 +267,135 @@ TEST(ViewerRenderWorker, ANewSceneDoesNotWaitForTheFrameInFlight) {
   ASSERT_TRUE(worker.take(&frame));
   EXPECT_EQ(frame.image.width, 6);
   EXPECT_EQ(frame.image.height, 3) << "rendered with the new scene";
+}
+
+// The caller's flag stops a render made through with_renderer (the comparison's renders on
+// its task thread); without one, the worker's own cancels never reach it.
+TEST(ViewerRenderWorker, ARenderThroughWithRendererStopsOnTheCallersFlag) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  GatedRenderer* gated = owned.get();
+  fv::RenderWorker worker(std::move(owned), nullptr);
+  std::atomic<bool> cancel{false};
+  flashgs::FrameStats stats;
+  auto call = std::async(std::launch::async, [&] {
+    worker.with_renderer(
+        [&](flashgs::Renderer& r) {
+          flashgs::Image image;
+          r.render(request_of_width(3).camera, {}, image, &stats);
+        },
+        &cancel);
+  });
+  gated->wait_started(1);
+  cancel = true;
+  ASSERT_EQ(call.wait_for(std::chrono::seconds(30)), std::future_status::ready) << "the flag did not stop the render";
+  EXPECT_TRUE(stats.cancelled);
+  worker.request(request_of_width(4));  // the worker's own frames still render (its flag is back)
+  gated->release();
+  worker.wait_until_idle();
+  fv::FinishedFrame frame;
+  ASSERT_TRUE(worker.take(&frame));
+  EXPECT_EQ(frame.image.width, 4);
+}
+
+// On a path that renders in the background, start() returns while the renders run (before,
+// the comparison ran in the frame loop and the window froze until it ended); the outcome,
+// with its texture bytes, is taken once, and a second comparison meanwhile is refused.
+TEST(ViewerCompareTask, ItRunsBesideTheCallerAndItsOutcomeIsTakenOnce) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  GatedRenderer* gated = owned.get();
+  WorkerPath path(std::move(owned), true);
+  std::atomic<int> wakes{0};
+  fv::CompareTask task([&] { ++wakes; });
+  auto start = std::async(std::launch::async, [&] { return task.start(path, job_of_width(6)); });
+  gated->wait_started(1);
+  const bool returned = start.wait_for(std::chrono::seconds(30)) == std::future_status::ready;
+  if (!returned) gated->release(2);  // a start() that waits for the renders: let it end
+  ASSERT_TRUE(returned) << "start() waited for the comparison's renders";
+  ASSERT_TRUE(start.get());
+  fv::CompareOutcome outcome;
+  EXPECT_TRUE(task.busy());
+  EXPECT_FALSE(task.take(&outcome)) << "nothing to take while it renders";
+  EXPECT_FALSE(task.start(path, job_of_width(6))) << "one comparison at a time";
+  gated->release(2);
+  task.wait();
+  EXPECT_EQ(wakes.load(), 1);
+  ASSERT_TRUE(task.take(&outcome));
+  EXPECT_TRUE(outcome.result.valid) << outcome.result.error;
+  EXPECT_EQ(outcome.result.right_label, "flash");
+  EXPECT_EQ(outcome.result.left_label, "baseline");
+  EXPECT_EQ(outcome.left_rgba.size(), 6u * 4u);
+  EXPECT_EQ(outcome.right_rgba.size(), 6u * 4u);
+  EXPECT_EQ(outcome.difference_rgba.size(), 6u * 4u);
+  EXPECT_FALSE(outcome.cancelled());
+  EXPECT_FALSE(task.take(&outcome)) << "taken once";
+  EXPECT_FALSE(task.busy());
+  EXPECT_EQ(task.elapsed_seconds(), 0.0);
+}
+
+// cancel() stops the render in flight (the worker's renderer sees the task's flag) and the
+// outcome says so; the next comparison starts afresh.
+TEST(ViewerCompareTask, CancelStopsTheRenderInFlight) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  GatedRenderer* gated = owned.get();
+  WorkerPath path(std::move(owned), true);
+  fv::CompareTask task;
+  ASSERT_TRUE(task.start(path, job_of_width(5)));
+  gated->wait_started(1);
+  task.cancel();
+  task.wait();  // returns: the render saw the flag (else this test hangs)
+  fv::CompareOutcome outcome;
+  ASSERT_TRUE(task.take(&outcome));
+  EXPECT_TRUE(outcome.cancelled());
+  EXPECT_FALSE(outcome.result.valid);
+  EXPECT_TRUE(outcome.left_rgba.empty());
+  EXPECT_EQ(gated->wait_started(1).size(), 1u) << "the second side never started";
+  ASSERT_TRUE(task.start(path, job_of_width(5)));
+  gated->release(2);
+  task.wait();
+  ASSERT_TRUE(task.take(&outcome));
+  EXPECT_TRUE(outcome.result.valid) << outcome.result.error;
+}
+
+// A comparison finished but not yet taken when the scene changes is dropped all the same.
+TEST(ViewerCompareTask, ACancelAfterTheRendersEndedStillDropsTheOutcome) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  owned->release(2);
+  WorkerPath path(std::move(owned), true);
+  fv::CompareTask task;
+  ASSERT_TRUE(task.start(path, job_of_width(4)));
+  task.wait();
+  task.cancel();
+  fv::CompareOutcome outcome;
+  ASSERT_TRUE(task.take(&outcome));
+  EXPECT_TRUE(outcome.cancelled());
+  EXPECT_TRUE(outcome.difference_rgba.empty());
+}
+
+TEST(ViewerCompareTask, DestroyingItStopsTheComparisonInFlight) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  GatedRenderer* gated = owned.get();
+  WorkerPath path(std::move(owned), true);
+  {
+    fv::CompareTask task;
+    ASSERT_TRUE(task.start(path, job_of_width(7)));
+    gated->wait_started(1);
+  }  // returns: the task cancelled its render and joined (else this test hangs)
+  SUCCEED();
+}
+
+// On a path that renders in the caller's thread (a GPU path) the comparison is done when
+// start() returns: one code path, no thread; a failing render is the outcome's error.
+TEST(ViewerCompareTask, OnAPathThatRendersHereItIsDoneWhenStartReturns) {
+  auto owned = std::make_unique<GatedRenderer>(true);
+  owned->release(2);
+  WorkerPath path(std::move(owned), false);
+  fv::CompareTask task;
+  ASSERT_TRUE(task.start(path, job_of_width(3)));
+  fv::CompareOutcome outcome;
+  ASSERT_TRUE(task.take(&outcome));
+  EXPECT_TRUE(outcome.result.valid) << outcome.result.error;
+  ASSERT_TRUE(task.start(path, job_of_width(13)));
+  ASSERT_TRUE(task.take(&outcome));
+  EXPECT_FALSE(outcome.result.valid);
+  EXPECT_EQ(outcome.result.error, "width 13 refused");
 }

@@ -50,7 +50,7 @@ std::string same_configuration_problem(const RenderOptions& left, const RenderOp
 }
 
 CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOptions& left_options,
-                          const RenderOptions& right_options, bool warm_up) {
+                          const RenderOptions& right_options, bool warm_up, const std::atomic<bool>* cancel) {
   CompareResult r;
   r.left_label = left_options.label();
   r.right_label = right_options.label();
@@ -61,14 +61,25 @@ CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOpt
   try {
     const RenderOptions left = untracked(left_options), right = untracked(right_options);
     FrameStats sl, sr;
+    // Each render, unless cancelled before it or during it; true when stopped.
+    auto render = [&](const RenderOptions& options, Image& out, FrameStats& stats) {
+      if (cancel && cancel->load()) return true;
+      path.render_image(camera, options, out, &stats, cancel);
+      return stats.cancelled;
+    };
+    auto stopped = [&] {
+      r.error = kCompareCancelled;
+      r.left_image = r.right_image = Image{};
+      return r;
+    };
     using clock = std::chrono::steady_clock;
-    if (warm_up) path.render_image(camera, right, r.right_image, &sr);
+    if (warm_up && render(right, r.right_image, sr)) return stopped();
     auto t0 = clock::now();
-    path.render_image(camera, right, r.right_image, &sr);
+    if (render(right, r.right_image, sr)) return stopped();
     auto t1 = clock::now();
-    if (warm_up) path.render_image(camera, left, r.left_image, &sl);
+    if (warm_up && render(left, r.left_image, sl)) return stopped();
     auto t2 = clock::now();
-    path.render_image(camera, left, r.left_image, &sl);
+    if (render(left, r.left_image, sl)) return stopped();
     auto t3 = clock::now();
     r.right_wall_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
     r.left_wall_ms = std::chrono::duration<double, std::milli>(t3 - t2).count();

@@ -1,6 +1,7 @@
 // Compare mode: two configurations rendered for one view (by default the baseline and the current one), their images, difference and times.
 #pragma once
 
+#include <atomic>
 #include <string>
 
 #include "flashgs/camera.h"
@@ -42,9 +43,11 @@ struct CompareResult {
 // Renders `camera` with `left` and with `right` through `path`'s host-memory route and
 // compares them. With `warm_up` each is rendered twice and the second timed (a GPU path's
 // first use of a size allocates); the CPU path's buffers are already sized by the frame
-// just shown, and a second render would double the wait. Never throws: errors (and two
-// equal configurations) land in `error`.
+// just shown, and a second render would double the wait. Once `cancel` is set (it may be
+// null) the renders stop where the path can and `error` is kCompareCancelled. Never throws:
+// errors (and two equal configurations) land in `error`.
+inline constexpr const char kCompareCancelled[] = "cancelled";
 CompareResult run_compare(FramePath& path, const Camera& camera, const RenderOptions& left, const RenderOptions& right,
-                          bool warm_up = true);
+                          bool warm_up, const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace flashgs::viewer

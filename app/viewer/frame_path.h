@@ -1,6 +1,7 @@
 // FramePath: how a rendered frame reaches the window's texture (CUDA-GL interop, or a renderer's image uploaded from host memory).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -42,8 +43,11 @@ class FramePath {
   // use after the render). For frames that render nothing, screenshots and checks.
   virtual void present_latest() {}
   // Renders into host memory (compare mode, float screenshots). Thread-safe on a path that
-  // renders_in_background(): the comparison calls it from a task thread.
-  virtual void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) = 0;
+  // renders_in_background(): the comparison calls it from a task thread, and there the render
+  // stops early (stats->cancelled set) once `cancel` is set; the other paths finish it (a GPU
+  // frame takes milliseconds). `cancel` may be null.
+  virtual void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats,
+                            const std::atomic<bool>* cancel) = 0;
 
   // The viewer's one way to get frames, on every path. A path that renders in the background
   // (the CPU backend on its worker thread) returns from submit() at once and delivers the frame

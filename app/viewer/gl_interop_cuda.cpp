@@ -96,7 +96,8 @@ class InteropPath final : public FramePath {
     m_shown = texture;
   }
 
-  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
+  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats,
+                    const std::atomic<bool>*) override {
     m_renderer->render(camera, options, out, stats);
   }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "flashgs/image.h"
+#include "rgba8_image.h"
 #include "gl_headers_gl.h"
 #include "shader_program_gl.h"
 
@@ -15,10 +16,6 @@ struct HeatmapView {
   float opacity = 0.6f;
   float legend_rect[4] = {0, 0, 0, 0};  // window framebuffer pixels (x0, y0, x1, y1), y down
 };
-
-// A float RGB image (top row first) as RGBA8 bytes, rounded as write_image's 8-bit path does
-// (so a CPU-path screenshot equals the CLI's PNG).
-void to_rgba8(const Image& image, std::vector<std::uint8_t>& rgba);
 
 class ImagePresenter {
  public:

@@ -69,7 +69,7 @@ void RenderWorker::set_scene(std::shared_ptr<const Scene> scene) {
   m_wake.notify_all();
 }
 
-void RenderWorker::with_renderer(const std::function<void(Renderer&)>& fn) {
+void RenderWorker::with_renderer(const std::function<void(Renderer&)>& fn, const std::atomic<bool>* cancel) {
   {
     std::lock_guard<std::mutex> lock(m_mutex);
     ++m_waiting_users;  // the worker starts no frame until this call is done (no starvation)
@@ -87,16 +87,25 @@ void RenderWorker::with_renderer(const std::function<void(Renderer&)>& fn) {
   } done{this};
   std::lock_guard<std::mutex> renderer_lock(m_renderer_mutex);
   m_cancel = false;  // nothing of the worker's renders now: the flag was for its frame only
+  // The caller's flag while `fn` runs (the worker's own stops only the worker's frames).
+  struct WatchedFlag {
+    Renderer& r;
+    const std::atomic<bool>* worker_flag;
+    ~WatchedFlag() { r.set_cancel_flag(worker_flag); }
+  } watched{*m_renderer, &m_cancel};
+  m_renderer->set_cancel_flag(cancel);
   fn(*m_renderer);
+}
+
+void lower_this_thread_priority() {
+#ifdef __linux__
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 5);  // threads it starts inherit it
+#endif
 }
 
 void RenderWorker::loop() {
   using Clock = std::chrono::steady_clock;
-#ifdef __linux__
-  // Below the UI thread: on a machine with few cores the window must still answer at once.
-  // The renderer's OpenMP threads, started from this thread, inherit it.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 5);
-#endif
+  lower_this_thread_priority();  // the renderer's OpenMP threads, started from here, too
   for (;;) {
     std::unique_lock<std::mutex> renderer_lock(m_renderer_mutex, std::defer_lock);
     {

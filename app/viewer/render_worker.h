@@ -34,6 +34,10 @@ struct FinishedFrame {
   std::string error;  // non-empty: the render threw (out of memory, ...); image and stats are empty
 };
 
+// Puts the calling thread below the UI thread (and the OpenMP threads it starts later): on a
+// machine with few cores the window must still answer at once. For the threads that render.
+void lower_this_thread_priority();
+
 class RenderWorker {
  public:
   // `on_finished` runs on the worker thread after each finished frame (the viewer wakes its
@@ -60,8 +64,9 @@ class RenderWorker {
   void set_scene(std::shared_ptr<const Scene> scene);
   // Runs `fn` with the renderer on the calling thread once no frame renders: the one in flight
   // is cancelled and requested again afterwards. Thread-safe (set_scene from the UI thread,
-  // the comparison's renders from a task thread); exceptions from `fn` propagate.
-  void with_renderer(const std::function<void(Renderer&)>& fn);
+  // the comparison's renders from a task thread); exceptions from `fn` propagate. The renders
+  // `fn` makes stop early once `cancel` is set (null: they finish).
+  void with_renderer(const std::function<void(Renderer&)>& fn, const std::atomic<bool>* cancel = nullptr);
 
  private:
   void loop();

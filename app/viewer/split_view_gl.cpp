@@ -1,7 +1,6 @@
 // Texture upload and the split / difference draw of the comparison.
 #include "split_view_gl.h"
 
-#include "image_presenter_gl.h"
 #include "viewer_shaders.h"  // generated from shaders/*.glsl by CMake
 
 namespace flashgs::viewer {
@@ -24,18 +23,10 @@ void SplitViewPresenter::init() {
   }
 }
 
-void SplitViewPresenter::upload(GLuint texture, const Image& image) {
-  std::vector<std::uint8_t> rgba;
-  to_rgba8(image, rgba);
-  glBindTexture(GL_TEXTURE_2D, texture);
+void SplitViewPresenter::set_image(int index, int width, int height, const std::uint8_t* rgba) {
+  glBindTexture(GL_TEXTURE_2D, m_textures[index]);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
-}
-
-void SplitViewPresenter::set_images(const Image& left, const Image& right, const Image& difference) {
-  upload(m_textures[0], left);
-  upload(m_textures[1], right);
-  upload(m_textures[2], difference);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
 }
 
 void SplitViewPresenter::draw(int fb_width, int fb_height, float divider, float line_px, bool difference) {

@@ -1,7 +1,8 @@
 // SplitViewPresenter: the comparison's images as textures, drawn split at the divider or (the difference image) alone.
 #pragma once
 
-#include "flashgs/image.h"
+#include <cstdint>
+
 #include "gl_headers_gl.h"
 #include "shader_program_gl.h"
 
@@ -15,15 +16,14 @@ class SplitViewPresenter {
   SplitViewPresenter& operator=(const SplitViewPresenter&) = delete;
 
   void init();  // compiles the shader (throws flashgs::Error with the driver's log)
-  // Uploads the comparison's left and right renders and their difference image (float RGB,
-  // top row first; the same conversion to 8 bits as the frame's upload).
-  void set_images(const Image& left, const Image& right, const Image& difference);
+  // Uploads the comparison's left (0) or right (1) render or their difference image (2),
+  // `width` x `height` RGBA8 bytes (to_rgba8, done beforehand: it takes longer than a frame).
+  void set_image(int index, int width, int height, const std::uint8_t* rgba);
   // Over the whole framebuffer: left | right split at `divider` (fraction of the width) with a
   // white line `line_px` wide, or the difference image when `difference` is set.
   void draw(int framebuffer_width, int framebuffer_height, float divider, float line_px, bool difference);
 
  private:
-  void upload(GLuint texture, const Image& image);
 
   ShaderProgram m_program;
   GLuint m_vao = 0;

@@ -19,7 +19,8 @@ class UploadPath final : public FramePath {
     m_renderer->render(camera, options, m_image, stats);
     m_presenter->upload(m_image);
   }
-  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
+  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats,
+                    const std::atomic<bool>*) override {
     m_renderer->render(camera, options, out, stats);
   }
   void tile_counts(const FrameStats& stats, std::vector<std::uint32_t>& out) override { out = stats.tile_pair_counts; }
@@ -64,8 +65,9 @@ class BackgroundUploadPath final : public FramePath {
     m_worker.with_renderer([&](Renderer& r) { r.render(camera, options, m_image, stats); });
     m_presenter->upload(m_image);
   }
-  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
-    m_worker.with_renderer([&](Renderer& r) { r.render(camera, options, out, stats); });
+  void render_image(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats,
+                    const std::atomic<bool>* cancel) override {
+    m_worker.with_renderer([&](Renderer& r) { r.render(camera, options, out, stats); }, cancel);
   }
   void tile_counts(const FrameStats& stats, std::vector<std::uint32_t>& out) override { out = stats.tile_pair_counts; }
   const Image* last_image() const override { return &m_image; }

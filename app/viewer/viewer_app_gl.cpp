@@ -66,7 +66,8 @@ std::string size_text(int width, int height) { return std::to_string(width) + "x
 
 }  // namespace
 
-ViewerApp::ViewerApp(ViewerArgs args) : m_args(std::move(args)) {
+ViewerApp::ViewerApp(ViewerArgs args)
+    : m_args(std::move(args)), m_compare_task([] { glfwPostEmptyEvent(); }) {  // a finished comparison wakes the loop
   m_scripted = m_args.scripted();
   // Interactive runs start from the saved settings, the command line over them; scripted
   // runs from the defaults and the command line only (repeatable, and they save nothing).
@@ -149,6 +150,9 @@ void ViewerApp::remember_recent(const std::string& path) {
 }
 
 ViewerApp::~ViewerApp() {
+  // A comparison renders through the path: it stops first.
+  m_compare_task.cancel();
+  m_compare_task.wait();
   // GL objects and interop registrations go before the context (the window) does.
   m_path.reset();
   m_split.reset();
@@ -158,6 +162,10 @@ ViewerApp::~ViewerApp() {
 }
 
 void ViewerApp::use_cpu_path(const std::string& why) {
+  if (m_compare_task.busy()) {  // it renders through the path being replaced
+    m_compare_task.cancel();
+    m_compare_task.wait();
+  }
   // The worker wakes the event loop when a frame is done: the window shows it at once.
   m_path = make_background_upload_path(make_cpu_renderer(m_args.cpu_threads), m_presenter.get(), "CPU renderer + texture upload",
                                        [] { glfwPostEmptyEvent(); });
@@ -199,6 +207,9 @@ void ViewerApp::install_scene(LoadedScene scene) {
   // Another level of the same LOD set: the same place, seen from where the user stands.
   const bool same_place = !scene.lod_gaussians.empty() && scene.path == m_scene.path && m_scene.scene;
   m_scene = std::move(scene);
+  m_compare_task.cancel();  // a comparison of the old scene: dropped when it ends...
+  m_arrived = {};           // ...or while its textures are going up
+  m_arrived_textures = 0;
   if (same_place) {
     m_compare = {};
     m_have_request = false;
@@ -463,32 +474,72 @@ void ViewerApp::apply_actions(const UiActions& a) {
   if (a.compare) m_compare_pending = true;
   if (m_compare_pending && m_have_frame && m_frame_is_full) {
     m_compare_pending = false;
-    run_comparison();
+    start_comparison();
   }
 }
 
-void ViewerApp::run_comparison() {
-  const RenderOptions left = compare_choice_options(m_settings.compare_left, m_settings.options);
-  const RenderOptions right = compare_choice_options(m_settings.compare_right, m_settings.options);
-  m_compare = run_compare(*m_path, m_last_camera, left, right, /*warm_up=*/!m_path_is_cpu);
-  m_compare_camera = m_last_camera;
-  m_compare_options = m_last_options;
-  if (!m_compare.valid) {
-    set_notice("compare: " + m_compare.error);
+void ViewerApp::start_comparison() {
+  if (comparing()) {
+    set_notice("still comparing " + m_comparing + ": this request is ignored");
     return;
   }
-  const Image difference = difference_image(m_compare.right_image, m_compare.left_image, &m_difference_factor);
-  if (!m_split) {
-    m_split = std::make_unique<SplitViewPresenter>();
-    m_split->init();
+  CompareJob job;
+  job.camera = m_last_camera;
+  job.left = compare_choice_options(m_settings.compare_left, m_settings.options);
+  job.right = compare_choice_options(m_settings.compare_right, m_settings.options);
+  job.warm_up = !m_path_is_cpu;
+  m_compare = {};  // the last comparison's images are of another view: the frame shows meanwhile
+  m_compare_camera = m_last_camera;
+  m_compare_options = m_last_options;
+  m_comparing = job.right.label() + " vs " + job.left.label() + " at " + size_text(job.camera.width, job.camera.height);
+  if (m_path->renders_in_background())
+    std::fprintf(stderr, "flashgs-viewer: comparing %s in the background\n", m_comparing.c_str());
+  m_compare_task.start(*m_path, job);
+}
+
+bool ViewerApp::comparing() const { return m_compare_task.busy() || m_arrived_textures > 0; }
+
+void ViewerApp::finish_comparison(bool at_once) {
+  CompareOutcome& done = m_arrived;
+  if (m_arrived_textures == 0) {
+    if (!m_compare_task.take(&done)) return;
+    if (done.cancelled()) {  // another scene, or quitting
+      std::fprintf(stderr, "flashgs-viewer: comparison of %s cancelled after %.0f ms\n", m_comparing.c_str(),
+                   done.elapsed_ms);
+      return;
+    }
+    if (!done.result.valid) {
+      m_compare = std::move(done.result);
+      set_notice("compare: " + m_compare.error);
+      return;
+    }
+    if (!m_split) {
+      m_split = std::make_unique<SplitViewPresenter>();
+      m_split->init();
+    }
   }
-  m_split->set_images(m_compare.left_image, m_compare.right_image, difference);
+  // One texture a frame unless `at_once`: each takes about a frame's time on llvmpipe.
+  const std::uint8_t* textures[3] = {done.left_rgba.data(), done.right_rgba.data(), done.difference_rgba.data()};
+  do {
+    m_split->set_image(m_arrived_textures, done.result.width, done.result.height, textures[m_arrived_textures]);
+  } while (++m_arrived_textures < 3 && at_once);
+  if (m_arrived_textures < 3) return;
+  m_arrived_textures = 0;
+  m_compare = std::move(done.result);
+  m_difference_factor = done.difference_factor;
   std::fprintf(stderr,
                "flashgs-viewer: compare %s vs %s at %dx%d: PSNR %.2f dB, max abs %.6f, %.3f ms vs %.3f ms, "
                "speed-up %.2fx, pair reduction %.1f%%, difference image x%.0f\n",
                m_compare.right_label.c_str(), m_compare.left_label.c_str(), m_compare.width, m_compare.height,
                m_compare.difference.psnr_db, m_compare.difference.max_abs, m_compare.right_ms, m_compare.left_ms,
                m_compare.speed_up(), 100.0 * m_compare.pair_reduction(), m_difference_factor);
+  // The view or configuration asked for while it ran is not the one compared.
+  if (m_have_request && (!same_camera(m_requested.camera, m_compare_camera) || !(m_requested.options == m_compare_options))) {
+    m_compare.stale = true;
+    std::fprintf(stderr, "flashgs-viewer: the comparison is stale: the view or options changed in its %.0f ms\n",
+                 done.elapsed_ms);
+  }
+  done = CompareOutcome{};
 }
 
 bool ViewerApp::comparison_shown() const {
@@ -573,7 +624,7 @@ void ViewerApp::export_step() {
   options.collect_tile_counts = false;
   try {
     Image image;
-    m_path->render_image(camera, options, image, nullptr);
+    m_path->render_image(camera, options, image, nullptr, nullptr);
     write_image(image, m_export.next_file());
   } catch (const std::exception& e) {
     set_notice("path export stopped: " + reason(e));
@@ -794,7 +845,8 @@ void ViewerApp::log_held_input() {
                "flashgs-viewer: frame %d held:%s at %.0f,%.0f | camera %.6f %.6f %.6f forward %.6f %.6f %.6f "
                "right %.6f %.6f %.6f pivot %.6f %.6f %.6f%s, HUD %.1f FPS\n",
                m_presented, held.c_str(), x, y, p.position.x, p.position.y, p.position.z, f.x, f.y, f.z, r.x, r.y, r.z,
-               pivot.x, pivot.y, pivot.z, m_path->busy() ? " (a frame is rendering)" : "",
+               pivot.x, pivot.y, pivot.z,
+               comparing() ? " (comparing)" : m_path->busy() ? " (a frame is rendering)" : "",
                m_rendered_rate.rate(ms_since(m_started) / 1000.0));
 }
 
@@ -873,7 +925,7 @@ void ViewerApp::save_screenshot(const std::string& path) {
       image = *host;
     } else if (ext == ".exr" || ext == ".EXR" || ext == ".pfm") {
       // Float formats get the float frame, rendered again for the same view.
-      m_path->render_image(m_last_camera, m_last_options, image, nullptr);
+      m_path->render_image(m_last_camera, m_last_options, image, nullptr, nullptr);
     } else {
       image = m_presenter->read_back();  // what the window shows, byte for byte
     }
@@ -916,7 +968,7 @@ void ViewerApp::check_displayed_frame() {
   m_presenter->show(m_path->shown_texture());
   const Image shown = m_presenter->read_back();
   Image expected;
-  m_path->render_image(m_last_camera, m_last_options, expected, nullptr);
+  m_path->render_image(m_last_camera, m_last_options, expected, nullptr, nullptr);
   int worst = 0;
   std::size_t off = 0;
   if (shown.width != expected.width || shown.height != expected.height) {
@@ -954,6 +1006,8 @@ void ViewerApp::finish_script() {
     UiActions a;
     a.compare = true;
     apply_actions(a);
+    m_compare_task.wait();  // the line below is the comparison's, however long it renders
+    finish_comparison(/*at_once=*/true);
     if (m_compare.valid)
       std::printf("viewer compare: %s vs %s PSNR %.2f dB max abs %.6f\n", m_compare.right_label.c_str(),
                   m_compare.left_label.c_str(), m_compare.difference.psnr_db, m_compare.difference.max_abs);
@@ -1111,8 +1165,8 @@ bool ViewerApp::open_window() {
 bool ViewerApp::begin_frame(int* fb_w, int* fb_h, float* dt) {
   // Waits for events only when nothing moves or renders every frame; a frame finished on the
   // worker wakes the loop (glfwPostEmptyEvent), and a load in progress redraws its bar.
-  const bool idle = !m_scripted && !m_settings.continuous && !m_playing && !m_moving;
-  double wait_s = !idle ? 0.0 : m_loader.busy() ? 0.1 : 0.5;
+  const bool idle = !m_scripted && !m_settings.continuous && !m_playing && !m_moving && m_arrived_textures == 0;
+  double wait_s = !idle ? 0.0 : m_loader.busy() || comparing() ? 0.1 : 0.5;  // progress redrawn
   const double settle_left_ms = kSettleMs - ms_since(m_last_motion);
   if (wait_s > 0 && settle_left_ms > 0) wait_s = std::min(wait_s, settle_left_ms / 1000.0 + 0.001);  // then the full frame
   m_window->poll(wait_s);
@@ -1166,7 +1220,9 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.render_height = m_presenter->height();
   model.fps = m_rendered_rate.rate(ms_since(m_started) / 1000.0);
   model.last_frame_ms = m_last_frame_ms;
-  model.rendering = m_path->busy();
+  model.rendering = m_path->busy() || comparing();
+  if (comparing()) model.comparing = m_comparing;
+  model.compare_elapsed_s = m_compare_task.elapsed_seconds();
   model.stats = m_have_frame ? &m_stats : nullptr;
   model.history = &m_history;
   model.compare = &m_compare;
@@ -1226,8 +1282,8 @@ void ViewerApp::record_frame_times(double frame_ms, double ui_ms, bool rendering
     ++m_ui_frames_while_rendering;
     m_worst_ui_ms_while_rendering = std::max(m_worst_ui_ms_while_rendering, ui_ms);
     if (m_args.log_input && ui_ms >= 50.0)  // where a slow one went (tests print it on failure)
-      std::fprintf(stderr, "flashgs-viewer: slow UI frame %d: %.1f ms (events + panels %.1f, frame request %.1f, draw %.1f, swap %.1f%s)\n",
-                   m_presented, ui_ms, m_before_render_ms, m_render_call_ms, m_draw_ms, m_swap_ms,
+      std::fprintf(stderr, "flashgs-viewer: slow UI frame %d: %.1f ms (events + panels %.1f, frame request %.1f, comparison textures %.1f, draw %.1f, swap %.1f%s)\n",
+                   m_presented, ui_ms, m_before_render_ms, m_render_call_ms, m_compare_show_ms, m_draw_ms, m_swap_ms,
                    m_delivered ? ", a frame uploaded" : "");
   }
   if (!m_scripted) return;
@@ -1254,7 +1310,8 @@ int ViewerApp::run() {
     int fb_w = 0, fb_h = 0;
     float dt = 0;
     if (!begin_frame(&fb_w, &fb_h, &dt)) continue;
-    const bool rendering = m_path->busy();  // a background frame in flight as this frame starts
+    // A background frame or comparison in flight as this frame starts.
+    const bool rendering = m_path->busy() || comparing();
     UiActions actions;
     NavigationInput nav;
     gather_input(nav, actions);
@@ -1270,6 +1327,9 @@ int ViewerApp::run() {
     m_before_render_ms = ms_since(m_frame_start);
     request_frame(fb_w, fb_h, m_moving || ms_since(m_last_motion) < kSettleMs);
     collect_frame();
+    const auto t_compare = Clock::now();
+    finish_comparison(/*at_once=*/false);
+    m_compare_show_ms = ms_since(t_compare);
     draw_and_present(fb_w, fb_h);
     const auto swapped = Clock::now();
     const double frame_ms = std::chrono::duration<double, std::milli>(swapped - last_swap).count();
@@ -1277,6 +1337,11 @@ int ViewerApp::run() {
     record_frame_times(frame_ms, ms_since(m_frame_start), rendering);
   }
   save_settings();
+  if (m_compare_task.busy()) {  // quitting stops it: its renders end at their next check, before the path goes
+    m_compare_task.cancel();
+    m_compare_task.wait();
+    finish_comparison(/*at_once=*/true);  // logs the cancel
+  }
   if (m_ui_frames_while_rendering > 0)
     std::fprintf(stderr, "flashgs-viewer: UI frames while a frame rendered in the background: %d, worst %.1f ms\n",
                  m_ui_frames_while_rendering, m_worst_ui_ms_while_rendering);

@@ -9,6 +9,7 @@
 #include "camera_controller.h"
 #include "camera_path.h"
 #include "compare_mode.h"
+#include "compare_task.h"
 #include "file_browser_ui.h"
 #include "file_dialog.h"
 #include "heatmap_legend.h"
@@ -88,7 +89,12 @@ class ViewerApp {
   void legend_rect(int fb_w, int fb_h, float* rect) const;  // the heat-map legend, framebuffer pixels
   void save_screenshot(const std::string& path);
   void save_window_screenshot(const std::string& path, int width, int height);
-  void run_comparison();
+  // The comparison of this view: started on its task (beside the frame loop on the CPU path);
+  // finished once the task has it and its images are textures of the split view (GL, this
+  // thread; one a frame unless `at_once`).
+  void start_comparison();
+  void finish_comparison(bool at_once);
+  bool comparing() const;  // started, and not yet shown
   bool comparison_shown() const;  // the split or difference image replaces the frame
   void handle_divider_drag(bool left_down, double x);
   int frustum_under_click(bool left_down, double x, double y);  // on release of a click, else -1
@@ -142,6 +148,10 @@ class ViewerApp {
   CompareResult m_compare;
   Camera m_compare_camera;          // the view and configuration the comparison was made for
   RenderOptions m_compare_options;
+  CompareTask m_compare_task;
+  CompareOutcome m_arrived;         // the finished comparison whose textures are going up...
+  int m_arrived_textures = 0;       // ...and how many of its three are up (0: none arriving)
+  std::string m_comparing;          // "flash vs baseline at WxH": the comparison the task runs
   float m_difference_factor = 1.0f;  // the difference image's magnification
   SplitDivider m_divider;
   bool m_left_was_down = false;
@@ -172,8 +182,8 @@ class ViewerApp {
   int m_max_texture_size = 0;                     // GL_MAX_TEXTURE_SIZE
   int m_ui_frames = 0;                            // frames presented with the panels since the first load
   int m_presented = 0;                            // frames presented in all
-  // UI frames (input to swap, the wait for events not counted) while a frame rendered in the
-  // background: the worst is logged at exit (the UI must answer within 100 ms).
+  // UI frames (input to swap, the wait for events not counted) while a frame or a comparison
+  // rendered in the background: the worst is logged at exit (the UI must answer within 100 ms).
   int m_ui_frames_while_rendering = 0;
   double m_worst_ui_ms_while_rendering = 0;
 
@@ -191,6 +201,7 @@ class ViewerApp {
   bool m_scripted = false;
   std::unique_ptr<ScriptedRun> m_script;
   double m_render_call_ms = 0, m_before_render_ms = 0, m_draw_ms = 0, m_swap_ms = 0;  // this frame's parts
+  double m_compare_show_ms = 0;  // ...and the comparison's textures uploaded in it
   int m_exit_code = 0;
   std::string m_pending_window_shot;
   bool m_close_after_shot = false;

@@ -105,10 +105,10 @@ void load_window(const UiModel& m, UiActions& a) {
 }
 
 // One line over the picture: rendered frames per second, time per frame, pairs, backend, and
-// whether a frame is on its way (the picture shown is then the previous one).
+// whether a frame or a comparison is on its way (the picture shown is then the previous one).
 void hud_line(const UiModel& m, float panel_right) {
   const char* backend = m.backend == Backend::cpu ? "CPU" : "CUDA";
-  const char* busy = m.rendering ? " | rendering..." : "";
+  const char* busy = !m.comparing.empty() ? " | comparing..." : m.rendering ? " | rendering..." : "";
   char rate[64], size[32];
   if (m.fps > 0) std::snprintf(rate, sizeof rate, "%.1f FPS | %.0f ms/frame", m.fps, m.last_frame_ms);
   else std::snprintf(rate, sizeof rate, "idle | last frame %.0f ms", m.last_frame_ms);
@@ -316,7 +316,7 @@ void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   side("left", &s.compare_left);
   ImGui::SameLine();
   side("right", &s.compare_right);
-  ImGui::BeginDisabled(!m.compare_problem.empty());
+  ImGui::BeginDisabled(!m.compare_problem.empty() || !m.comparing.empty());  // one comparison at a time
   if (ImGui::Button("Compare this view (C)")) a.compare = true;
   note_widget_place("Compare this view (C)");
   ImGui::EndDisabled();
@@ -326,6 +326,10 @@ void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   ImGui::SetNextItemWidth(ui(120));
   ImGui::Combo("##view", &view, views, 3);
   s.compare_view = static_cast<CompareView>(view);
+  if (!m.comparing.empty()) {
+    ImGui::TextColored(ImVec4(1.0f, 0.86f, 0.47f, 1), "comparing %s ... %.1f s", m.comparing.c_str(), m.compare_elapsed_s);
+    return;
+  }
   if (!m.compare_problem.empty()) {
     ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.compare_problem.c_str());
     return;

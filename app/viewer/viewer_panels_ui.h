@@ -44,6 +44,8 @@ struct UiModel {
   const FrameStats* stats = nullptr;
   const StatsHistory* history = nullptr;
   const CompareResult* compare = nullptr;
+  std::string comparing;          // the comparison running now ("flash vs baseline at WxH"), if any
+  double compare_elapsed_s = 0;   // for how long it has run
   std::uint32_t heatmap_max = 0;  // the scale's top (locked or this frame's)
   int tile_size = 16;
   bool compare_shown = false;     // the split or difference image is on screen
