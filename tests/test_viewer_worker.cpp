@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "background_job.h"
 #include "camera_controller.h"
 #include "compare_task.h"
 #include "flashgs/generators.h"
@@ -398,4 +399,48 @@ TEST(ViewerCompareTask, OnAPathThatRendersHereItIsDoneWhenStartReturns) {
   ASSERT_TRUE(task.take(&outcome));
   EXPECT_FALSE(outcome.result.valid);
   EXPECT_EQ(outcome.result.error, "width 13 refused");
+}
+
+// A path export's frame job: beside the caller, one at a time, its outcome taken once; the
+// cancel flag reaches it; a throw becomes its message.
+TEST(ViewerBackgroundJob, OneJobBesideTheCallerItsOutcomeTakenOnce) {
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  std::atomic<int> done_calls{0};
+  flashgs::viewer::BackgroundJob job([&] { ++done_calls; });
+  ASSERT_TRUE(job.start(true, [released](const std::atomic<bool>&) -> std::string {
+    released.wait();  // the caller has gone on: start() did not wait for this
+    return "";
+  }));
+  EXPECT_TRUE(job.busy());
+  EXPECT_FALSE(job.start(true, [](const std::atomic<bool>&) -> std::string { return ""; })) << "a second job while busy";
+  std::string error = "unset";
+  EXPECT_FALSE(job.take(&error)) << "taken before it ended";
+  release.set_value();
+  job.wait();
+  ASSERT_TRUE(job.take(&error));
+  EXPECT_EQ(error, "");
+  EXPECT_FALSE(job.take(&error)) << "taken twice";
+  EXPECT_FALSE(job.busy());
+  EXPECT_EQ(done_calls.load(), 1);
+  // At once when not on a thread, and a throw is the job's message.
+  ASSERT_TRUE(job.start(false, [](const std::atomic<bool>&) -> std::string { throw std::runtime_error("disk full"); }));
+  ASSERT_TRUE(job.take(&error));
+  EXPECT_EQ(error, "disk full");
+}
+
+TEST(ViewerBackgroundJob, CancelRaisesTheJobsFlag) {
+  flashgs::viewer::BackgroundJob job;
+  std::atomic<bool> started{false};
+  ASSERT_TRUE(job.start(true, [&started](const std::atomic<bool>& cancel) -> std::string {
+    started = true;
+    while (!cancel) std::this_thread::yield();  // a render checking its flag between tiles
+    return "cancelled";
+  }));
+  while (!started) std::this_thread::yield();
+  job.cancel();
+  job.wait();
+  std::string error;
+  ASSERT_TRUE(job.take(&error));
+  EXPECT_EQ(error, "cancelled");
 }

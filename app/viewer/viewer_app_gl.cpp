@@ -67,7 +67,9 @@ std::string size_text(int width, int height) { return std::to_string(width) + "x
 }  // namespace
 
 ViewerApp::ViewerApp(ViewerArgs args)
-    : m_args(std::move(args)), m_compare_task([] { glfwPostEmptyEvent(); }) {  // a finished comparison wakes the loop
+    : m_args(std::move(args)),
+      m_compare_task([] { glfwPostEmptyEvent(); }),  // a finished comparison wakes the loop
+      m_export_job([] { glfwPostEmptyEvent(); }) {   // as does each exported frame
   m_scripted = m_args.scripted();
   // Interactive runs start from the saved settings, the command line over them; scripted
   // runs from the defaults and the command line only (repeatable, and they save nothing).
@@ -150,9 +152,11 @@ void ViewerApp::remember_recent(const std::string& path) {
 }
 
 ViewerApp::~ViewerApp() {
-  // A comparison renders through the path: it stops first.
+  // A comparison and an export frame render through the path: they stop first.
   m_compare_task.cancel();
   m_compare_task.wait();
+  m_export_job.cancel();
+  m_export_job.wait();
   // GL objects and interop registrations go before the context (the window) does.
   m_path.reset();
   m_split.reset();
@@ -165,6 +169,16 @@ void ViewerApp::use_cpu_path(const std::string& why) {
   if (m_compare_task.busy()) {  // it renders through the path being replaced
     m_compare_task.cancel();
     m_compare_task.wait();
+  }
+  if (m_export_job.busy()) {  // so does an export frame: the export stops
+    m_export_job.cancel();
+    m_export_job.wait();
+    std::string ignored;
+    m_export_job.take(&ignored);
+    if (m_export.active()) {
+      set_notice("path export stopped after " + std::to_string(m_export.done_frames()) + " frames: the frame path changed");
+      m_export.cancel();
+    }
   }
   // The worker wakes the event loop when a frame is done: the window shows it at once.
   m_path = make_background_upload_path(make_cpu_renderer(m_args.cpu_threads), m_presenter.get(), "CPU renderer + texture upload",
@@ -462,6 +476,12 @@ void ViewerApp::apply_actions(const UiActions& a) {
   if (a.cancel_export && m_export.active()) {
     set_notice("path export cancelled after " + std::to_string(m_export.done_frames()) + " frames");
     m_export.cancel();
+    // The frame in flight stops at its next check (the CPU renderer's are between tiles) and
+    // is dropped here, so that the next export starts clean.
+    m_export_job.cancel();
+    m_export_job.wait();
+    std::string dropped;
+    m_export_job.take(&dropped);
   }
   if (a.screenshot) {
     // The picture of the view at full resolution: a scripted run has it now; an interactive
@@ -498,6 +518,8 @@ void ViewerApp::start_comparison() {
 }
 
 bool ViewerApp::comparing() const { return m_compare_task.busy() || m_arrived_textures > 0; }
+
+bool ViewerApp::background_busy() const { return m_path->busy() || comparing() || m_export_job.busy(); }
 
 void ViewerApp::finish_comparison(bool at_once) {
   CompareOutcome& done = m_arrived;
@@ -604,6 +626,12 @@ void ViewerApp::start_path_export(const std::string& folder, int frames) {
     if (m_scripted) m_exit_code = 2;
     return;
   }
+  if (m_export_job.busy()) {
+    set_notice("path export: the last export is still finishing (" +
+               std::string(m_encoding_video ? "ffmpeg" : "a frame") + "); try again when it is done");
+    if (m_scripted) m_exit_code = 2;
+    return;
+  }
   const std::string problem = m_export.start(folder, frames);
   if (!problem.empty()) {
     set_notice(problem);
@@ -615,6 +643,40 @@ void ViewerApp::start_path_export(const std::string& folder, int frames) {
 }
 
 void ViewerApp::export_step() {
+  const bool on_thread = m_path->renders_in_background() && !m_scripted;
+  std::string error;
+  if (m_encoding_video) {  // the last step: ffmpeg, beside the frame loop too
+    if (!m_export_job.take(&error)) return;
+    m_encoding_video = false;
+    set_notice(exported_frames_line() + (error.empty() ? ", video " + m_export.folder() + "/path.mp4" : ", " + error));
+    return;
+  }
+  // The frame in flight, finished: written, or the export stops with why.
+  if (m_export_job.take(&error)) {
+    if (!error.empty()) {
+      set_notice("path export stopped: " + error);
+      m_export.cancel();
+      if (m_scripted) m_exit_code = 2;
+      return;
+    }
+    m_export.advance();
+    if (!m_export.active()) {
+      const std::string video = m_export.video_command(30);
+      if (video.empty()) {
+        set_notice(exported_frames_line() + " (no ffmpeg on PATH: image sequence only)");
+      } else {
+        m_encoding_video = true;
+        m_export_job.start(on_thread, [video](const std::atomic<bool>&) -> std::string {
+          const int rc = std::system(video.c_str());
+          return rc == 0 ? "" : "ffmpeg failed (exit " + std::to_string(rc) + ")";
+        });
+      }
+      return;
+    }
+  }
+  if (m_export_job.busy() || !m_export.active()) return;
+  // The next frame renders and is written beside the frame loop where the path renders in the
+  // background (the CPU), so the window keeps answering; scripted runs wait for each.
   const int width = m_presenter->width() > 0 ? m_presenter->width() : 1280;
   const int height = m_presenter->height() > 0 ? m_presenter->height() : 720;
   CameraController at = m_controller;
@@ -622,27 +684,21 @@ void ViewerApp::export_step() {
   const Camera camera = at.render_camera(width, height, m_camera_path->fov_at(m_export.next_t()));
   RenderOptions options = m_settings.options;
   options.collect_tile_counts = false;
-  try {
-    Image image;
-    m_path->render_image(camera, options, image, nullptr, nullptr);
-    write_image(image, m_export.next_file());
-  } catch (const std::exception& e) {
-    set_notice("path export stopped: " + reason(e));
-    m_export.cancel();
-    if (m_scripted) m_exit_code = 2;
-    return;
-  }
-  m_export.advance();
-  if (m_export.active()) return;
-  std::string done = "path export: " + std::to_string(m_export.done_frames()) + " frames in " + m_export.folder();
-  const std::string video = m_export.video_command(30);
-  if (video.empty()) {
-    done += " (no ffmpeg on PATH: image sequence only)";
-  } else {
-    const int rc = std::system(video.c_str());
-    done += rc == 0 ? ", video " + m_export.folder() + "/path.mp4" : ", ffmpeg failed (exit " + std::to_string(rc) + ")";
-  }
-  set_notice(done);
+  FramePath* path = m_path.get();
+  const std::string file = m_export.next_file();
+  m_export_job.start(on_thread,
+                     [path, camera, options, file](const std::atomic<bool>& cancel) -> std::string {
+                       Image image;
+                       FrameStats stats;
+                       path->render_image(camera, options, image, &stats, &cancel);
+                       if (stats.cancelled) return "cancelled";
+                       write_image(image, file);
+                       return "";
+                     });
+}
+
+std::string ViewerApp::exported_frames_line() const {
+  return "path export: " + std::to_string(m_export.done_frames()) + " frames in " + m_export.folder();
 }
 
 void ViewerApp::log_legend() {
@@ -846,7 +902,10 @@ void ViewerApp::log_held_input() {
                "right %.6f %.6f %.6f pivot %.6f %.6f %.6f%s, HUD %.1f FPS\n",
                m_presented, held.c_str(), x, y, p.position.x, p.position.y, p.position.z, f.x, f.y, f.z, r.x, r.y, r.z,
                pivot.x, pivot.y, pivot.z,
-               comparing() ? " (comparing)" : m_path->busy() ? " (a frame is rendering)" : "",
+               comparing()          ? " (comparing)"
+               : m_export_job.busy() ? " (exporting)"
+               : m_path->busy()      ? " (a frame is rendering)"
+                                     : "",
                m_rendered_rate.rate(ms_since(m_started) / 1000.0));
 }
 
@@ -1014,7 +1073,7 @@ void ViewerApp::finish_script() {
   }
   if (!m_args.export_path.empty()) {
     start_path_export(m_args.export_path, m_args.export_frames);
-    while (m_export.active()) export_step();
+    while (m_export.active() || m_encoding_video) export_step();
   }
   if (m_args.check_frame && m_have_frame) check_displayed_frame();
   if (!m_args.screenshot.empty()) take_screenshot(m_args.screenshot);
@@ -1220,7 +1279,7 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.render_height = m_presenter->height();
   model.fps = m_rendered_rate.rate(ms_since(m_started) / 1000.0);
   model.last_frame_ms = m_last_frame_ms;
-  model.rendering = m_path->busy() || comparing();
+  model.rendering = background_busy();
   if (comparing()) model.comparing = m_comparing;
   model.compare_elapsed_s = m_compare_task.elapsed_seconds();
   model.stats = m_have_frame ? &m_stats : nullptr;
@@ -1311,7 +1370,7 @@ int ViewerApp::run() {
     float dt = 0;
     if (!begin_frame(&fb_w, &fb_h, &dt)) continue;
     // A background frame or comparison in flight as this frame starts.
-    const bool rendering = m_path->busy() || comparing();
+    const bool rendering = background_busy();
     UiActions actions;
     NavigationInput nav;
     gather_input(nav, actions);
@@ -1321,7 +1380,7 @@ int ViewerApp::run() {
     apply_actions(actions);
     log_option_changes();
     finish_pending_load();
-    if (m_export.active() && !m_scripted) export_step();  // one frame of the export per window frame
+    if ((m_export.active() || m_encoding_video) && !m_scripted) export_step();  // polls the export's job
     m_moving = advance_camera(nav, dt);
     if (m_moving) m_last_motion = Clock::now();
     m_before_render_ms = ms_since(m_frame_start);

@@ -9,6 +9,7 @@
 #include "camera_controller.h"
 #include "camera_path.h"
 #include "compare_mode.h"
+#include "background_job.h"
 #include "compare_task.h"
 #include "file_browser_ui.h"
 #include "file_dialog.h"
@@ -95,13 +96,15 @@ class ViewerApp {
   void start_comparison();
   void finish_comparison(bool at_once);
   bool comparing() const;  // started, and not yet shown
+  bool background_busy() const;  // a frame, a comparison or an export frame renders beside the loop
   bool comparison_shown() const;  // the split or difference image replaces the frame
   void handle_divider_drag(bool left_down, double x);
   int frustum_under_click(bool left_down, double x, double y);  // on release of a click, else -1
   void draw_guides(int fb_w, int fb_h);  // grid, axes and frustums over the frame
   void open_file_dialog();
   void start_path_export(const std::string& folder, int frames);
-  void export_step();  // renders and writes the export's next frame
+  void export_step();  // takes the export's finished frame and starts the next (or the video)
+  std::string exported_frames_line() const;
   void log_legend();   // the heat-map legend's ticks, once per change
   void finish_script();
   void check_displayed_frame();
@@ -163,6 +166,8 @@ class ViewerApp {
   FileDialog m_dialog;
   FileBrowser m_browser;
   PathExport m_export;
+  BackgroundJob m_export_job;   // the export frame (or ffmpeg) in flight
+  bool m_encoding_video = false;  // the job is ffmpeg making path.mp4
   std::string m_pending_overlay_shot;  // a screenshot of the image with the heat map, taken before the panels are drawn
   bool m_compare_pending = false;  // asked for before there was a full frame to compare
   std::string m_status;

@@ -396,8 +396,10 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
   } else if (m.camera_count > 0) {
     ImGui::SetNextItemWidth(ui(-90));
     ImGui::InputTextWithHint("##export", "folder for the path's frames", &export_folder);
+    note_widget_place("export folder");
     ImGui::SameLine();
     if (ImGui::Button("Export path") && !export_folder.empty()) a.export_folder = export_folder;
+    note_widget_place("Export path");
     if (ImGui::IsItemHovered())
       ImGui::SetTooltip("one loop of the camera path as frame_00000.png, ...; also path.mp4 when ffmpeg is on PATH");
   }
@@ -507,8 +509,17 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   const ImGuiViewport* vp = ImGui::GetMainViewport();
   ImGui::SetNextWindowSizeConstraints(ImVec2(ui(300), ui(100)), ImVec2(ui(600), std::max(ui(120), vp->WorkSize.y - ui(20))));
   ImGui::SetNextWindowSize(ImVec2(ui(380), 0), ImGuiCond_FirstUseEver);
+  // A new scene adds rows (its counts, the camera path, the export row): the panel's height
+  // fits its content again, up to the window's (a height of 0 asks ImGui for that fit), so
+  // that nothing below ends up cut off under the panel's first, scene-less height.
+  static std::string fitted_for;
+  static float panel_width = 0;
+  const std::string scene_key = m.scene_path + "|" + std::to_string(m.gaussians) + "|" + std::to_string(m.camera_count);
+  if (scene_key != fitted_for && panel_width > 0) ImGui::SetNextWindowSize(ImVec2(panel_width, 0), ImGuiCond_Always);
+  fitted_for = scene_key;
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("flashgs-viewer");
+  panel_width = ImGui::GetWindowSize().x;
   const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
   ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels
   scene_panel(m, a, path_buffer);

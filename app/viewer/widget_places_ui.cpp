@@ -19,7 +19,8 @@ std::map<std::string, ImVec2>& last_places() {
 void set_widget_place_logging(bool on) { g_logging = on; }
 
 void note_widget_place(const char* name) {
-  if (!g_logging) return;
+  // Only where it can be clicked: inside its window's visible part (not scrolled away).
+  if (!g_logging || !ImGui::IsItemVisible()) return;
   const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
   // ImGui's points are the window's coordinates: the ones the cursor and XTEST use.
   const ImVec2 centre(std::round((lo.x + hi.x) * 0.5f), std::round((lo.y + hi.y) * 0.5f));
