@@ -28,9 +28,8 @@ void order_tiles_by_pairs(Frame& frame, std::size_t tiles) {
 }  // namespace
 
 void TileGaussians::grow(std::size_t n) {
-  if (mean_x.size() >= n) return;
-  for (std::vector<float>* v : {&mean_x, &mean_y, &whiten0, &whiten1, &whiten2, &whiten3, &opacity, &red, &green,
-                                &blue, &row_q_coeff, &q_cut, &row_slope, &inv_conic_a})
+  if (mean_y.size() >= n) return;
+  for (std::vector<float>* v : {&mean_y, &row_q_coeff, &q_cut})
     v->resize(n);
   row_first.resize(n);
   row_last.resize(n);

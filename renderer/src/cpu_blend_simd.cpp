@@ -30,9 +30,10 @@ constexpr int kTilePixels = gm::kTileSize * gm::kTileSize;
 // A vector covers consecutive pixels of one tile row: 16 lanes (AVX-512) are a row, 8 (AVX2) half.
 using FloatTag = hn::CappedTag<float, gm::kTileSize>;
 
-// Copies the tile's Gaussians, in blend order, into structure of arrays (prefetching the
-// ones a few keys ahead, which lie anywhere in blend_data), then finds each one's rows: the
-// scalar kernel's y_first / y_last, several Gaussians per vector.
+// Copies what the row ranges need of the tile's Gaussians, in blend order, into arrays
+// (prefetching the ones a few keys ahead, which lie anywhere in blend_data; the blend loop
+// then finds their lines in the cache), then finds each one's rows: the scalar kernel's
+// y_first / y_last, several Gaussians per vector.
 void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, TileGaussians& g) {
   const FloatTag d;
   const hn::RebindToSigned<FloatTag> di;
@@ -49,20 +50,9 @@ void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, Til
     if (k + kPrefetchAhead < count)
       hwy::Prefetch(&frame.blend_data[static_cast<std::uint32_t>(job.keys[k + kPrefetchAhead])]);
     const BlendGaussian& b = frame.blend_data[static_cast<std::uint32_t>(job.keys[k])];
-    g.mean_x[k] = b.mean_x;
     g.mean_y[k] = b.mean_y;
-    g.whiten0[k] = b.whiten[0];
-    g.whiten1[k] = b.whiten[1];
-    g.whiten2[k] = b.whiten[2];
-    g.whiten3[k] = b.whiten[3];
-    g.opacity[k] = b.opacity;
-    g.red[k] = b.rgb[0];
-    g.green[k] = b.rgb[1];
-    g.blue[k] = b.rgb[2];
     g.row_q_coeff[k] = b.row_q_coeff;
     g.q_cut[k] = b.q_cut;
-    g.row_slope[k] = b.row_slope;
-    g.inv_conic_a[k] = b.inv_conic_a;
   }
   const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), half = hn::Set(d, 0.5f);
   const auto top = hn::Set(d, static_cast<float>(y_begin)), last_row = hn::Set(d, static_cast<float>(tile_h - 1));
@@ -141,14 +131,15 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   for (std::uint64_t k = 0; k < job.count && live_groups > 0; ++k) {
     const int y_first = g.row_first[k], y_last = g.row_last[k];
     if (y_first > y_last) continue;
-    const float mean_x = g.mean_x[k], mean_y = g.mean_y[k];
-    const float q_reach = g.q_cut[k] + 0.5f;
-    const auto centre_x = hn::Set(d, mean_x), w0 = hn::Set(d, g.whiten0[k]), w2 = hn::Set(d, g.whiten2[k]);
-    const auto opacity = hn::Set(d, g.opacity[k]);
-    const auto r = hn::Set(d, g.red[k]), gr = hn::Set(d, g.green[k]), b = hn::Set(d, g.blue[k]);
+    const BlendGaussian& gauss = frame.blend_data[static_cast<std::uint32_t>(job.keys[k])];
+    const float mean_x = gauss.mean_x, mean_y = gauss.mean_y;
+    const float q_reach = gauss.q_cut + 0.5f;
+    const auto centre_x = hn::Set(d, mean_x), w0 = hn::Set(d, gauss.whiten[0]), w2 = hn::Set(d, gauss.whiten[2]);
+    const auto opacity = hn::Set(d, gauss.opacity);
+    const auto r = hn::Set(d, gauss.rgb[0]), gr = hn::Set(d, gauss.rgb[1]), b = hn::Set(d, gauss.rgb[2]);
     // The scalar kernel's row spans, computed the same way for a vector of rows at a time.
-    const auto q_reach_v = hn::Set(d, q_reach), coeff = hn::Set(d, g.row_q_coeff[k]);
-    const auto slope = hn::Set(d, g.row_slope[k]), inv_conic_a = hn::Set(d, g.inv_conic_a[k]);
+    const auto q_reach_v = hn::Set(d, q_reach), coeff = hn::Set(d, gauss.row_q_coeff);
+    const auto slope = hn::Set(d, gauss.row_slope), inv_conic_a = hn::Set(d, gauss.inv_conic_a);
     const auto mean_y_v = hn::Set(d, mean_y);
     for (int row = y_first / static_cast<int>(lanes) * static_cast<int>(lanes); row <= y_last;
          row += static_cast<int>(lanes)) {
@@ -168,7 +159,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       if (row_live[y] == 0 || span_first[y] > span_last[y]) continue;
       const float dy = static_cast<float>(y_begin + y) - mean_y;
       const int x0 = static_cast<int>(span_first[y]), x1 = static_cast<int>(span_last[y]);
-      const auto u_row = hn::Set(d, g.whiten1[k] * dy), v_row = hn::Set(d, g.whiten3[k] * dy);
+      const auto u_row = hn::Set(d, gauss.whiten[1] * dy), v_row = hn::Set(d, gauss.whiten[3] * dy);
       // No early outs per lane group (finished, or no lane above power_cut): the masks below
       // make those lanes no-ops, and the branches mispredicted more than the work they saved
       // (callgrind on pc_playbot: 29% fewer mispredicts for 5% more instructions).

@@ -31,12 +31,11 @@ struct alignas(64) BlendGaussian {
   float inv_conic_a;
 };
 
-// One tile's Gaussians in blend order as structure of arrays, gathered from blend_data: the
-// SIMD kernel reads each field as a contiguous stream (broadcast per Gaussian) and computes
-// the row range of several Gaussians per vector. One per thread; vectors only grow.
+// What the SIMD kernel needs of one tile's Gaussians as arrays, in blend order, gathered
+// from blend_data: the row range of several Gaussians per vector (the other fields are read
+// from each Gaussian's BlendGaussian line, broadcast). One per thread; vectors only grow.
 struct TileGaussians {
-  std::vector<float> mean_x, mean_y, whiten0, whiten1, whiten2, whiten3, opacity, red, green, blue, row_q_coeff,
-      q_cut, row_slope, inv_conic_a;
+  std::vector<float> mean_y, row_q_coeff, q_cut;
   std::vector<std::int32_t> row_first, row_last;  // rows of the tile that can reach power_cut
   void grow(std::size_t n);
 };
