@@ -231,6 +231,11 @@ void ViewerApp::install_scene(LoadedScene scene) {
                  m_scene.scene->size());
     return;
   }
+  if (m_export.active()) {  // its frames follow the old scene's cameras: it stops here
+    set_notice("path export stopped after " + std::to_string(m_export.done_frames()) + " frames: another scene was opened");
+    m_export.cancel();
+    m_export_job.cancel();  // the frame in flight is dropped when it ends
+  }
   m_camera_path = std::make_unique<CameraPath>(m_scene.cameras);
   m_playing = false;
   m_camera_index = -1;
@@ -653,6 +658,7 @@ void ViewerApp::export_step() {
   }
   // The frame in flight, finished: written, or the export stops with why.
   if (m_export_job.take(&error)) {
+    if (!m_export.active()) return;  // the frame of an export stopped meanwhile: dropped
     if (!error.empty()) {
       set_notice("path export stopped: " + error);
       m_export.cancel();
@@ -1380,7 +1386,7 @@ int ViewerApp::run() {
     apply_actions(actions);
     log_option_changes();
     finish_pending_load();
-    if ((m_export.active() || m_encoding_video) && !m_scripted) export_step();  // polls the export's job
+    if ((m_export.active() || m_export_job.busy()) && !m_scripted) export_step();  // polls the export's job
     m_moving = advance_camera(nav, dt);
     if (m_moving) m_last_motion = Clock::now();
     m_before_render_ms = ms_since(m_frame_start);
