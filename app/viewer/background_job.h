@@ -33,6 +33,8 @@ class BackgroundJob {
   bool take(std::string* error);
   // Raises the running job's cancel flag; it ends as soon as its renders stop.
   void cancel();
+  // cancel() was called since this job started (it may have ended all the same).
+  bool cancel_requested() const { return m_cancel; }
   // Blocks until the job's thread has ended (before what it uses goes away).
   void wait();
 

@@ -1,7 +1,6 @@
-// The comparison's task: run_compare and the difference image on a thread of their own (or at once on a path that renders in the caller's thread), the outcome taken by the frame loop.
+// The comparison's task: run_compare and the difference image as a BackgroundJob (on a thread of its own, or at once on a path that renders in the caller's thread), the outcome taken by the frame loop.
 #include "compare_task.h"
 
-#include "render_worker.h"
 #include "rgba8_image.h"
 #include "split_view.h"
 
@@ -9,84 +8,66 @@ namespace flashgs::viewer {
 
 using Clock = std::chrono::steady_clock;
 
-CompareTask::CompareTask(std::function<void()> on_done) : m_on_done(std::move(on_done)) {}
-
-CompareTask::~CompareTask() {
-  cancel();
-  wait();
-}
+CompareTask::CompareTask(std::function<void()> on_done) : m_job(std::move(on_done)) {}
 
 bool CompareTask::start(FramePath& path, const CompareJob& job) {
+  if (m_job.busy()) return false;
   {
     std::lock_guard<std::mutex> lock(m_mutex);
-    if (m_busy) return false;
-    m_busy = true;
-    m_done = false;
+    m_outcome = CompareOutcome{};
     m_started = Clock::now();
   }
-  wait();  // the last comparison's thread, finished (it was taken)
-  m_cancel = false;
-  if (path.renders_in_background())
-    m_thread = std::thread([this, &path, job] {
-      lower_this_thread_priority();  // its renders run here, as the worker's do on its thread
-      run(path, job);
-    });
-  else run(path, job);
-  return true;
+  return m_job.start(path.renders_in_background(), [this, &path, job](const std::atomic<bool>& cancel) {
+    run(path, job, cancel);
+    return std::string();
+  });
 }
 
-void CompareTask::run(FramePath& path, const CompareJob& job) {
+void CompareTask::run(FramePath& path, const CompareJob& job, const std::atomic<bool>& cancel) {
   CompareOutcome outcome;
-  outcome.result = run_compare(path, job.camera, job.left, job.right, job.warm_up, &m_cancel);
-  if (outcome.result.valid && !m_cancel) {
+  outcome.result = run_compare(path, job.camera, job.left, job.right, job.warm_up, &cancel);
+  if (outcome.result.valid && !cancel) {
     const CompareResult& r = outcome.result;
     to_rgba8(r.left_image, outcome.left_rgba);
     to_rgba8(r.right_image, outcome.right_rgba);
     to_rgba8(difference_image(r.right_image, r.left_image, &outcome.difference_factor), outcome.difference_rgba);
   }
-  {
-    std::lock_guard<std::mutex> lock(m_mutex);
-    outcome.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - m_started).count();
-    m_outcome = std::move(outcome);
-    m_done = true;
-  }
-  if (m_on_done) m_on_done();
+  std::lock_guard<std::mutex> lock(m_mutex);
+  outcome.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - m_started).count();
+  m_outcome = std::move(outcome);
 }
 
-bool CompareTask::busy() const {
-  std::lock_guard<std::mutex> lock(m_mutex);
-  return m_busy;
-}
+bool CompareTask::busy() const { return m_job.busy(); }
 
 double CompareTask::elapsed_seconds() const {
+  if (!m_job.busy()) return 0.0;
   std::lock_guard<std::mutex> lock(m_mutex);
-  return m_busy ? std::chrono::duration<double>(Clock::now() - m_started).count() : 0.0;
+  return std::chrono::duration<double>(Clock::now() - m_started).count();
 }
 
 bool CompareTask::take(CompareOutcome* out) {
+  const bool cancelled = m_job.cancel_requested();  // before take(): it ends the job's turn
+  std::string error;
+  if (!m_job.take(&error)) return false;
   std::lock_guard<std::mutex> lock(m_mutex);
-  if (!m_done) return false;
   *out = std::move(m_outcome);
   m_outcome = CompareOutcome{};
-  if (m_cancel) {  // cancelled after the renders ended: dropped all the same
+  if (!error.empty()) {  // the job threw (out of memory converting the images)
+    out->result.valid = false;
+    out->result.error = error;
+  }
+  if (cancelled) {  // cancelled after the renders ended: dropped all the same
     out->result.valid = false;
     out->result.error = kCompareCancelled;
     out->left_rgba.clear();
     out->right_rgba.clear();
     out->difference_rgba.clear();
   }
-  m_done = false;
-  m_busy = false;
   return true;
 }
 
-void CompareTask::cancel() {
-  std::lock_guard<std::mutex> lock(m_mutex);
-  if (m_busy) m_cancel = true;
-}
+void CompareTask::cancel() { m_job.cancel(); }
 
-void CompareTask::wait() {
-  if (m_thread.joinable()) m_thread.join();
-}
+void CompareTask::wait() { m_job.wait(); }
 
 }  // namespace flashgs::viewer

@@ -1,13 +1,12 @@
 // CompareTask: one comparison (compare_mode.h's renders and the difference image) run beside the frame loop, so the window keeps answering while a slow backend renders it.
 #pragma once
 
-#include <atomic>
 #include <chrono>
 #include <functional>
 #include <mutex>
-#include <thread>
 #include <vector>
 
+#include "background_job.h"
 #include "compare_mode.h"
 #include "frame_path.h"
 
@@ -34,8 +33,7 @@ class CompareTask {
   // `on_done` runs on the task's thread when a comparison ends (the viewer wakes its event
   // loop with it); it must not call back into the task.
   explicit CompareTask(std::function<void()> on_done = {});
-  // Cancels a comparison still running and waits for its thread.
-  ~CompareTask();
+  // A comparison still running is cancelled and its thread waited for (by m_job's destructor).
   CompareTask(const CompareTask&) = delete;
   CompareTask& operator=(const CompareTask&) = delete;
 
@@ -57,16 +55,13 @@ class CompareTask {
   void wait();
 
  private:
-  void run(FramePath& path, const CompareJob& job);  // the comparison itself, on any thread
+  // The comparison itself, on the job's thread (or the caller's).
+  void run(FramePath& path, const CompareJob& job, const std::atomic<bool>& cancel);
 
-  std::function<void()> m_on_done;
-  mutable std::mutex m_mutex;  // guards everything up to m_cancel
-  bool m_busy = false;  // started, not yet taken
-  bool m_done = false;  // m_outcome is there to take
+  mutable std::mutex m_mutex;  // guards the two below
   CompareOutcome m_outcome;
   std::chrono::steady_clock::time_point m_started;
-  std::atomic<bool> m_cancel{false};
-  std::thread m_thread;  // UI thread only (start, wait, the destructor)
+  BackgroundJob m_job;  // last: its destructor stops the thread before the members above go
 };
 
 }  // namespace flashgs::viewer
