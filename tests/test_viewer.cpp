@@ -954,6 +954,29 @@ double worst_ui_frame_ms(const std::string& log, double* frames) {
   return at == std::string::npos ? -1 : std::atof(log.c_str() + at + 8);
 }
 
+#ifdef FLASHGS_X11_INPUT
+// The live tests on pc_playbot: a private display (their XTEST input must not reach another
+// session's) and the scene, its folder made canonical.
+#define REQUIRE_LIVE_PLAYBOT(prefix, dir)                                                    \
+  REQUIRE_DISPLAY(prefix);                                                                   \
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";                   \
+  const std::string dir = playbot_dir();                                                     \
+  if (dir.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped"
+
+std::string playbot_dir() {
+  const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
+  return found.empty() ? found : std::filesystem::canonical(found).string();
+}
+
+// The viewer on pc_playbot in a `window`-sized window, its frames rendered at 2048x1200 on one
+// thread: a render (or comparison, or export frame) then takes seconds here, long enough for
+// a test's input to arrive while it runs, and a core stays free for the test's script.
+std::string slow_playbot_viewer_args(const std::string& dir, const std::string& window) {
+  return "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size " + window +
+         " --render-size 2048x1200 --log-input";
+}
+#endif
+
 // While the CPU renders a frame of pc_playbot (seconds on a small machine) on the worker
 // thread, a real click (XTEST) on a checkbox is answered: the frames that see the button held
 // are logged while the frame renders, the option changes, and no UI frame in the whole run
@@ -963,17 +986,11 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
 #else
-  REQUIRE_DISPLAY(prefix);
-  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
-  const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
-  if (found.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
-  const std::string dir = std::filesystem::canonical(found).string();
+  REQUIRE_LIVE_PLAYBOT(prefix, dir);
   // H turns the heat map on (a new full frame starts rendering), then the "Tight box" checkbox
   // is clicked while that frame renders. 1024x600: the sections are open from 600 points up,
   // and the swap (llvmpipe drawing the window, Xvfb copying it) is most of a UI frame's time
-  // here. The frame renders at 2048x1200, four times the window's pixels, on one thread: a
-  // window-sized frame on every core can finish before the click (the SIMD blend), and a free
-  // core keeps this script's steps quick.
+  // here; a window-sized frame on every core could finish before the click (the SIMD blend).
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
       "[ $status -eq 0 ] && { hold H \" key72 \" || status=11; }\n"
@@ -981,7 +998,7 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
       "[ $status -eq 0 ] && { wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
       "[ $status -eq 0 ] && { close_window || status=15; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_rendering",
-                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size 1024x600 --render-size 2048x1200 --log-input",
+                                      slow_playbot_viewer_args(dir, "1024x600"),
                                       steps, 14);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 H, 12 click, 13 option not changed, 14 crash, 15 close)\n"
@@ -1020,11 +1037,7 @@ TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
 #else
-  REQUIRE_DISPLAY(prefix);
-  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
-  const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
-  if (found.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
-  const std::string dir = std::filesystem::canonical(found).string();
+  REQUIRE_LIVE_PLAYBOT(prefix, dir);
   // GLFW key code of C: 67.
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
@@ -1035,7 +1048,7 @@ TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
       "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=15; }\n"
       "[ $status -eq 0 ] && { close_window || status=17; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_comparing",
-                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size 1024x600 --render-size 2048x1200 --log-input",
+                                      slow_playbot_viewer_args(dir, "1024x600"),
                                       steps, 16);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 C, 12 not started in the background, 13 second C not "
@@ -1066,11 +1079,7 @@ TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
 #else
-  REQUIRE_DISPLAY(prefix);
-  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
-  const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
-  if (found.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
-  const std::string dir = std::filesystem::canonical(found).string();
+  REQUIRE_LIVE_PLAYBOT(prefix, dir);
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
       "[ $status -eq 0 ] && { hold c \" key67 \" || status=11; }\n"
@@ -1080,7 +1089,7 @@ TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
       "echo \"closed after $(( ($(date +%s%N) - t0) / 1000000 )) ms\"\n"
       "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=15\n";
   const RunResult r = run_live_viewer(prefix, "close_while_comparing",
-                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size 800x450 --render-size 2048x1200 --log-input",
+                                      slow_playbot_viewer_args(dir, "800x450"),
                                       steps, 13);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 C, 12 not started, 13 crash, 14 close, 15 exit status)\n"
@@ -1100,17 +1109,12 @@ TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
 #else
-  REQUIRE_DISPLAY(prefix);
-  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
-  const std::string found = flashgs::test::shared_scene_dir("pc_playbot");
-  if (found.empty()) GTEST_SKIP() << "../shared/scenes/pc_playbot is absent: skipped";
-  const std::string dir = std::filesystem::canonical(found).string();
+  REQUIRE_LIVE_PLAYBOT(prefix, dir);
   // The viewer runs in out_dir(): the typed name (letters: the input helper types no "/") is
   // a folder there.
   const std::string folder = out_dir() + "/exportwhilelive";
   std::filesystem::remove_all(folder);
-  // 1024x1000: the export row is on screen below the open sections. Each frame is 2048x1200
-  // on one thread (a second or more here).
+  // 1024x1000: the export row is on screen below the open sections.
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
       "[ $status -eq 0 ] && { click \"export folder\" && \"$input\" type exportwhilelive || status=11; }\n"
@@ -1119,8 +1123,7 @@ TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
       "[ $status -eq 0 ] && { wait_for \"path export: 3 frames in \" || status=14; }\n"
       "[ $status -eq 0 ] && { close_window || status=16; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_exporting",
-                                      "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size 1024x1000 "
-                                      "--render-size 2048x1200 --export-frames 3 --log-input",
+                                      slow_playbot_viewer_args(dir, "1024x1000") + " --export-frames 3",
                                       steps, 15, "PATH=/usr/bin:/bin");
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 typing the folder, 12 export not started, 13 click, "
