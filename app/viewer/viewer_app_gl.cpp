@@ -170,15 +170,11 @@ void ViewerApp::use_cpu_path(const std::string& why) {
     m_compare_task.cancel();
     m_compare_task.wait();
   }
-  if (m_export_job.busy()) {  // so does an export frame: the export stops
-    m_export_job.cancel();
+  stop_path_export("stopped", ": the frame path changed");
+  if (m_export_job.busy() && !m_encoding_video) {  // its frame renders through the path being replaced (ffmpeg does not)
     m_export_job.wait();
-    std::string ignored;
-    m_export_job.take(&ignored);
-    if (m_export.active()) {
-      set_notice("path export stopped after " + std::to_string(m_export.done_frames()) + " frames: the frame path changed");
-      m_export.cancel();
-    }
+    std::string dropped;
+    m_export_job.take(&dropped);
   }
   // The worker wakes the event loop when a frame is done: the window shows it at once.
   m_path = make_background_upload_path(make_cpu_renderer(m_args.cpu_threads), m_presenter.get(), "CPU renderer + texture upload",
@@ -231,11 +227,7 @@ void ViewerApp::install_scene(LoadedScene scene) {
                  m_scene.scene->size());
     return;
   }
-  if (m_export.active()) {  // its frames follow the old scene's cameras: it stops here
-    set_notice("path export stopped after " + std::to_string(m_export.done_frames()) + " frames: another scene was opened");
-    m_export.cancel();
-    m_export_job.cancel();  // the frame in flight is dropped when it ends
-  }
+  stop_path_export("stopped", ": another scene was opened");  // its frames follow the old scene's cameras
   m_camera_path = std::make_unique<CameraPath>(m_scene.cameras);
   m_playing = false;
   m_camera_index = -1;
@@ -478,16 +470,7 @@ void ViewerApp::apply_actions(const UiActions& a) {
   }
   if (a.open_dialog) open_file_dialog();
   if (!a.export_folder.empty()) start_path_export(a.export_folder, m_args.export_frames);
-  if (a.cancel_export && m_export.active()) {
-    set_notice("path export cancelled after " + std::to_string(m_export.done_frames()) + " frames");
-    m_export.cancel();
-    // The frame in flight stops at its next check (the CPU renderer's are between tiles) and
-    // is dropped here, so that the next export starts clean.
-    m_export_job.cancel();
-    m_export_job.wait();
-    std::string dropped;
-    m_export_job.take(&dropped);
-  }
+  if (a.cancel_export) stop_path_export("cancelled", "");
   if (a.screenshot) {
     // The picture of the view at full resolution: a scripted run has it now; an interactive
     // one may still be rendering it (or showing a reduced frame) and saves it once it is shown.
@@ -701,6 +684,15 @@ void ViewerApp::export_step() {
                        write_image(image, file);
                        return "";
                      });
+}
+
+void ViewerApp::stop_path_export(const std::string& verb, const std::string& why) {
+  if (!m_export.active()) return;
+  set_notice("path export " + verb + " after " + std::to_string(m_export.done_frames()) + " frames" + why);
+  m_export.cancel();
+  // The frame in flight stops at its renderer's next check (the CPU's are between tiles);
+  // export_step takes it and drops it, and a new export waits for that.
+  m_export_job.cancel();
 }
 
 std::string ViewerApp::exported_frames_line() const {

@@ -105,6 +105,8 @@ class ViewerApp {
   void start_path_export(const std::string& folder, int frames);
   void export_step();  // takes the export's finished frame and starts the next (or the video)
   std::string exported_frames_line() const;
+  // Stops an export in progress: "path export VERB after N frames WHY" (a notice).
+  void stop_path_export(const std::string& verb, const std::string& why);
   void log_legend();   // the heat-map legend's ticks, once per change
   void finish_script();
   void check_displayed_frame();
