@@ -270,6 +270,85 @@ TEST(CudaSortKeys, CompactKeysBlendInTheSameOrderAsFullKeys) {
   }
 }
 
+// `count` small Gaussians crowded around the centre of a 256x256 view, where four tiles meet:
+// each of those tiles holds about `count` pairs. Depths come from 100 levels, so many pairs of
+// a tile tie on depth and are ordered by id.
+std::shared_ptr<const Scene> crowded_scene(std::size_t count) {
+  Scene scene;
+  scene.reserve(count);
+  std::uint32_t state = 12345;
+  auto uniform = [&state]() {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / 16777216.0f;
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    const float position[3] = {0.04f * uniform() - 0.02f, 0.04f * uniform() - 0.02f,
+                               -1.0f + 0.02f * static_cast<float>(static_cast<int>(100 * uniform()))};
+    scene.positions.insert(scene.positions.end(), position, position + 3);
+    const float s = 0.005f + 0.01f * uniform();
+    scene.scales.insert(scene.scales.end(), {s, 0.7f * s, s});
+    scene.rotations.insert(scene.rotations.end(), {1.0f, 0.0f, 0.0f, 0.0f});
+    scene.opacities.push_back(0.2f + 0.7f * uniform());
+    scene.sh_dc.insert(scene.sh_dc.end(), {uniform() - 0.5f, uniform() - 0.5f, uniform() - 0.5f});
+  }
+  return std::make_shared<const Scene>(std::move(scene));
+}
+
+Camera crowded_camera() {
+  const float eye[3] = {0.0f, 0.0f, -5.0f}, target[3] = {0.0f, 0.0f, 0.0f}, up[3] = {0.0f, -1.0f, 0.0f};
+  return look_at_camera(eye, target, up, 256, 256, 60.0f);
+}
+
+// The tile-sort path (pairs counted into tile bins, each bin sorted by the blend) must give
+// the blend exactly the radix sort's order: the images are equal to the byte, with the same
+// pairs and the same fullest tile. The crowded scenes fill a tile past half the bin's shared
+// memory (the largest bin size) and past all of it (the frame falls back to the radix sort).
+TEST(CudaTileSort, BinsBlendInTheSameOrderAsTheRadixSort) {
+  FLASHGS_REQUIRE_CUDA();
+  auto gpu = make_cuda_renderer();
+  auto expect_same = [&](const std::string& what, const Camera& camera) {
+    for (RenderOptions binned : {RenderOptions{}, [] {
+                                   RenderOptions o;
+                                   o.fused_emit = false;
+                                   return o;
+                                 }()}) {
+      RenderOptions sorted = binned;
+      sorted.tile_sort = false;
+      const Result a = render(*gpu, camera, binned);
+      const Result b = render(*gpu, camera, sorted);
+      EXPECT_EQ(a.stats.kv_pairs, b.stats.kv_pairs) << what;
+      EXPECT_EQ(a.stats.max_tile_pairs, b.stats.max_tile_pairs) << what;
+      EXPECT_TRUE(a.image.rgb == b.image.rgb) << what << " " << binned.label() << ": the bins changed the blend order";
+    }
+  };
+  const struct {
+    std::size_t count;
+    std::uint32_t min_fullest, max_fullest;
+  } crowds[] = {{3000, 2049, 4096}, {6000, 4097, 100000}};
+  for (const auto& crowd : crowds) {
+    const auto scene = crowded_scene(crowd.count);
+    gpu->set_scene(scene);
+    const std::string what = "crowd of " + std::to_string(crowd.count);
+    const Result r = render(*gpu, crowded_camera(), RenderOptions{});
+    EXPECT_GE(r.stats.max_tile_pairs, crowd.min_fullest) << what << ": the scene does not fill a tile as meant";
+    EXPECT_LE(r.stats.max_tile_pairs, crowd.max_fullest) << what << ": the scene does not fill a tile as meant";
+    expect_same(what, crowded_camera());
+    auto cpu = make_cpu_renderer();
+    cpu->set_scene(scene);
+    expect_match(what, render(*cpu, crowded_camera(), RenderOptions{}), r);
+  }
+  for (const std::string& name : test::shared_scene_names()) {
+    gpu->set_scene(test::load_shared_scene(name));
+    const std::vector<Camera> cameras = test::load_shared_cameras(name);
+    for (int index : {0, 10, 20})
+      for (const Camera& camera : {cameras[index].resized(1920, 1080), cameras[index].resized(3840, 2160),
+                                   cameras[index].resized(1001, 563)})
+        expect_same(name + " camera " + std::to_string(index) + " " + std::to_string(camera.width) + "x" +
+                        std::to_string(camera.height),
+                    camera);
+  }
+}
+
 // Same tile counts as the CPU, tile by tile.
 TEST(CudaStats, TileCountsMatchTheCpu) {
   FLASHGS_REQUIRE_CUDA();
