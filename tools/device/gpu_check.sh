@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
-#   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench
+#   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-ab bench
 #                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
 #                                       profile-blend profile-sass
 #                                       build-bg wait-build
@@ -86,6 +86,17 @@ bench_scene() {  # scene-folder json-name extra-args...
 bench_quick() {
   log "bench quick"
   bench_scene "$SCENES/pc_biker" bench_biker_quick --backend cuda -r 1920x1080 --configs baseline,flash --warmup 2 --repeat 5
+}
+
+bench_ab() {  # flash against flash with one switch off (AB_CONFIG, default flash-no_tile_sort), same run
+  for scene in pc_biker pc_playbot; do
+    log "bench A/B $scene"
+    bench_scene "$SCENES/$scene" bench_ab_$scene --backend cuda -r 1920x1080,3840x2160 \
+      --configs flash,${AB_CONFIG:-flash-no_tile_sort},flash-no_sort_bits --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
+  done
+  log "bench A/B 7 x pc_playbot"
+  bench_scene "$SCENES/pc_playbot" bench_ab_tile7 --backend cuda --tile 7 -r 1920x1080,3840x2160 \
+    --configs flash,${AB_CONFIG:-flash-no_tile_sort} --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
 }
 
 bench_regions() {  # warp-blend region widths: WIDTHS (default 8 16)
@@ -190,6 +201,7 @@ for step in "$@"; do
     tests) tests ;;
     sanitize) sanitize ;;
     bench-quick) bench_quick ;;
+    bench-ab) bench_ab ;;
     bench) bench ;;
     bench-regions) bench_regions ;;
     bench-large) bench_large ;;
