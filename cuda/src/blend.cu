@@ -115,30 +115,6 @@ struct alignas(16) RegionGaussian {
 // nothing and keeps its transmittance, the background's weight, without a liveness test.
 constexpr float kFinishedX = 1e30f;
 
-// The tile-sort path: the block (one tile) loads its bin of n (depth bits << 32 | id) keys
-// into shared memory and sorts them with a bitonic network over the next power of two (at
-// least 32; the padding sorts last), so its warps walk the tile in (depth, id) order, the
-// order the radix sort and the ranges pass give. Every thread of the block must call.
-__device__ void load_and_sort_bin(std::uint64_t* bin, const std::uint64_t* __restrict__ src, unsigned n) {
-  unsigned size = kWarp;
-  while (size < n) size <<= 1;
-  for (unsigned i = threadIdx.x; i < size; i += blockDim.x) bin[i] = i < n ? src[i] : ~0ull;
-  __syncthreads();
-  if (n < 2) return;
-  for (unsigned k = 2; k <= size; k <<= 1)
-    for (unsigned j = k >> 1; j > 0; j >>= 1) {
-      for (unsigned i = threadIdx.x; i < size / 2; i += blockDim.x) {
-        const unsigned lo = ((i & ~(j - 1)) << 1) | (i & (j - 1)), hi = lo + j;
-        const std::uint64_t x = bin[lo], y = bin[hi];
-        if ((x > y) == ((lo & k) == 0)) {
-          bin[lo] = y;
-          bin[hi] = x;
-        }
-      }
-      __syncthreads();
-    }
-}
-
 // FlashGS render kernel, a warp per 64-pixel region of a tile: REGION_W x (64 / REGION_W)
 // pixels (16 x 4 strips or 8 x 8 quadrants, four warps per tile), each lane a pair of pixels
 // in a row. Four warps per tile rather than FlashGS's one: the heaviest tiles (thousands of
@@ -155,8 +131,7 @@ __device__ void load_and_sort_bin(std::uint64_t* bin, const std::uint64_t* __res
 // (at least one lane of the warp passes the cut on almost every visit, so a branch skipped
 // nothing and cost its own instructions); a finished pixel moves to kFinishedX, so later
 // Gaussians add exactly nothing to it. Otherwise the arithmetic is the CPU's, term for term.
-// BINNED (the tile-sort path): the tile's list is its bin, sorted in shared memory first.
-template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE, bool BINNED>
+template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
   constexpr int kRegionH = 64 / REGION_W;
   constexpr int kLanesX = REGION_W / kLanePixelsX;
@@ -189,19 +164,9 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     lane_x[p] = !EXP2 || (live & (1u << p)) ? static_cast<float>(x0 + p) - region_x0 : kFinishedX;
   }
   const unsigned inside = live;
-  uint2 range = a.tile_ranges[tile];
-  extern __shared__ std::uint64_t bin[];  // BINNED: a.bin_capacity keys
-  if constexpr (BINNED) {
-    load_and_sort_bin(bin, a.bins + range.x, range.y - range.x);
-    range = make_uint2(0, range.y - range.x);
-  }
-  // The Gaussian id at position i of the tile's sorted list.
-  auto list_id = [&a](unsigned i) {
-    if constexpr (BINNED) return static_cast<std::uint32_t>(bin[i]);
-    else return a.values[i];
-  };
+  const uint2 range = a.tile_ranges[tile];
   BlendGaussian next{};
-  if (PIPELINED && range.x + lane < range.y) next = load_gaussian(a.gaussians + list_id(range.x + lane));
+  if (PIPELINED && range.x + lane < range.y) next = load_gaussian(a.gaussians + a.values[range.x + lane]);
   for (unsigned base = range.x; base < range.y; base += kWarp) {
     if constexpr (EXP2) {
       live = 0;
@@ -209,7 +174,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       for (int p = 0; p < kLanePixelsX; ++p) live |= lane_x[p] != kFinishedX ? 1u << p : 0u;
     }
     if (!__any_sync(kFullMask, live)) break;
-    if (!PIPELINED && base + lane < range.y) next = load_gaussian(a.gaussians + list_id(base + lane));
+    if (!PIPELINED && base + lane < range.y) next = load_gaussian(a.gaussians + a.values[base + lane]);
     __syncwarp();
     unsigned relevant = 0xffffffffu;
     if constexpr (EXP2) {
@@ -237,7 +202,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     }
     __syncwarp();
     if (PIPELINED && base + kWarp + lane < range.y)
-      next = load_gaussian(a.gaussians + list_id(base + kWarp + lane));
+      next = load_gaussian(a.gaussians + a.values[base + kWarp + lane]);
     const unsigned n = min(static_cast<unsigned>(kWarp), range.y - base);
     if (n < kWarp) relevant &= (1u << n) - 1u;
     for (unsigned m = relevant; m && (EXP2 || live); m &= m - 1) {
@@ -298,28 +263,16 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
                            cb[p] + t[p] * a.background[2]);
 }
 
-template <int REGION_W, bool SURFACE, bool BINNED>
-void launch_warp_tile_kernel(const BlendArgs& a, unsigned tiles, cudaStream_t stream) {
-  // A block is one tile (its four regions), which the bin sort relies on.
-  static_assert(kWarpsPerBlock == kRegionsPerTile, "a block must be one tile");
-  const unsigned blocks = tiles;
-  const unsigned threads = kWarpsPerBlock * kWarp;
-  const std::size_t shared = BINNED ? a.bin_capacity * sizeof(std::uint64_t) : 0;
-  const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
-  if (pipelined && a.exp2_alpha)
-    blend_warp_tile_kernel<REGION_W, true, true, SURFACE, BINNED><<<blocks, threads, shared, stream>>>(a);
-  else if (pipelined)
-    blend_warp_tile_kernel<REGION_W, true, false, SURFACE, BINNED><<<blocks, threads, shared, stream>>>(a);
-  else if (a.exp2_alpha)
-    blend_warp_tile_kernel<REGION_W, false, true, SURFACE, BINNED><<<blocks, threads, shared, stream>>>(a);
-  else
-    blend_warp_tile_kernel<REGION_W, false, false, SURFACE, BINNED><<<blocks, threads, shared, stream>>>(a);
-}
-
 template <int REGION_W, bool SURFACE>
 void launch_warp_tile(const BlendArgs& a, unsigned tiles, cudaStream_t stream) {
-  if (a.bins) launch_warp_tile_kernel<REGION_W, SURFACE, true>(a, tiles, stream);
-  else launch_warp_tile_kernel<REGION_W, SURFACE, false>(a, tiles, stream);
+  const unsigned regions = tiles * kRegionsPerTile;
+  const unsigned blocks = (regions + kWarpsPerBlock - 1) / kWarpsPerBlock;
+  const unsigned threads = kWarpsPerBlock * kWarp;
+  const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
+  if (pipelined && a.exp2_alpha) blend_warp_tile_kernel<REGION_W, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else if (pipelined) blend_warp_tile_kernel<REGION_W, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else if (a.exp2_alpha) blend_warp_tile_kernel<REGION_W, false, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else blend_warp_tile_kernel<REGION_W, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
 }
 
 template <bool SURFACE>

@@ -298,12 +298,12 @@ class CudaRendererImpl final : public CudaRenderer {
   }
 
  private:
-  enum Event { kBegin, kProjected, kScanned, kBinBegin, kBinned, kCounted, kEmitBegin, kEmitted, kSortBegin, kSorted,
-               kRanged, kBlended, kEventCount };
+  enum Event { kBegin, kProjected, kScanned, kCounted, kEmitBegin, kEmitted, kSortBegin, kSorted, kRanged, kBlended,
+               kEventCount };
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &tile_counts_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
+            &values_[1], &ranges_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
   }
 
   // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
@@ -366,7 +366,6 @@ class CudaRendererImpl final : public CudaRenderer {
     b.huge = deferred_list(huge_footprints_, huge_ids_);
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
-    b.tile_counts = tile_sort_ ? tile_counts_.as<std::uint32_t>() : nullptr;
     b.image_rgb = image_.as<float>();
     b.pixel_capacity = image_.bytes() / (3 * sizeof(float));
     b.cub_temp = cub_temp_.as<void>();
@@ -398,14 +397,6 @@ class CudaRendererImpl final : public CudaRenderer {
     cub_sized_for_pairs_ = pair_capacity_;
   }
 
-  // Tile-sort path: each tile's bin start and the fullest tile from the counts emission made;
-  // its events always recorded (back to back without the tile sort), as stage_times reads them.
-  void bin_offsets(const cuda::FrameBuffers& b, std::uint64_t tiles, cudaEvent_t* events) {
-    check_cuda(cudaEventRecord(events[kBinBegin], stream_), "event record");
-    if (b.tile_counts) cuda::launch_bin_offsets(tiles, b, stream_);
-    check_cuda(cudaEventRecord(events[kBinned], stream_), "event record");
-  }
-
   // Stage times of the frame whose events are in `set` (its work must have finished).
   StageTimes stage_times(int set) const {
     auto elapsed = [this, set](Event a, Event b) {
@@ -416,7 +407,7 @@ class CudaRendererImpl final : public CudaRenderer {
     StageTimes t;
     t.project_ms = elapsed(kBegin, kProjected);
     t.emit_ms = elapsed(kProjected, kScanned) + elapsed(kEmitBegin, kEmitted);
-    t.sort_ms = elapsed(kBinBegin, kBinned) + elapsed(kSortBegin, kSorted);
+    t.sort_ms = elapsed(kSortBegin, kSorted);
     t.ranges_ms = elapsed(kSorted, kRanged);
     t.blend_ms = elapsed(kRanged, kBlended);
     t.total_ms = t.project_ms + t.emit_ms + t.sort_ms + t.ranges_ms + t.blend_ms;
@@ -472,8 +463,6 @@ class CudaRendererImpl final : public CudaRenderer {
     }
 
     ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
-    tile_sort_ = !baseline && options.tile_sort;
-    if (tile_sort_) tile_counts_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile pair counts");
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     if (fused && !baseline && options.warp_cooperative_emit) {
       // Lists of deferred Gaussians; a frame with more emits the rest in the preprocess kernel.
@@ -516,15 +505,11 @@ class CudaRendererImpl final : public CudaRenderer {
     for (int attempt = 0;; ++attempt) {
       const cuda::FrameBuffers b = frame_buffers();
       check_cuda(cudaMemsetAsync(b.counters, 0, sizeof(cuda::FrameCounters), stream_), "counter reset");
-      if (b.tile_counts) check_cuda(cudaMemsetAsync(b.tile_counts, 0, tiles * sizeof(std::uint32_t), stream_), "tile count reset");
       check_cuda(cudaEventRecord(events[kBegin], stream_), "event record");
       cuda::launch_preprocess(device_scene_, b, args, fused, stream_);
       check_cuda(cudaEventRecord(events[kProjected], stream_), "event record");
       if (!fused) cuda::launch_scan(n, b, stream_);
       check_cuda(cudaEventRecord(events[kScanned], stream_), "event record");
-      // Fused emission has counted every tile's pairs by now: their bins and the fullest tile
-      // come back with the pair count, so the path is chosen without another wait.
-      if (fused) bin_offsets(b, tiles, events);
       check_cuda(cudaMemcpyAsync(&readback_->counters, b.counters, sizeof(cuda::FrameCounters),
                                  cudaMemcpyDeviceToHost, stream_),
                  "pair count read back");
@@ -544,30 +529,15 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaEventRecord(events[kEmitBegin], stream_), "event record");
     if (!fused) cuda::launch_duplicate(n, b, cam, args.exact_tile_test, stream_);
     check_cuda(cudaEventRecord(events[kEmitted], stream_), "event record");
-    if (!fused) {  // separate emission counted the pairs only now
-      bin_offsets(b, tiles, events);
-      if (tile_sort_) {
-        check_cuda(cudaMemcpyAsync(&readback_->counters.max_tile_pairs, &b.counters->max_tile_pairs,
-                                   sizeof(std::uint32_t), cudaMemcpyDeviceToHost, stream_),
-                   "tile maximum read back");
-        check_cuda(cudaStreamSynchronize(stream_), "tile count");
-      }
-    }
-    // Tile sort: the bins, sorted by the blend, unless a tile holds more pairs than its
-    // shared memory takes; then (and with the switch off) the radix sort and ranges pass.
-    const std::uint32_t fullest_tile = readback_->counters.max_tile_pairs;
-    const bool binned = tile_sort_ && fullest_tile <= cuda::kMaxBinPairs;
 
     const int tile_bits = std::max(bits_for(tiles), 1);
     int end_bit = 64;
     if (key_format_.depth_bits > 0) end_bit = tile_bits + key_format_.depth_bits;
     else if (baseline || options.minimal_sort_bits) end_bit = std::min(64, 32 + tile_bits);
     check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
-    int which = 0;
-    if (binned) cuda::launch_bin_scatter(pairs, b, stream_);
-    else which = cuda::launch_sort(pairs, end_bit, b, stream_);
+    const int which = cuda::launch_sort(pairs, end_bit, b, stream_);
     check_cuda(cudaEventRecord(events[kSorted], stream_), "event record");
-    if (!binned) cuda::launch_ranges(pairs, tiles, b, which, stream_);
+    cuda::launch_ranges(pairs, tiles, b, which, stream_);
     check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
 
     cuda::BlendArgs blend{};
@@ -582,8 +552,6 @@ class CudaRendererImpl final : public CudaRenderer {
     blend.exp2_alpha = args.exp2_alpha;
     blend.region_width = region_width_;
     blend.values = b.values[which];
-    blend.bins = binned ? b.keys[1] : nullptr;
-    blend.bin_capacity = std::max(cuda::kWarp, 1 << bits_for(fullest_tile));
     blend.tile_ranges = b.tile_ranges;
     blend.gaussians = b.blend;
     blend.image_rgb = out ? b.image_rgb : nullptr;
@@ -591,16 +559,11 @@ class CudaRendererImpl final : public CudaRenderer {
     cuda::launch_blend(blend, stream_);
     check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     last_tiles_ = tiles;
-    // The fullest tile, for the statistics (after the last timed event: not a stage's cost);
-    // the tile-sort path counted it already.
-    if (tile_sort_) {
-      readback_->tile_max[event_set_] = fullest_tile;
-    } else {
-      cuda::launch_tile_max(tiles, b, stream_);
-      check_cuda(cudaMemcpyAsync(&readback_->tile_max[event_set_], &b.counters->max_tile_pairs,
-                                 sizeof(std::uint32_t), cudaMemcpyDeviceToHost, stream_),
-                 "tile maximum read back");
-    }
+    // The fullest tile, for the statistics (after the last timed event: not a stage's cost).
+    cuda::launch_tile_max(tiles, b, stream_);
+    check_cuda(cudaMemcpyAsync(&readback_->tile_max[event_set_], &b.counters->max_tile_pairs, sizeof(std::uint32_t),
+                               cudaMemcpyDeviceToHost, stream_),
+               "tile maximum read back");
 
     if (out) {
       if (out->width != camera.width || out->height != camera.height) out->resize(camera.width, camera.height);
@@ -652,7 +615,6 @@ class CudaRendererImpl final : public CudaRenderer {
   HostReadback* readback_ = nullptr;         // in pinned_
   int event_set_ = 0;
   bool last_frame_complete_ = false;  // the last frame recorded all its events
-  bool tile_sort_ = false;           // this frame counts pairs into tile bins (RenderOptions::tile_sort)
   std::shared_ptr<const Scene> scene_;
   cuda::DeviceScene device_scene_;
   std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;
@@ -674,8 +636,7 @@ class CudaRendererImpl final : public CudaRenderer {
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
-  DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_counts_,
-      image_,
+  DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, image_,
       cub_temp_, large_footprints_, large_ids_, huge_footprints_, huge_ids_;
 };
 

@@ -36,7 +36,6 @@ __device__ __forceinline__ std::uint32_t sort_depth(const KeyFormat& k, float de
 
 // Stores one pair if it fits: an offset at or past the capacity writes nothing; the host
 // sees the wanted total in FrameCounters::pairs, grows the buffers and runs the frame again.
-// In the tile-sort path it also counts the pair in its tile (an atomic whose result is unused).
 __device__ __forceinline__ void store_pair(const FrameBuffers& b, unsigned long long offset, std::uint32_t tile,
                                            std::uint32_t depth, std::uint32_t gaussian) {
   if (offset < b.pair_capacity) {
@@ -45,7 +44,6 @@ __device__ __forceinline__ void store_pair(const FrameBuffers& b, unsigned long 
     else
       b.keys[0][offset] = (static_cast<std::uint64_t>(tile) << 32) | depth;
     b.values[0][offset] = gaussian;
-    if (b.tile_counts) atomicAdd(b.tile_counts + tile, 1u);
   }
 }
 

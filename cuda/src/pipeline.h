@@ -22,11 +22,6 @@ constexpr int kLargeBoxTiles = 32;
 // block per Gaussian: one warp looping over 10^4 tiles would set the preprocess kernel's length.
 constexpr int kHugeBoxTiles = 1024;
 
-// The tile-sort path sorts each tile's list in the blend's shared memory, up to this many
-// pairs (32 KB of 8-byte keys beside the blend's 6 KB keeps ~5 blocks per SM); a frame with
-// a fuller tile takes the radix sort instead (same order, same image).
-constexpr unsigned kMaxBinPairs = 4096;
-
 // Preprocess takes the Gaussians in chunks of this many (one block each) and skips the
 // projection of a chunk whose bounds lie outside the view (chunk_cull.cuh).
 constexpr int kChunkSize = 256;
@@ -144,11 +139,8 @@ struct FrameBuffers {
   std::uint64_t* keys[2] = {nullptr, nullptr};    // [pair_capacity]
   std::uint32_t* values[2] = {nullptr, nullptr};  // [pair_capacity]
   std::uint64_t pair_capacity = 0;
-  // Per tile: [start, end) of its pairs in the sorted list (or, in the tile-sort path, in the
-  // bins: keys[1] as (depth bits << 32 | Gaussian id), each tile's bin in no order).
+  // Per tile: [start, end) of its pairs in the sorted list.
   uint2* tile_ranges = nullptr;  // [tile_capacity]
-  // Tile-sort path only (else null): pairs per tile, counted by store_pair as they are written.
-  std::uint32_t* tile_counts = nullptr;  // [tile_capacity]
   std::uint64_t tile_capacity = 0;
   // Frame image, float RGB, row 0 at the top.
   float* image_rgb = nullptr;  // [pixel_capacity * 3]
@@ -190,12 +182,6 @@ int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, c
 // Gaussian id) order.
 void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers& buffers, int which,
                    cudaStream_t stream);
-// Tile-sort path. From tile_counts: each tile's bin start in tile_ranges (as both start and
-// end: the scatter advances the end) and FrameCounters::max_tile_pairs (the host picks the
-// path from it).
-void launch_bin_offsets(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
-// Writes every pair into its tile's bin (keys[1]), in no order within the bin.
-void launch_bin_scatter(std::uint64_t pairs, const FrameBuffers& buffers, cudaStream_t stream);
 // FrameCounters::max_tile_pairs from the tile ranges (a statistic: run outside the timed stages).
 void launch_tile_max(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
 
@@ -206,9 +192,7 @@ struct BlendArgs {
   BlendKernel kernel;
   bool exp2_alpha;
   int region_width;              // warp blend: a warp's region, 16 x 4 or 8 x 8 pixels
-  const std::uint32_t* values;   // sorted Gaussian ids, or
-  const std::uint64_t* bins;     // each tile's unsorted bin (tile-sort path), sorted by the blend
-  unsigned bin_capacity;         // bins: a power of two >= the fullest tile's pairs
+  const std::uint32_t* values;   // sorted Gaussian ids
   const uint2* tile_ranges;
   const BlendGaussian* gaussians;
   float* image_rgb;              // float output, or

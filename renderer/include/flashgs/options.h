@@ -27,7 +27,6 @@ struct RenderOptions {
   bool warp_cooperative_emit = true;
   bool fused_emit = true;
   bool minimal_sort_bits = true;
-  bool tile_sort = true;
   bool pipelined_blend = true;
   bool exp2_alpha = true;
 
@@ -95,10 +94,6 @@ inline constexpr RenderSwitch kRenderSwitches[] = {
     {"sort-bits", "sort_bits", "Sort bits", &RenderOptions::minimal_sort_bits, kCudaOnly, false,
      "radix sort over only the key bits the frame needs instead of all 64",
      "section 4, sort of the Gaussian-tile keys", "the CPU backend counting-sorts by tile, not by key bits"},
-    {"tile-sort", "tile_sort", "Tile sort", &RenderOptions::tile_sort, kCudaOnly, false,
-     "pairs counted into tile bins, each bin depth-sorted in shared memory by the blend: no radix sort of every pair",
-     "not in it: our sort shaped for short per-tile lists",
-     "the CPU backend already sorts each tile's list on its own"},
     {"pipelined-blend", "pipelined_blend", "Pipelined blend", &RenderOptions::pipelined_blend, kCudaOnly, false,
      "the render loop prefetches the next Gaussians: no stall on each load",
      "section 4, multi-stage pipelining of the render loop", "the CPU backend has no prefetch stage"},
