@@ -270,6 +270,36 @@ TEST(CudaSortKeys, CompactKeysBlendInTheSameOrderAsFullKeys) {
   }
 }
 
+// The blend's tile order (fullest tiles first) must change no byte: every tile blended once,
+// each by the same code. Another view is rendered in between, so that a tile the order missed
+// would show that view's pixels, not the same frame's.
+TEST(CudaTileOrder, DenseTilesFirstChangesNoByte) {
+  FLASHGS_REQUIRE_CUDA();
+  RenderOptions natural;
+  natural.dense_tiles_first = false;
+  auto check = [&natural](const std::string& name, std::shared_ptr<const Scene> scene, const std::vector<Camera>& cameras) {
+    auto gpu = make_cuda_renderer();
+    gpu->set_scene(scene);
+    for (std::size_t k = 0; k < cameras.size(); ++k) {
+      const Camera& camera = cameras[k];
+      const Result in_order = render(*gpu, camera, natural);
+      render(*gpu, cameras[(k + 1) % cameras.size()].resized(camera.width, camera.height), RenderOptions{});
+      const Result dense_first = render(*gpu, camera, RenderOptions{});
+      EXPECT_EQ(in_order.stats.kv_pairs, dense_first.stats.kv_pairs) << name << " " << camera.name;
+      EXPECT_TRUE(in_order.image.rgb == dense_first.image.rgb)
+          << name << " " << camera.name << " " << camera.width << "x" << camera.height << ": the tile order changed the image";
+    }
+  };
+  const auto demo = test::load_demo_scene();
+  const auto demo_cameras = test::load_demo_cameras();
+  check("demo", demo, {demo_cameras[0].resized(1001, 563), demo_cameras[3].resized(1001, 563),
+                       inside_camera(*demo, 1001, 563)});
+  for (const std::string& name : test::shared_scene_names()) {
+    const std::vector<Camera> cameras = test::load_shared_cameras(name);
+    check(name, test::load_shared_scene(name), {cameras[0].resized(1920, 1080), cameras[10].resized(1920, 1080)});
+  }
+}
+
 // Same tile counts as the CPU, tile by tile.
 TEST(CudaStats, TileCountsMatchTheCpu) {
   FLASHGS_REQUIRE_CUDA();

@@ -139,11 +139,12 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   using Staged = std::conditional_t<EXP2, RegionGaussian, BlendGaussian>;
   __shared__ Staged batch[kWarpsPerBlock][kWarp];
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
-  const unsigned region = blockIdx.x * kWarpsPerBlock + warp;
-  const unsigned tile = region / kRegionsPerTile;
+  // A block is one tile, its warps the tile's regions.
+  static_assert(kWarpsPerBlock == kRegionsPerTile, "a block must be one tile");
+  const unsigned tile = a.tile_order ? a.tile_order[blockIdx.x] : blockIdx.x;
   if (tile >= static_cast<unsigned>(a.tiles_x) * static_cast<unsigned>(a.tiles_y)) return;  // whole warp
   const int tx = static_cast<int>(tile % a.tiles_x), ty = static_cast<int>(tile / a.tiles_x);
-  const int region_in_tile = static_cast<int>(region % kRegionsPerTile);
+  const int region_in_tile = static_cast<int>(warp);
   // The region's pixel-centre rectangle, clipped to the image, and this lane's pixels.
   const float region_x0 = static_cast<float>(tx * kTile + (region_in_tile % kRegionsX) * REGION_W);
   const float region_y0 = static_cast<float>(ty * kTile + (region_in_tile / kRegionsX) * kRegionH);

@@ -303,7 +303,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
+            &values_[1], &ranges_, &tile_order_, &tile_places_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
   }
 
   // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
@@ -366,6 +366,8 @@ class CudaRendererImpl final : public CudaRenderer {
     b.huge = deferred_list(huge_footprints_, huge_ids_);
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
+    b.tile_order = tile_order_.as<std::uint32_t>();
+    b.tile_places = tile_places_.as<std::uint32_t>();
     b.image_rgb = image_.as<float>();
     b.pixel_capacity = image_.bytes() / (3 * sizeof(float));
     b.cub_temp = cub_temp_.as<void>();
@@ -463,6 +465,11 @@ class CudaRendererImpl final : public CudaRenderer {
     }
 
     ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
+    const bool dense_tiles_first = !baseline && options.dense_tiles_first;
+    if (dense_tiles_first) {
+      tile_order_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile order");
+      tile_places_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile places");
+    }
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     if (fused && !baseline && options.warp_cooperative_emit) {
       // Lists of deferred Gaussians; a frame with more emits the rest in the preprocess kernel.
@@ -538,6 +545,7 @@ class CudaRendererImpl final : public CudaRenderer {
     const int which = cuda::launch_sort(pairs, end_bit, b, stream_);
     check_cuda(cudaEventRecord(events[kSorted], stream_), "event record");
     cuda::launch_ranges(pairs, tiles, b, which, stream_);
+    if (dense_tiles_first) cuda::launch_tile_order(tiles, b, stream_);
     check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
 
     cuda::BlendArgs blend{};
@@ -553,6 +561,7 @@ class CudaRendererImpl final : public CudaRenderer {
     blend.region_width = region_width_;
     blend.values = b.values[which];
     blend.tile_ranges = b.tile_ranges;
+    blend.tile_order = dense_tiles_first ? b.tile_order : nullptr;
     blend.gaussians = b.blend;
     blend.image_rgb = out ? b.image_rgb : nullptr;
     blend.surface = surface;
@@ -636,7 +645,8 @@ class CudaRendererImpl final : public CudaRenderer {
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
-  DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, image_,
+  DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_order_,
+      tile_places_, image_,
       cub_temp_, large_footprints_, large_ids_, huge_footprints_, huge_ids_;
 };
 

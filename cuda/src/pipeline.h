@@ -102,6 +102,9 @@ struct KeyFormat {
   std::uint32_t exponent_base = 0;
 };
 
+// Tiles are ordered for the blend by the bit length of their pair count (launch_tile_order).
+constexpr int kTileClasses = 33;
+
 // Counters one frame accumulates on the device; copied to the host once per frame.
 struct FrameCounters {
   unsigned long long pairs;        // Gaussian-tile pairs wanted (may exceed capacity)
@@ -112,6 +115,7 @@ struct FrameCounters {
   unsigned int large;             // Gaussians deferred to the large-emission kernel
   unsigned int huge;              // Gaussians deferred to the huge-emission kernel
   unsigned long long chunk_culled; // Gaussians of chunks outside the view (classified, not projected)
+  unsigned int tiles_by_class[kTileClasses];  // tiles per pair-count class (launch_tile_order)
 };
 
 // Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
@@ -142,6 +146,10 @@ struct FrameBuffers {
   // Per tile: [start, end) of its pairs in the sorted list.
   uint2* tile_ranges = nullptr;  // [tile_capacity]
   std::uint64_t tile_capacity = 0;
+  // The blend's tile order, fullest first: tile_order[block] = tile; tile_places holds each
+  // tile's class and place within it on the way (launch_tile_order).
+  std::uint32_t* tile_order = nullptr;   // [tile_capacity]
+  std::uint32_t* tile_places = nullptr;  // [tile_capacity]
   // Frame image, float RGB, row 0 at the top.
   float* image_rgb = nullptr;  // [pixel_capacity * 3]
   std::uint64_t pixel_capacity = 0;
@@ -182,6 +190,10 @@ int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, c
 // Gaussian id) order.
 void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers& buffers, int which,
                    cudaStream_t stream);
+// tile_order from the tile ranges: tiles by descending bit length of their pair count (the
+// order inside a class is immaterial: tiles blend independently), so the fullest tiles start
+// first instead of wherever they lie in the image.
+void launch_tile_order(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
 // FrameCounters::max_tile_pairs from the tile ranges (a statistic: run outside the timed stages).
 void launch_tile_max(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
 
@@ -194,6 +206,7 @@ struct BlendArgs {
   int region_width;              // warp blend: a warp's region, 16 x 4 or 8 x 8 pixels
   const std::uint32_t* values;   // sorted Gaussian ids
   const uint2* tile_ranges;
+  const std::uint32_t* tile_order;  // warp blend: block b blends tile tile_order[b] (null: tile b)
   const BlendGaussian* gaussians;
   float* image_rgb;              // float output, or
   unsigned long long surface;    // RGBA8 surface (when image_rgb is null)

@@ -1,6 +1,6 @@
-// Stage `ranges`: each tile's [start, end) in the sorted pairs, and runs of equal keys put in
-// (depth, Gaussian id) order, so the blend order is exactly the CPU's whatever the key format:
-// equal 64-bit keys share their depth (the atomics of emission shuffled their ids), equal
+// Stage `ranges`: each tile's [start, end) in the sorted pairs, the blend's tile order (fullest
+// first), and runs of equal keys put in (depth, Gaussian id) order, so the blend order is
+// exactly the CPU's whatever the key format: equal 64-bit keys share their depth (the atomics of emission shuffled their ids), equal
 // compact keys share a quantised depth bin.
 #include "device_common.cuh"
 #include "pipeline.h"
@@ -81,7 +81,52 @@ __global__ void __launch_bounds__(kBlock) tile_max_kernel(std::uint64_t tiles, c
   if (lane_id() == 0 && warp_max > 0) atomicMax(&counters->max_tile_pairs, warp_max);
 }
 
+// A tile's class: the leading zeros of its pair count, so fuller tiles come first.
+__device__ __forceinline__ unsigned tile_class(uint2 range) { return __clz(range.y - range.x); }
+
+// Each tile's place within its class: one atomic per class present in the warp.
+__global__ void __launch_bounds__(kBlock) tile_places_kernel(std::uint64_t tiles, const uint2* __restrict__ tile_ranges,
+                                                             std::uint32_t* __restrict__ places,
+                                                             FrameCounters* counters) {
+  const std::uint64_t t = static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x;
+  const bool real = t < tiles;
+  const unsigned cls = real ? tile_class(tile_ranges[t]) : kTileClasses;  // kTileClasses: no tile
+  const unsigned peers = __match_any_sync(kFullMask, cls);
+  const unsigned leader = __ffs(peers) - 1;
+  unsigned base = 0;
+  if (real && lane_id() == leader) base = atomicAdd(&counters->tiles_by_class[cls], __popc(peers));
+  base = __shfl_sync(kFullMask, base, leader);
+  if (real) places[t] = base + __popc(peers & ((1u << lane_id()) - 1u));
+}
+
+// tile_order[start of the tile's class + its place] = tile.
+__global__ void __launch_bounds__(kBlock) tile_order_kernel(std::uint64_t tiles, const uint2* __restrict__ tile_ranges,
+                                                            const std::uint32_t* __restrict__ places,
+                                                            const FrameCounters* __restrict__ counters,
+                                                            std::uint32_t* __restrict__ order) {
+  __shared__ unsigned class_start[kTileClasses];
+  if (threadIdx.x == 0) {
+    unsigned start = 0;
+    for (int c = 0; c < kTileClasses; ++c) {
+      class_start[c] = start;
+      start += counters->tiles_by_class[c];
+    }
+  }
+  __syncthreads();
+  const std::uint64_t t = static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x;
+  if (t < tiles) order[class_start[tile_class(tile_ranges[t])] + places[t]] = static_cast<std::uint32_t>(t);
+}
+
 }  // namespace
+
+void launch_tile_order(std::uint64_t tiles, const FrameBuffers& b, cudaStream_t stream) {
+  if (tiles == 0) return;
+  const unsigned blocks = static_cast<unsigned>((tiles + kBlock - 1) / kBlock);
+  tile_places_kernel<<<blocks, kBlock, 0, stream>>>(tiles, b.tile_ranges, b.tile_places, b.counters);
+  check_cuda(cudaGetLastError(), "tile places kernel launch");
+  tile_order_kernel<<<blocks, kBlock, 0, stream>>>(tiles, b.tile_ranges, b.tile_places, b.counters, b.tile_order);
+  check_cuda(cudaGetLastError(), "tile order kernel launch");
+}
 
 void launch_tile_max(std::uint64_t tiles, const FrameBuffers& b, cudaStream_t stream) {
   if (tiles == 0) return;

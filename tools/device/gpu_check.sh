@@ -166,6 +166,18 @@ profile() {  # PROFILE_SCENE (pc_playbot), PROFILE_RES (3840x2160)
   grep -E "^  [a-z_].*\(|Duration|Memory Throughput|Compute \(SM\) Throughput|Registers Per|Achieved Occupancy" "$OUT/ncu.txt" | head -60
 }
 
+profile_kernels() {  # each kernel's GPU time in one frame: KERNEL_SCENES, KERNEL_RES, KERNEL_FLAGS (e.g. --no-tile-sort)
+  for scene in ${KERNEL_SCENES:-pc_playbot}; do
+    for res in ${KERNEL_RES:-1920x1080 3840x2160}; do
+      log "ncu kernel times $scene $res ${KERNEL_FLAGS:-}"
+      timeout 120 ncu --metrics gpu__time_duration.sum --cache-control none --clock-control none --launch-skip 30 \
+        --launch-count 12 "$FLASHGS" render "$SCENES/$scene/point_cloud.ply" --backend cuda -c 10 -r "$res" \
+        ${KERNEL_FLAGS:-} --repeat 8 -o /tmp/p.ppm > "$OUT/ncu_kernels_${scene}_$res.txt" 2>&1
+      grep -E "^  [a-zA-Z_]|gpu__time_duration" "$OUT/ncu_kernels_${scene}_$res.txt" | cut -c1-90
+    done
+  done
+}
+
 profile_blend() {  # one blend kernel in detail: stall reasons, instruction mix, hot lines
   log "ncu blend ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-1920x1080}"
   timeout 240 ncu --section SpeedOfLight --section WarpStateStats --section SchedulerStats --section InstructionStats \
@@ -210,6 +222,7 @@ for step in "$@"; do
     bench-scale) bench_scale ;;
     report) report ;;
     profile) profile ;;
+    profile-kernels) profile_kernels ;;
     profile-blend) profile_blend ;;
     profile-sass) profile_sass ;;
     *) echo "unknown step $step" ;;

@@ -27,6 +27,7 @@ struct RenderOptions {
   bool warp_cooperative_emit = true;
   bool fused_emit = true;
   bool minimal_sort_bits = true;
+  bool dense_tiles_first = true;
   bool pipelined_blend = true;
   bool exp2_alpha = true;
 
@@ -94,6 +95,9 @@ inline constexpr RenderSwitch kRenderSwitches[] = {
     {"sort-bits", "sort_bits", "Sort bits", &RenderOptions::minimal_sort_bits, kCudaOnly, false,
      "radix sort over only the key bits the frame needs instead of all 64",
      "section 4, sort of the Gaussian-tile keys", "the CPU backend counting-sorts by tile, not by key bits"},
+    {"dense-tiles-first", "dense_tiles_first", "Dense tiles first", &RenderOptions::dense_tiles_first, kCudaOnly,
+     false, "the blend takes tiles fullest first: no dense tile starting last and setting the frame's length",
+     "not in it: our order of the blend's tiles", "the CPU backend schedules its tiles dynamically"},
     {"pipelined-blend", "pipelined_blend", "Pipelined blend", &RenderOptions::pipelined_blend, kCudaOnly, false,
      "the render loop prefetches the next Gaussians: no stall on each load",
      "section 4, multi-stage pipelining of the render loop", "the CPU backend has no prefetch stage"},
