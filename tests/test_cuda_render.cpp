@@ -278,7 +278,9 @@ TEST(CudaTileOrder, DenseTilesFirstChangesNoByte) {
   RenderOptions natural;
   natural.dense_tiles_first = false;
   auto check = [&natural](const std::string& name, std::shared_ptr<const Scene> scene, const std::vector<Camera>& cameras) {
+    setenv("FLASHGS_DENSE_TILES_FIRST", "1", 1);  // on every frame, not only where it pays
     auto gpu = make_cuda_renderer();
+    unsetenv("FLASHGS_DENSE_TILES_FIRST");
     gpu->set_scene(scene);
     for (std::size_t k = 0; k < cameras.size(); ++k) {
       const Camera& camera = cameras[k];

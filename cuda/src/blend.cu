@@ -3,6 +3,7 @@
 // walking a tile's list with 32-Gaussian batches prefetched one ahead).
 #include <math.h>
 
+#include <algorithm>
 #include <type_traits>
 
 #include "device_common.cuh"
@@ -288,6 +289,16 @@ void launch_for_output(const BlendArgs& a, cudaStream_t stream) {
 }
 
 }  // namespace
+
+std::uint64_t blend_resident_blocks() {
+  int device = 0, sms = 0, per_sm = 0;
+  check_cuda(cudaGetDevice(&device), "device query");
+  check_cuda(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "device query");
+  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false>,
+                                                           kWarpsPerBlock * kWarp, 0),
+             "occupancy query");
+  return static_cast<std::uint64_t>(std::max(1, sms * per_sm));
+}
 
 void launch_blend(const BlendArgs& args, cudaStream_t stream) {
   if (args.image_rgb) launch_for_output<false>(args, stream);

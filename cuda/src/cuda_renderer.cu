@@ -187,6 +187,11 @@ class CudaRendererImpl final : public CudaRenderer {
     // FLASHGS_CHUNK_CULL=0 projects every Gaussian, =1 culls chunks in any scene (unset: scenes
     // of kChunkCullMinGaussians and more).
     if (const char* cull = std::getenv("FLASHGS_CHUNK_CULL")) chunk_cull_ = std::atoi(cull) != 0 ? kAlways : kNever;
+    // FLASHGS_DENSE_TILES_FIRST=1 orders the tiles on every frame, =0 never (unset: when the
+    // last frame's fullest tile outlasted a wave of the blend, see dense_order_pays).
+    if (const char* dense = std::getenv("FLASHGS_DENSE_TILES_FIRST"))
+      dense_tiles_mode_ = std::atoi(dense) != 0 ? kAlways : kNever;
+    blend_resident_blocks_ = cuda::blend_resident_blocks();
     for (int set = 0; set < 2; ++set)
       for (int e = 0; e < kEventCount; ++e) {
         check_cuda(cudaEventCreate(event_handles_[set][e].out()), "event creation");
@@ -399,6 +404,19 @@ class CudaRendererImpl final : public CudaRenderer {
     cub_sized_for_pairs_ = pair_capacity_;
   }
 
+  // Whether ordering the tiles fullest first pays this frame. It costs two small kernels and
+  // the locality of neighbouring tiles blending together, and gains when one tile's serial walk
+  // outlasts what the blend's resident blocks do in a wave: when the fullest tile holds more
+  // pairs than the mean per resident block. Judged on the last frame of the same size (the
+  // view moves little between frames); the first frame blends in image order.
+  // Call after this frame's first wait, with the event sets already switched.
+  bool dense_order_pays(std::uint64_t tiles, bool have_last_frame) const {
+    if (dense_tiles_mode_ != kAuto) return dense_tiles_mode_ == kAlways;
+    if (!have_last_frame || tiles != last_tiles_ || last_pairs_ == 0) return false;
+    const std::uint64_t fullest = readback_->tile_max[event_set_ ^ 1];
+    return fullest * blend_resident_blocks_ > last_pairs_;
+  }
+
   // Stage times of the frame whose events are in `set` (its work must have finished).
   StageTimes stage_times(int set) const {
     auto elapsed = [this, set](Event a, Event b) {
@@ -465,11 +483,6 @@ class CudaRendererImpl final : public CudaRenderer {
     }
 
     ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
-    const bool dense_tiles_first = !baseline && options.dense_tiles_first;
-    if (dense_tiles_first) {
-      tile_order_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile order");
-      tile_places_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile places");
-    }
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     if (fused && !baseline && options.warp_cooperative_emit) {
       // Lists of deferred Gaussians; a frame with more emits the rest in the preprocess kernel.
@@ -532,6 +545,12 @@ class CudaRendererImpl final : public CudaRenderer {
       if (attempt > 0) throw Error("cuda renderer: internal error, pair count changed between identical runs");
     }
 
+    // After the wait above: the last frame's fullest tile has come back by now.
+    const bool dense_tiles_first = !baseline && options.dense_tiles_first && dense_order_pays(tiles, previous_complete);
+    if (dense_tiles_first) {
+      tile_order_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile order");
+      tile_places_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile places");
+    }
     const cuda::FrameBuffers b = frame_buffers();
     check_cuda(cudaEventRecord(events[kEmitBegin], stream_), "event record");
     if (!fused) cuda::launch_duplicate(n, b, cam, args.exact_tile_test, stream_);
@@ -568,6 +587,7 @@ class CudaRendererImpl final : public CudaRenderer {
     cuda::launch_blend(blend, stream_);
     check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     last_tiles_ = tiles;
+    last_pairs_ = pairs;
     // The fullest tile, for the statistics (after the last timed event: not a stage's cost).
     cuda::launch_tile_max(tiles, b, stream_);
     check_cuda(cudaMemcpyAsync(&readback_->tile_max[event_set_], &b.counters->max_tile_pairs, sizeof(std::uint32_t),
@@ -637,7 +657,11 @@ class CudaRendererImpl final : public CudaRenderer {
   // 100M one's 2.8x on an H200) and costs a test per 256 Gaussians that cannot pay off when
   // the whole of a small scene is in view (pc_biker's and pc_playbot's orbit views).
   static constexpr std::size_t kChunkCullMinGaussians = std::size_t{1} << 20;
-  enum ChunkCullMode { kAuto, kAlways, kNever } chunk_cull_ = kAuto;
+  enum Mode { kAuto, kAlways, kNever };
+  Mode chunk_cull_ = kAuto;
+  Mode dense_tiles_mode_ = kAuto;
+  std::uint64_t blend_resident_blocks_ = 1;  // warp-blend blocks the device runs at once
+  std::uint64_t last_pairs_ = 0;             // pairs of the last frame (of last_tiles_ tiles)
   cuda::KeyFormat key_format_;           // this frame's
   double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
   double bounds_radius_ = 0;

@@ -212,6 +212,9 @@ struct BlendArgs {
   unsigned long long surface;    // RGBA8 surface (when image_rgb is null)
 };
 void launch_blend(const BlendArgs& args, cudaStream_t stream);
+// Blocks of the default warp blend (8 x 8 regions, pipelined, exp2, float output) that the
+// device runs at once: one wave.
+std::uint64_t blend_resident_blocks();
 
 // Throws flashgs::Error naming `what` when `status` is not cudaSuccess.
 void check_cuda(cudaError_t status, const char* what);
