@@ -1,5 +1,6 @@
 // Chunk culling: the bounds of every chunk of 256 consecutive Gaussians (once per scene, on
-// the device) and the per-frame constants of the test in chunk_cull.cuh.
+// the device), the per-frame constants of the test in chunk_cull.cuh, and the per-frame list
+// of the chunks that preprocess must read.
 #include <math.h>
 
 #include <cub/block/block_reduce.cuh>
@@ -7,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "chunk_cull.cuh"
 #include "device_common.cuh"
 #include "flashgs/model_constants.h"
 #include "pipeline.h"
@@ -92,6 +94,35 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
   }
 }
 
+__global__ void __launch_bounds__(kChunkSize) chunk_list_kernel(DeviceScene scene, FrameBuffers buf,
+                                                                gm::CameraParams cam, gm::GeometryParams geo,
+                                                                ChunkCullFrame frame, unsigned chunks) {
+  const unsigned c = blockIdx.x * kChunkSize + threadIdx.x;
+  const bool real = c < chunks;
+  ChunkVerdict verdict = kChunkAllOffscreen;
+  unsigned members = 0;
+  if (real) {
+    const ChunkBound b = scene.chunks[c];
+    verdict = chunk_verdict(b, cam, geo, frame);
+    members = b.members;
+  }
+  const bool listed = real && (verdict == kChunkProject || verdict == kChunkClassify);
+  const unsigned ballot = __ballot_sync(kFullMask, listed);
+  const unsigned lane = lane_id();
+  unsigned base = 0;
+  if (lane == 0 && ballot) base = atomicAdd(&buf.counters->listed_chunks, static_cast<unsigned>(__popc(ballot)));
+  base = __shfl_sync(kFullMask, base, 0);
+  if (listed) buf.chunk_list[base + __popc(ballot & ((1u << lane) - 1u))] = c << 1 | (verdict == kChunkClassify);
+  // Wholly culled chunks are counted here without reading a Gaussian: one atomic per warp.
+  const unsigned near = __reduce_add_sync(kFullMask, real && verdict == kChunkAllNear ? members : 0u);
+  const unsigned offscreen = __reduce_add_sync(kFullMask, real && verdict == kChunkAllOffscreen ? members : 0u);
+  if (lane == 0 && near + offscreen > 0) {
+    if (near) atomicAdd(&buf.counters->by_reason[gm::kCulledNear], near);
+    if (offscreen) atomicAdd(&buf.counters->by_reason[gm::kCulledOffscreen], offscreen);
+    atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(near + offscreen));
+  }
+}
+
 }  // namespace
 
 ChunkCullFrame chunk_cull_frame(const gm::CameraParams& cam, const gm::GeometryParams& geo, float max_opacity) {
@@ -121,6 +152,15 @@ ChunkCullFrame chunk_cull_frame(const gm::CameraParams& cam, const gm::GeometryP
   f.reach_per_sigma = static_cast<float>(1.001 * s * k);
   f.jacobian_bound = static_cast<float>(k);
   return f;
+}
+
+void launch_chunk_list(const DeviceScene& scene, const FrameBuffers& b, const PreprocessArgs& args,
+                       cudaStream_t stream) {
+  const unsigned chunks = static_cast<unsigned>((scene.count + kChunkSize - 1) / kChunkSize);
+  if (chunks == 0) return;
+  chunk_list_kernel<<<(chunks + kChunkSize - 1) / kChunkSize, kChunkSize, 0, stream>>>(
+      scene, b, args.camera, args.geometry, args.chunk_frame, chunks);
+  check_cuda(cudaGetLastError(), "chunk list kernel launch");
 }
 
 void launch_chunk_bounds(const DeviceScene& scene, ChunkBound* bounds, cudaStream_t stream) {

@@ -308,7 +308,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &tile_order_, &tile_places_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
+            &values_[1], &ranges_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
   }
 
   // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
@@ -378,6 +378,7 @@ class CudaRendererImpl final : public CudaRenderer {
     b.cub_temp = cub_temp_.as<void>();
     b.cub_temp_bytes = cub_temp_.bytes();
     b.counters = counters_.as<cuda::FrameCounters>();
+    b.chunk_list = list_chunks_ ? chunk_list_.as<std::uint32_t>() : nullptr;
     return b;
   }
 
@@ -511,6 +512,12 @@ class CudaRendererImpl final : public CudaRenderer {
     args.large_box_tiles = large_box_tiles_;
     args.chunk_cull = !baseline && (chunk_cull_ == kAlways || (chunk_cull_ == kAuto && n >= kChunkCullMinGaussians));
     if (args.chunk_cull) args.chunk_frame = cuda::chunk_cull_frame(cam, args.geometry, max_opacity_);
+    // Fused emission runs the chunk test as a pass of its own and preprocess over the chunks
+    // it lists, so a chunk outside the view costs one thread rather than a block.
+    list_chunks_ = args.chunk_cull && fused;
+    if (list_chunks_)
+      chunk_list_.reserve(std::max<std::size_t>((n + cuda::kChunkSize - 1) / cuda::kChunkSize, 1) * sizeof(std::uint32_t),
+                          "chunk list");
 
     // project (+ fused emit), then the frame's one read back: the pair count. Fused emission
     // that overflowed wrote nothing past the capacity; grow and run it again.
@@ -644,6 +651,7 @@ class CudaRendererImpl final : public CudaRenderer {
   HostReadback* readback_ = nullptr;         // in pinned_
   int event_set_ = 0;
   bool last_frame_complete_ = false;  // the last frame recorded all its events
+  bool list_chunks_ = false;          // this frame's preprocess walks a chunk list (FrameBuffers::chunk_list)
   std::shared_ptr<const Scene> scene_;
   cuda::DeviceScene device_scene_;
   std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;
@@ -670,7 +678,7 @@ class CudaRendererImpl final : public CudaRenderer {
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
   DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_order_,
-      tile_places_, image_,
+      tile_places_, chunk_list_, image_,
       cub_temp_, large_footprints_, large_ids_, huge_footprints_, huge_ids_;
 };
 

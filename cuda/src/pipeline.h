@@ -115,6 +115,7 @@ struct FrameCounters {
   unsigned int large;             // Gaussians deferred to the large-emission kernel
   unsigned int huge;              // Gaussians deferred to the huge-emission kernel
   unsigned long long chunk_culled; // Gaussians of chunks outside the view (classified, not projected)
+  unsigned int listed_chunks;      // chunks the chunk cull left to preprocess (launch_chunk_list)
   unsigned int tiles_by_class[kTileClasses];  // tiles per pair-count class (launch_tile_order)
 };
 
@@ -156,6 +157,9 @@ struct FrameBuffers {
   void* cub_temp = nullptr;  // sort and scan scratch
   std::size_t cub_temp_bytes = 0;
   FrameCounters* counters = nullptr;  // [1] device
+  // Fused emission with the chunk cull: the chunks left to preprocess, chunk << 1 | 1 for
+  // kChunkClassify, 0 for kChunkProject (null: preprocess tests every chunk itself).
+  std::uint32_t* chunk_list = nullptr;  // [chunks]
 };
 
 struct PreprocessArgs {
@@ -172,6 +176,10 @@ struct PreprocessArgs {
 
 // Fills the scene's chunk bounds (once per scene).
 void launch_chunk_bounds(const DeviceScene& scene, ChunkBound* bounds, cudaStream_t stream);
+// The chunk test of every chunk, a thread each: chunks wholly culled are counted, the others
+// listed in buffers.chunk_list for preprocess, which then runs a grid over the list only.
+void launch_chunk_list(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
+                       cudaStream_t stream);
 
 // project (+ fused key emission when `fused`).
 void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,

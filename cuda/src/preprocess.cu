@@ -2,6 +2,8 @@
 // the Gaussian-tile keys, all in one pass over the scene.
 #include <math.h>
 
+#include <algorithm>
+
 #include <cub/block/block_scan.cuh>
 
 #include "chunk_cull.cuh"
@@ -251,37 +253,22 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
   return my_count;
 }
 
-// One thread per Gaussian. FUSED: keys are written here (FlashGS); otherwise the footprint
-// and the pair count are stored for the separate prefix sum + duplicate pass (3DGS).
+// One chunk, a thread per Gaussian, for a chunk whose verdict is kChunkProject or
+// kChunkClassify (the same for the whole block). FUSED: keys are written here (FlashGS);
+// otherwise the footprint and the pair count are stored for the separate prefix sum +
+// duplicate pass (3DGS).
 template <int DEGREE, bool FUSED>
-__global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, FrameBuffers buf,
-                                                            PreprocessArgs args) {
-  static_assert(kBlock == kChunkSize, "a block is one chunk");
+__device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& buf, const PreprocessArgs& args,
+                                 unsigned chunk_index, int chunk) {
   __shared__ unsigned block_counts[gm::kCullReasonCount];  // by gm::CullReason
-  __shared__ int chunk;  // ChunkVerdict
   if (threadIdx.x < gm::kCullReasonCount) block_counts[threadIdx.x] = 0;
-  if (threadIdx.x == 0) {
-    chunk = args.chunk_cull ? chunk_verdict(scene.chunks[blockIdx.x], args.camera, args.geometry, args.chunk_frame)
-                            : kChunkProject;
-    if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {  // counted without reading a Gaussian
-      const unsigned members = scene.chunks[blockIdx.x].members;
-      atomicAdd(&buf.counters->by_reason[chunk == kChunkAllNear ? gm::kCulledNear : gm::kCulledOffscreen], members);
-      atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(members));
-    }
-  }
   __syncthreads();
 
-  const unsigned i = blockIdx.x * kBlock + threadIdx.x;
+  const unsigned i = chunk_index * kBlock + threadIdx.x;
   const unsigned lane = lane_id();
   const bool valid = i < scene.count;
   const gm::CameraParams& cam = args.camera;
 
-  if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {
-    if constexpr (!FUSED) {
-      if (valid) buf.pair_counts[i] = 0;
-    }
-    return;
-  }
   if (chunk == kChunkClassify) {  // the whole block: only the centre and opacity are read
     int reason = gm::kCulledOffscreen;
     if (valid) {
@@ -303,7 +290,7 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
     if (threadIdx.x < gm::kCullReasonCount && block_counts[threadIdx.x] > 0)
       atomicAdd(&buf.counters->by_reason[threadIdx.x], block_counts[threadIdx.x]);
     if (threadIdx.x == 0) {
-      const std::size_t first = static_cast<std::size_t>(blockIdx.x) * kBlock;
+      const std::size_t first = static_cast<std::size_t>(chunk_index) * kBlock;
       const std::size_t members = scene.count - first < kBlock ? scene.count - first : kBlock;
       atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(members));
     }
@@ -454,6 +441,42 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
     atomicAdd(&buf.counters->by_reason[threadIdx.x], block_counts[threadIdx.x]);
 }
 
+// A block per chunk (kChunkSize Gaussians). With a chunk list (launch_chunk_list ran first)
+// the grid walks only the listed chunks; otherwise each block tests its own chunk.
+template <int DEGREE, bool FUSED>
+__global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, FrameBuffers buf,
+                                                            PreprocessArgs args) {
+  static_assert(kBlock == kChunkSize, "a block is one chunk");
+  if (buf.chunk_list) {
+    const unsigned listed = buf.counters->listed_chunks;
+    for (unsigned k = blockIdx.x; k < listed; k += gridDim.x) {
+      const unsigned entry = buf.chunk_list[k];
+      preprocess_chunk<DEGREE, FUSED>(scene, buf, args, entry >> 1, (entry & 1u) ? kChunkClassify : kChunkProject);
+      __syncthreads();  // the chunk's shared counts are reset by the next one
+    }
+    return;
+  }
+  __shared__ int chunk;  // ChunkVerdict
+  if (threadIdx.x == 0) {
+    chunk = args.chunk_cull ? chunk_verdict(scene.chunks[blockIdx.x], args.camera, args.geometry, args.chunk_frame)
+                            : kChunkProject;
+    if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {  // counted without reading a Gaussian
+      const unsigned members = scene.chunks[blockIdx.x].members;
+      atomicAdd(&buf.counters->by_reason[chunk == kChunkAllNear ? gm::kCulledNear : gm::kCulledOffscreen], members);
+      atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(members));
+    }
+  }
+  __syncthreads();
+  if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {
+    if constexpr (!FUSED) {
+      const unsigned i = blockIdx.x * kBlock + threadIdx.x;
+      if (i < scene.count) buf.pair_counts[i] = 0;
+    }
+    return;
+  }
+  preprocess_chunk<DEGREE, FUSED>(scene, buf, args, blockIdx.x, chunk);
+}
+
 // The deferred large Gaussians: a warp per Gaussian, spread over every warp of the grid. A
 // warp tests up to kLargeBatch of its Gaussians before it reserves all their pairs with one
 // atomic: a wait on the contended pair counter for each Gaussian held the kernel back. Boxes
@@ -577,10 +600,23 @@ __global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm:
   }
 }
 
+// Blocks of a preprocess grid over a chunk list: a few waves' worth (the list's length is
+// known on the device only), each walking every gridDim-th listed chunk.
+unsigned list_grid_blocks() {
+  static const unsigned blocks = [] {
+    int device = 0, sms = 0;
+    check_cuda(cudaGetDevice(&device), "device query");
+    check_cuda(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "device query");
+    return static_cast<unsigned>(std::max(1, sms) * 16);
+  }();
+  return blocks;
+}
+
 template <bool FUSED>
 void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
                        cudaStream_t stream) {
-  const unsigned blocks = static_cast<unsigned>((scene.count + kBlock - 1) / kBlock);
+  const unsigned chunks = static_cast<unsigned>((scene.count + kBlock - 1) / kBlock);
+  const unsigned blocks = buffers.chunk_list ? std::min(chunks, list_grid_blocks()) : chunks;
   switch (args.sh_degree) {
     case 0: preprocess_kernel<0, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
     case 1: preprocess_kernel<1, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
@@ -595,6 +631,7 @@ void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, co
                        bool fused, cudaStream_t stream) {
   if (scene.count == 0) return;
   if (fused) {
+    if (buffers.chunk_list) launch_chunk_list(scene, buffers, args, stream);
     launch_for_degree<true>(scene, buffers, args, stream);
     if (args.warp_cooperative && buffers.large.capacity > 0)
       large_emit_kernel<<<kDeferredEmitBlocks, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test);
