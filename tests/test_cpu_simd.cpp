@@ -13,6 +13,7 @@
 #include <hwy/targets.h>
 #endif
 
+#include "cpu_frame.h"  // simd_alpha and its bound
 #include "flashgs/generators.h"
 #include "flashgs/renderer.h"
 #include "test_support.h"
@@ -20,8 +21,9 @@
 namespace flashgs {
 namespace {
 
-// The SIMD kernel runs the scalar kernel's operations except exp (Highway's, 1 ulp, vs
-// glibc's): the bound is test::kExpUlp*, the one CPU vs CUDA has.
+// The SIMD kernel runs the scalar kernel's operations except alpha's exponential (an exp2 with
+// a short polynomial, relative error under cpu::kSimdAlphaMaxRelError, vs glibc's expf): the
+// image bound is test::kExpUlp*, the one CPU vs CUDA has.
 
 struct Frame {
   Image image;
@@ -83,6 +85,61 @@ TEST(CpuSimdBlend, EveryTargetThisCpuRunsMatchesTheScalarKernel) {
   hwy::SetSupportedTargetsForTest(0);  // back to what the CPU supports
 #else
   GTEST_SKIP() << "built without Highway: the scalar kernel only";
+#endif
+}
+
+// The SIMD kernel's alpha against opacity e^(-q/2) in double, over opacities from 1/255 to 1
+// (log2 opacity rounded to float as the project stage stores it) and q from 0 to far beyond
+// the Gaussian's reach: within kSimdAlphaMaxRelError wherever alpha >= 1/255, and below 1/255
+// wherever the exact value is below 1/255 e^-0.001 (power_cut's margin, which lets the kernel
+// skip the power_cut test). On every SIMD target this CPU runs.
+void expect_simd_alpha_within_its_bound(const std::string& what) {
+  constexpr int kOpacities = 256, kSteps = 4096;
+  std::vector<float> q, log2_opacity;
+  std::vector<double> exact;
+  for (int i = 0; i < kOpacities; ++i) {
+    const float opacity = i == kOpacities - 1 ? 1.0f : static_cast<float>(std::pow(255.0, -1.0 + double(i) / kOpacities));
+    const float lo = static_cast<float>(std::log2(double(opacity)));
+    const double q_edge = 2.0 * std::log(255.0 * double(opacity));  // exact alpha = 1/255 there
+    for (int k = 0; k <= kSteps; ++k) {
+      q.push_back(static_cast<float>(q_edge * 1.01 * k / kSteps));
+      log2_opacity.push_back(lo);
+    }
+    for (const float far : {100.0f, 1e4f, 1e30f, INFINITY}) {
+      q.push_back(far);
+      log2_opacity.push_back(lo);
+    }
+  }
+  for (std::size_t i = 0; i < q.size(); ++i)
+    exact.push_back(std::exp2(double(log2_opacity[i])) * std::exp(-0.5 * double(q[i])));
+  std::vector<float> alpha(q.size());
+  cpu::simd_alpha(q.data(), log2_opacity.data(), alpha.data(), q.size());
+  double worst = 0.0;
+  std::size_t out_of_bound = 0, let_through = 0;
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    if (exact[i] >= gm::kAlphaMin) {
+      const double error = std::abs(double(alpha[i]) / exact[i] - 1.0);
+      worst = std::max(worst, error);
+      out_of_bound += !(error <= cpu::kSimdAlphaMaxRelError);
+    } else if (exact[i] < gm::kAlphaMin * std::exp(-1e-3)) {
+      let_through += !(alpha[i] < gm::kAlphaMin && alpha[i] >= 0.0f);
+    }
+  }
+  std::printf("%-8s simd alpha: max relative error %.2e where alpha >= 1/255 (bound %.1e), %zu values\n",
+              what.c_str(), worst, cpu::kSimdAlphaMaxRelError, q.size());
+  EXPECT_EQ(out_of_bound, 0u) << what << ": worst " << worst;
+  EXPECT_EQ(let_through, 0u) << what << ": values below power_cut passed 1/255";
+}
+
+TEST(CpuSimdBlend, AlphaWithinItsBoundOnEveryTarget) {
+#ifdef FLASHGS_HAVE_HWY
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    expect_simd_alpha_within_its_bound(hwy::TargetName(target));
+  }
+  hwy::SetSupportedTargetsForTest(0);
+#else
+  expect_simd_alpha_within_its_bound("scalar");
 #endif
 }
 

@@ -41,6 +41,7 @@ void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb) {
     // never changes which pixels pass the exact test below.
     const float reach_y = g.row_q_coeff > 0.0f ? std::sqrt((g.q_cut + 0.5f) / g.row_q_coeff) + 1.0f : 1e30f;
     const float local_y = g.mean_y - static_cast<float>(y_begin);
+    const float power_cut = -0.5f * g.q_cut;  // exact (cpu_project.cpp)
     const int y_first = static_cast<int>(std::max(0.0f, std::ceil(local_y - reach_y)));
     const int y_last = static_cast<int>(std::min(static_cast<float>(tile_h - 1), std::floor(local_y + reach_y)));
     for (int y = y_first; y <= y_last; ++y) {
@@ -61,7 +62,7 @@ void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb) {
         // needle's axis, dropping its most opaque pixels) is gone.
         const float u = g.whiten[0] * dx + u_row, v = g.whiten[2] * dx + v_row;
         const float power = -0.5f * (u * u + v * v);
-        if (power < g.power_cut) continue;
+        if (power < power_cut) continue;
         const float alpha = std::min(gm::kAlphaMax, g.opacity * std::exp(power));
         if (alpha < gm::kAlphaMin) continue;
         const float next_t = transmittance[p] * (1.0f - alpha);

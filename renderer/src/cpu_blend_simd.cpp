@@ -2,11 +2,13 @@
 // time (Google Highway, compiled for every x86 target and dispatched at run time).
 //
 // Per pixel it runs the scalar kernel's operations in the same order (no fused multiply-add),
-// with one exception: the exponential is Highway's (max error 1 ulp) instead of glibc's expf
-// (under 1 ulp). An ulp can move alpha across 1/255 or T across 1e-4, the same flips as
-// between the CPU and CUDA backends (see test_cuda_render.cpp), so the images stay within that
-// bound of the scalar kernel's; measured on every real scene at 960x540: max abs 4.8e-7
-// (test_cpu_simd.cpp). For a given CPU (target) and any thread count the bytes are the same.
+// with one exception: alpha's exponential. The kernel computes opacity e^power as one exp2,
+// 2^(q * -log2(e)/2 + log2 opacity), by a short polynomial valid where it matters (see
+// exp2_nonpositive): relative error under kSimdAlphaMaxRelError (2e-6; glibc's expf and the
+// product with opacity: about 1.8e-7). Such an error can move alpha across 1/255 or T across
+// 1e-4, the same flips as between the CPU and CUDA backends (see test_cuda_render.cpp), so the
+// images stay within that bound of the scalar kernel's (test_cpu_simd.cpp, every real scene).
+// For a given CPU (target) and any thread count the bytes are the same.
 #include <algorithm>
 #include <cmath>
 
@@ -18,7 +20,6 @@
 #include <hwy/foreach_target.h>  // re-includes this file once per target
 #include <hwy/highway.h>
 #include <hwy/cache_control.h>
-#include <hwy/contrib/math/math-inl.h>
 
 HWY_BEFORE_NAMESPACE();
 namespace flashgs {
@@ -74,6 +75,49 @@ void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, Til
   }
 }
 
+// 2^x for x >= -32 (below, 2^-32: a lane so far out fails the alpha test as the exact value
+// would). x = n + f with n = round(x), f in [-0.5, 0.5] (exact); 2^f by a degree-5 polynomial
+// (Chebyshev interpolation, relative error 2.2e-7 in float with FMA); 2^n added to the
+// exponent. The blend's x = q * -log2(e)/2 + log2 opacity is at most 0 (q >= 0, opacity <= 1);
+// where alpha >= 1/255 is possible both terms lie in [-8, 0], so rounding the argument (the
+// constant: 8 * 2^-24; log2 opacity and the FMA: half an ulp of 8 each) moves x by 2^-20 and
+// alpha by 2^-20 ln 2 = 6.6e-7 at most: 8.8e-7 in all, under kSimdAlphaMaxRelError.
+template <class D, class V>
+HWY_INLINE V exp2_nonpositive(D d, V x) {
+  const hn::RebindToSigned<D> di;
+  x = hn::Max(x, hn::Set(d, -32.0f));
+  const auto n = hn::Round(x);
+  const auto f = hn::Sub(x, n);
+  auto p = hn::Set(d, 0x1.5f089p-10f);
+  p = hn::MulAdd(p, f, hn::Set(d, 0x1.3d107p-7f));
+  p = hn::MulAdd(p, f, hn::Set(d, 0x1.c6af6cp-5f));
+  p = hn::MulAdd(p, f, hn::Set(d, 0x1.ebf906p-3f));
+  p = hn::MulAdd(p, f, hn::Set(d, 0x1.62e43p-1f));
+  p = hn::MulAdd(p, f, hn::Set(d, 0x1.000002p+0f));
+  const auto exponent = hn::ShiftLeft<23>(hn::ConvertTo(di, n));
+  return hn::BitCast(d, hn::Add(hn::BitCast(di, p), exponent));
+}
+
+// log2(e) / 2: power * log2(e) = q * -kHalfLog2E.
+constexpr float kHalfLog2E = 0.72134752044448170368f;
+
+// The kernel's alpha before the cap, for the tests (simd_alpha).
+void SimdAlpha(const float* q, const float* log2_opacity, float* alpha, std::size_t n) {
+  const FloatTag d;
+  const std::size_t lanes = hn::Lanes(d);
+  HWY_ALIGN float q_in[gm::kTileSize], lo_in[gm::kTileSize], out[gm::kTileSize];
+  for (std::size_t i = 0; i < n; i += lanes) {
+    const std::size_t m = std::min(lanes, n - i);
+    for (std::size_t k = 0; k < lanes; ++k) {
+      q_in[k] = k < m ? q[i + k] : 0.0f;
+      lo_in[k] = k < m ? log2_opacity[i + k] : 0.0f;
+    }
+    const auto x = hn::MulAdd(hn::Load(d, q_in), hn::Set(d, -kHalfLog2E), hn::Load(d, lo_in));
+    hn::Store(exp2_nonpositive(d, x), d, out);
+    for (std::size_t k = 0; k < m; ++k) alpha[i + k] = out[k];
+  }
+}
+
 // std::max(a, x) and std::min(a, x) lane by lane, NaN included ((a < x) ? x : a), so that the
 // spans are those of the scalar kernel for any input.
 template <class V>
@@ -123,7 +167,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   if (job.count > 0) gather(frame, job, y_begin, tile_h, g);
   // Each row's span [first, last] of pixels that can reach power_cut, for the current Gaussian.
   HWY_ALIGN float span_first[gm::kTileSize], span_last[gm::kTileSize];
-  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), minus_half = hn::Set(d, -0.5f);
+  const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), minus_half_log2e = hn::Set(d, -kHalfLog2E);
   const auto tile_left = hn::Set(d, static_cast<float>(x_begin));
   const auto tile_right = hn::Set(d, static_cast<float>(tile_w - 1));
   const auto alpha_max = hn::Set(d, gm::kAlphaMax), alpha_min = hn::Set(d, gm::kAlphaMin);
@@ -135,7 +179,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
     const float mean_x = gauss.mean_x, mean_y = gauss.mean_y;
     const float q_reach = gauss.q_cut + 0.5f;
     const auto centre_x = hn::Set(d, mean_x), w0 = hn::Set(d, gauss.whiten[0]), w2 = hn::Set(d, gauss.whiten[2]);
-    const auto opacity = hn::Set(d, gauss.opacity);
+    const auto log2_opacity = hn::Set(d, gauss.log2_opacity);
     const auto r = hn::Set(d, gauss.rgb[0]), gr = hn::Set(d, gauss.rgb[1]), b = hn::Set(d, gauss.rgb[2]);
     // The scalar kernel's row spans, computed the same way for a vector of rows at a time.
     const auto q_reach_v = hn::Set(d, q_reach), coeff = hn::Set(d, gauss.row_q_coeff);
@@ -169,12 +213,12 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         const int p = y * gm::kTileSize + local_x;
         const auto dx = hn::Sub(hn::Iota(d, static_cast<float>(x_begin + local_x)), centre_x);
         const auto u = hn::Add(hn::Mul(w0, dx), u_row), w = hn::Add(hn::Mul(w2, dx), v_row);
-        const auto power = hn::Mul(minus_half, hn::Add(hn::Mul(u, u), hn::Mul(w, w)));
+        const auto q = hn::Add(hn::Mul(u, u), hn::Mul(w, w));
         // Only the exact test: a lane outside the row's span or below power_cut has alpha <
         // 1/255 for certain (the margins the scalar kernel's pruning relies on), so it fails
         // this test as surely as it would have been skipped there.
         auto live = hn::MaskFromVec(hn::Load(d, active + p));
-        const auto alpha = hn::Min(alpha_max, hn::Mul(opacity, hn::Exp(d, power)));
+        const auto alpha = hn::Min(alpha_max, exp2_nonpositive(d, hn::MulAdd(q, minus_half_log2e, log2_opacity)));
         auto blends = hn::And(live, hn::Ge(alpha, alpha_min));
         const auto t = hn::Load(d, transmittance + p);
         const auto next_t = hn::Mul(t, hn::Sub(one, alpha));
@@ -221,10 +265,15 @@ namespace flashgs {
 namespace cpu {
 
 HWY_EXPORT(BlendTileSimd);
+HWY_EXPORT(SimdAlpha);
 HWY_EXPORT(TargetName);
 
 void blend_tile_simd(const Frame& frame, const TileJob& tile, TileGaussians& scratch, float* rgb) {
   HWY_DYNAMIC_DISPATCH(BlendTileSimd)(frame, tile, scratch, rgb);
+}
+
+void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(SimdAlpha)(q, log2_opacity, alpha, n);
 }
 
 std::string simd_target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
@@ -240,6 +289,10 @@ namespace cpu {
 
 void blend_tile_simd(const Frame& frame, const TileJob& tile, TileGaussians&, float* rgb) {
   blend_tile_scalar(frame, tile, rgb);
+}
+
+void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) alpha[i] = std::exp2(log2_opacity[i]) * std::exp(-0.5f * q[i]);
 }
 
 std::string simd_target_name() { return "scalar"; }

@@ -20,11 +20,11 @@ struct alignas(64) BlendGaussian {
   float whiten[4];  // q = (w0 dx + w1 dy)^2 + (w2 dx + w3 dy)^2 (gm::Footprint::whiten)
   float opacity;
   float rgb[3];
-  // Below this power, alpha < 1/255 for certain (a margin keeps the exact test authoritative).
-  float power_cut;
+  float log2_opacity;  // the SIMD kernel's alpha is 2^(q * -log2(e) / 2 + log2_opacity)
   // Row pruning: over a row at offset dy the smallest q is row_q_coeff * dy^2, reached at
   // dx = row_slope * dy (= -conic_b / conic_a * dy); pixels farther than
-  // sqrt((q_cut - q) * inv_conic_a) from it cannot pass power_cut.
+  // sqrt((q_cut - q) * inv_conic_a) from it cannot pass power_cut = -q_cut / 2, below which
+  // alpha < 1/255 for certain (a margin keeps the exact test authoritative).
   float row_q_coeff;
   float q_cut;
   float row_slope;
@@ -88,6 +88,12 @@ bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const
 // without Highway it is the scalar one). Both write the tile's pixels of `rgb`.
 void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb);
 void blend_tile_simd(const Frame& frame, const TileJob& tile, TileGaussians& scratch, float* rgb);
+// The SIMD kernel's alpha before its 0.99 cap, opacity e^(-q/2) computed as 2^(q * -log2(e)/2 +
+// log2_opacity), for n lanes (the tests check its bound on every target). Its relative error
+// against the exact value is below kSimdAlphaMaxRelError wherever alpha >= 1/255, and it is
+// below 1/255 wherever the exact value is below 1/255 e^-0.001 (power_cut's margin).
+void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::size_t n);
+constexpr double kSimdAlphaMaxRelError = 2e-6;
 // The SIMD target blend_tile_simd runs on this CPU ("AVX2", "AVX3", ...; "scalar" without Highway).
 std::string simd_target_name();
 

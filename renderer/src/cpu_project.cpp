@@ -29,7 +29,8 @@ void project_all(const Scene& scene, Frame& frame) {
       g.mean_y = f.mean_y;
       for (int k = 0; k < 4; ++k) g.whiten[k] = f.whiten[k];
       g.opacity = opacity;
-      g.power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
+      const float power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
+      g.log2_opacity = static_cast<float>(std::log2(static_cast<double>(opacity)));
       // (a c - b^2) / a = det(W)^2 / a (Lagrange's identity); det(W) = w0 w3 - w1 w2 adds two
       // non-negative terms, so a needle (a nearly singular conic) keeps an accurate row minimum.
       const double w0 = f.whiten[0], w1 = f.whiten[1], w2 = f.whiten[2], w3 = f.whiten[3];
@@ -37,7 +38,7 @@ void project_all(const Scene& scene, Frame& frame) {
       g.row_q_coeff = static_cast<float>(det_w * det_w / conic_a);
       g.row_slope = static_cast<float>(-(w0 * w1 + w2 * w3) / conic_a);
       g.inv_conic_a = static_cast<float>(1.0 / conic_a);
-      g.q_cut = -2.0f * g.power_cut;
+      g.q_cut = -2.0f * power_cut;  // exact: power_cut = -0.5 q_cut
       gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], &scene.sh_dc[i * 3],
                             DEGREE > 0 ? rest + i * rest_n : nullptr, g.rgb);
     });
