@@ -89,7 +89,7 @@ TEST(CpuSimdBlend, EveryTargetThisCpuRunsMatchesTheScalarKernel) {
 }
 
 // The SIMD kernel's alpha against opacity e^(-q/2) in double, over opacities from 1/255 to 1
-// (log2 opacity rounded to float as the project stage stores it) and q from 0 to far beyond
+// (log2 opacity in float, as the project stage stores it) and q from 0 to far beyond
 // the Gaussian's reach: within kSimdAlphaMaxRelError wherever alpha >= 1/255, and below 1/255
 // wherever the exact value is below 1/255 e^-0.001 (power_cut's margin, which lets the kernel
 // skip the power_cut test). On every SIMD target this CPU runs.
@@ -99,7 +99,7 @@ void expect_simd_alpha_within_its_bound(const std::string& what) {
   std::vector<double> exact;
   for (int i = 0; i < kOpacities; ++i) {
     const float opacity = i == kOpacities - 1 ? 1.0f : static_cast<float>(std::pow(255.0, -1.0 + double(i) / kOpacities));
-    const float lo = static_cast<float>(std::log2(double(opacity)));
+    const float lo = std::log2(opacity);  // as the project stage stores it
     const double q_edge = 2.0 * std::log(255.0 * double(opacity));  // exact alpha = 1/255 there
     for (int k = 0; k <= kSteps; ++k) {
       q.push_back(static_cast<float>(q_edge * 1.01 * k / kSteps));

@@ -78,15 +78,19 @@ void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, Til
 // 2^x for x >= -32 (below, 2^-32: a lane so far out fails the alpha test as the exact value
 // would). x = n + f with n = round(x), f in [-0.5, 0.5] (exact); 2^f by a degree-5 polynomial
 // (Chebyshev interpolation, relative error 2.2e-7 in float with FMA); 2^n added to the
-// exponent. The blend's x = q * -log2(e)/2 + log2 opacity is at most 0 (q >= 0, opacity <= 1);
-// where alpha >= 1/255 is possible both terms lie in [-8, 0], so rounding the argument (the
-// constant: 8 * 2^-24; log2 opacity and the FMA: half an ulp of 8 each) moves x by 2^-20 and
-// alpha by 2^-20 ln 2 = 6.6e-7 at most: 8.8e-7 in all, under kSimdAlphaMaxRelError.
+// exponent. n comes from adding 1.5 * 2^23, which rounds x to an integer in the low mantissa
+// bits (so n << 23 is those bits shifted up; no float-to-int conversion). The blend's
+// x = q * -log2(e)/2 + log2 opacity is at most 0 (q >= 0, opacity <= 1); where alpha >= 1/255
+// is possible both terms lie in [-8, 0], so rounding the argument (the constant: 8 * 2^-24;
+// log2 opacity: an ulp of 8; the FMA: half one) moves x by 1.25 * 2^-20 and alpha by 8.3e-7
+// at most: 1.05e-6 in all, under kSimdAlphaMaxRelError (targets without FMA round once more).
 template <class D, class V>
 HWY_INLINE V exp2_nonpositive(D d, V x) {
   const hn::RebindToSigned<D> di;
   x = hn::Max(x, hn::Set(d, -32.0f));
-  const auto n = hn::Round(x);
+  const auto round_bias = hn::Set(d, 0x1.8p23f);
+  const auto biased = hn::Add(x, round_bias);  // 1.5 * 2^23 + round(x)
+  const auto n = hn::Sub(biased, round_bias);
   const auto f = hn::Sub(x, n);
   auto p = hn::Set(d, 0x1.5f089p-10f);
   p = hn::MulAdd(p, f, hn::Set(d, 0x1.3d107p-7f));
@@ -94,7 +98,7 @@ HWY_INLINE V exp2_nonpositive(D d, V x) {
   p = hn::MulAdd(p, f, hn::Set(d, 0x1.ebf906p-3f));
   p = hn::MulAdd(p, f, hn::Set(d, 0x1.62e43p-1f));
   p = hn::MulAdd(p, f, hn::Set(d, 0x1.000002p+0f));
-  const auto exponent = hn::ShiftLeft<23>(hn::ConvertTo(di, n));
+  const auto exponent = hn::ShiftLeft<23>(hn::BitCast(di, biased));
   return hn::BitCast(d, hn::Add(hn::BitCast(di, p), exponent));
 }
 
@@ -165,9 +169,14 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   for (int x = 0; x < gm::kTileSize; ++x) pixel_x[x] = static_cast<float>(x_begin + x);
 
   if (job.count > 0) gather(frame, job, y_begin, tile_h, g);
-  // Each row's span [first, last] of pixels that can reach power_cut, for the current Gaussian.
-  HWY_ALIGN float span_first[gm::kTileSize], span_last[gm::kTileSize];
+  // For the current Gaussian, per row: the lane groups (vectors) its span of pixels that can
+  // reach power_cut touches, [group_first, group_last] (1, 0 when empty), and the row's terms
+  // of u and w (whiten[1] dy, whiten[3] dy).
+  HWY_ALIGN std::int32_t group_first[gm::kTileSize], group_last[gm::kTileSize];
+  HWY_ALIGN float row_u[gm::kTileSize], row_w[gm::kTileSize];
+  const hn::RebindToSigned<FloatTag> di;
   const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), minus_half_log2e = hn::Set(d, -kHalfLog2E);
+  const auto lanes_f = hn::Set(d, static_cast<float>(lanes)), inv_lanes = hn::Set(d, 1.0f / static_cast<float>(lanes));
   const auto tile_left = hn::Set(d, static_cast<float>(x_begin));
   const auto tile_right = hn::Set(d, static_cast<float>(tile_w - 1));
   const auto alpha_max = hn::Set(d, gm::kAlphaMax), alpha_min = hn::Set(d, gm::kAlphaMin);
@@ -181,38 +190,42 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
     const auto centre_x = hn::Set(d, mean_x), w0 = hn::Set(d, gauss.whiten[0]), w2 = hn::Set(d, gauss.whiten[2]);
     const auto log2_opacity = hn::Set(d, gauss.log2_opacity);
     const auto r = hn::Set(d, gauss.rgb[0]), gr = hn::Set(d, gauss.rgb[1]), b = hn::Set(d, gauss.rgb[2]);
-    // The scalar kernel's row spans, computed the same way for a vector of rows at a time.
-    const auto q_reach_v = hn::Set(d, q_reach), coeff = hn::Set(d, gauss.row_q_coeff);
-    const auto slope = hn::Set(d, gauss.row_slope), inv_conic_a = hn::Set(d, gauss.inv_conic_a);
-    const auto mean_y_v = hn::Set(d, mean_y);
-    for (int row = y_first / static_cast<int>(lanes) * static_cast<int>(lanes); row <= y_last;
-         row += static_cast<int>(lanes)) {
-      const auto dy = hn::Sub(hn::Iota(d, static_cast<float>(y_begin + row)), mean_y_v);
-      const auto row_q = hn::Mul(hn::Mul(coeff, dy), dy);
-      const auto centre = hn::Sub(hn::Add(centre_x, hn::Mul(slope, dy)), tile_left);
-      const auto half = hn::Add(hn::Sqrt(hn::Mul(max_like_std(zero, hn::Sub(q_reach_v, row_q)), inv_conic_a)), one);
-      auto first = max_like_std(zero, hn::Ceil(hn::Sub(centre, half)));
-      auto last = min_like_std(tile_right, hn::Floor(hn::Add(centre, half)));
-      const auto reached = hn::Le(row_q, q_reach_v);  // false for NaN, as the scalar !(row_q <= ...)
-      first = hn::IfThenElse(reached, first, one);
-      last = hn::IfThenElse(reached, last, zero);
-      hn::Store(first, d, span_first + row);
-      hn::Store(last, d, span_last + row);
+    {
+      // The scalar kernel's row spans, computed the same way for a vector of rows at a time.
+      const auto q_reach_v = hn::Set(d, q_reach), coeff = hn::Set(d, gauss.row_q_coeff);
+      const auto slope = hn::Set(d, gauss.row_slope), inv_conic_a = hn::Set(d, gauss.inv_conic_a);
+      const auto mean_y_v = hn::Set(d, mean_y), w1 = hn::Set(d, gauss.whiten[1]), w3 = hn::Set(d, gauss.whiten[3]);
+      for (int row = y_first / static_cast<int>(lanes) * static_cast<int>(lanes); row <= y_last;
+           row += static_cast<int>(lanes)) {
+        const auto dy = hn::Sub(hn::Iota(d, static_cast<float>(y_begin + row)), mean_y_v);
+        const auto row_q = hn::Mul(hn::Mul(coeff, dy), dy);
+        const auto centre = hn::Sub(hn::Add(centre_x, hn::Mul(slope, dy)), tile_left);
+        const auto half = hn::Add(hn::Sqrt(hn::Mul(max_like_std(zero, hn::Sub(q_reach_v, row_q)), inv_conic_a)), one);
+        const auto first = max_like_std(zero, hn::Ceil(hn::Sub(centre, half)));
+        const auto last = min_like_std(tile_right, hn::Floor(hn::Add(centre, half)));
+        // The scalar kernel skips a row unless row_q <= q_reach (false for NaN) and first <= last.
+        const auto touched = hn::And(hn::Le(row_q, q_reach_v), hn::Le(first, last));
+        const auto first_group = hn::Floor(hn::Mul(hn::IfThenElse(touched, first, lanes_f), inv_lanes));
+        const auto last_group = hn::Floor(hn::Mul(hn::IfThenElseZero(touched, last), inv_lanes));
+        hn::Store(hn::ConvertTo(di, first_group), di, group_first + row);
+        hn::Store(hn::ConvertTo(di, last_group), di, group_last + row);
+        hn::Store(hn::Mul(w1, dy), d, row_u + row);
+        hn::Store(hn::Mul(w3, dy), d, row_w + row);
+      }
     }
     for (int y = y_first; y <= y_last; ++y) {
-      if (row_live[y] == 0 || span_first[y] > span_last[y]) continue;
-      const float dy = static_cast<float>(y_begin + y) - mean_y;
-      const int x0 = static_cast<int>(span_first[y]), x1 = static_cast<int>(span_last[y]);
-      const auto u_row = hn::Set(d, gauss.whiten[1] * dy), v_row = hn::Set(d, gauss.whiten[3] * dy);
+      if (row_live[y] == 0) continue;
+      const int v_last = group_last[y];
+      const auto u_row = hn::Set(d, row_u[y]), v_row = hn::Set(d, row_w[y]);
       // No early outs per lane group (finished, or no lane above power_cut): the masks below
       // make those lanes no-ops, and the branches mispredicted more than the work they saved
       // (callgrind on pc_playbot: 29% fewer mispredicts for 5% more instructions).
-      for (int v = x0 / static_cast<int>(lanes); v <= x1 / static_cast<int>(lanes); ++v) {
+      for (int v = group_first[y]; v <= v_last; ++v) {
         const int local_x = v * static_cast<int>(lanes);
         const int p = y * gm::kTileSize + local_x;
         const auto dx = hn::Sub(hn::Load(d, pixel_x + local_x), centre_x);
-        const auto u = hn::Add(hn::Mul(w0, dx), u_row), w = hn::Add(hn::Mul(w2, dx), v_row);
-        const auto q = hn::Add(hn::Mul(u, u), hn::Mul(w, w));
+        const auto u = hn::MulAdd(w0, dx, u_row), w = hn::MulAdd(w2, dx, v_row);
+        const auto q = hn::MulAdd(u, u, hn::Mul(w, w));
         // Only the exact test: a lane outside the row's span or below power_cut has alpha <
         // 1/255 for certain (the margins the scalar kernel's pruning relies on), so it fails
         // this test as surely as it would have been skipped there.
@@ -234,9 +247,9 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         // Lanes that do not blend add colour * 0: the same bytes as leaving them (colours start
         // at +0 and stay >= 0), for one select instead of three.
         const auto weight = hn::IfThenElseZero(blends, hn::Mul(alpha, t));
-        hn::Store(hn::Add(hn::Load(d, red + p), hn::Mul(r, weight)), d, red + p);
-        hn::Store(hn::Add(hn::Load(d, green + p), hn::Mul(gr, weight)), d, green + p);
-        hn::Store(hn::Add(hn::Load(d, blue + p), hn::Mul(b, weight)), d, blue + p);
+        hn::Store(hn::MulAdd(r, weight, hn::Load(d, red + p)), d, red + p);
+        hn::Store(hn::MulAdd(gr, weight, hn::Load(d, green + p)), d, green + p);
+        hn::Store(hn::MulAdd(b, weight, hn::Load(d, blue + p)), d, blue + p);
         hn::Store(hn::IfThenElse(blends, next_t, t), d, transmittance + p);
       }
     }

@@ -30,7 +30,7 @@ void project_all(const Scene& scene, Frame& frame) {
       for (int k = 0; k < 4; ++k) g.whiten[k] = f.whiten[k];
       g.opacity = opacity;
       const float power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
-      g.log2_opacity = static_cast<float>(std::log2(static_cast<double>(opacity)));
+      g.log2_opacity = std::log2(opacity);
       // (a c - b^2) / a = det(W)^2 / a (Lagrange's identity); det(W) = w0 w3 - w1 w2 adds two
       // non-negative terms, so a needle (a nearly singular conic) keeps an accurate row minimum.
       const double w0 = f.whiten[0], w1 = f.whiten[1], w2 = f.whiten[2], w3 = f.whiten[3];
