@@ -149,7 +149,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   HWY_ALIGN float active[kTilePixels];
   HWY_ALIGN float pixel_x[gm::kTileSize];  // the image x of each column
   int row_live[gm::kTileSize];  // live lane groups per row
-  int live_groups = 0;
+  std::uint32_t live_rows = 0;  // bit y: row y has a live group
   const auto tile_width = hn::Set(d, static_cast<float>(tile_w));
   for (int y = 0; y < gm::kTileSize; ++y) {
     row_live[y] = 0;
@@ -164,7 +164,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       hn::Store(hn::VecFromMask(d, inside), d, active + p);
       row_live[y] += !hn::AllFalse(d, inside);
     }
-    live_groups += row_live[y];
+    if (row_live[y] > 0) live_rows |= 1u << y;
   }
   for (int x = 0; x < gm::kTileSize; ++x) pixel_x[x] = static_cast<float>(x_begin + x);
 
@@ -181,7 +181,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   const auto tile_right = hn::Set(d, static_cast<float>(tile_w - 1));
   const auto alpha_max = hn::Set(d, gm::kAlphaMax), alpha_min = hn::Set(d, gm::kAlphaMin);
   const auto t_min = hn::Set(d, gm::kTransmittanceMin);
-  for (std::uint64_t k = 0; k < job.count && live_groups > 0; ++k) {
+  for (std::uint64_t k = 0; k < job.count && live_rows != 0; ++k) {
     const int y_first = g.row_first[k], y_last = g.row_last[k];
     if (y_first > y_last) continue;
     const BlendGaussian& gauss = frame.blend_data[static_cast<std::uint32_t>(job.keys[k])];
@@ -190,6 +190,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
     const auto centre_x = hn::Set(d, mean_x), w0 = hn::Set(d, gauss.whiten[0]), w2 = hn::Set(d, gauss.whiten[2]);
     const auto log2_opacity = hn::Set(d, gauss.log2_opacity);
     const auto r = hn::Set(d, gauss.rgb[0]), gr = hn::Set(d, gauss.rgb[1]), b = hn::Set(d, gauss.rgb[2]);
+    // Bit y: row y's span is not empty. Only these rows, and only while live, are visited.
+    std::uint32_t touched_rows = 0;
     {
       // The scalar kernel's row spans, computed the same way for a vector of rows at a time.
       const auto q_reach_v = hn::Set(d, q_reach), coeff = hn::Set(d, gauss.row_q_coeff);
@@ -211,10 +213,17 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         hn::Store(hn::ConvertTo(di, last_group), di, group_last + row);
         hn::Store(hn::Mul(w1, dy), d, row_u + row);
         hn::Store(hn::Mul(w3, dy), d, row_w + row);
+        std::uint8_t bits[(gm::kTileSize + 7) / 8] = {};
+        hn::StoreMaskBits(d, touched, bits);
+        touched_rows |= (static_cast<std::uint32_t>(bits[0]) | (lanes > 8 ? static_cast<std::uint32_t>(bits[1]) << 8 : 0u))
+                        << row;
       }
     }
-    for (int y = y_first; y <= y_last; ++y) {
-      if (row_live[y] == 0) continue;
+    // The span pass covers whole vectors of rows: keep [y_first, y_last] (the rest may lie
+    // below the image).
+    const std::uint32_t in_range = ((2u << y_last) - 1u) & ~((1u << y_first) - 1u);
+    for (std::uint32_t rows = touched_rows & in_range & live_rows; rows != 0; rows &= rows - 1u) {
+      const int y = static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero32(rows));
       const int v_last = group_last[y];
       const auto u_row = hn::Set(d, row_u[y]), v_row = hn::Set(d, row_w[y]);
       // No early outs per lane group (finished, or no lane above power_cut): the masks below
@@ -240,8 +249,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
           hn::Store(hn::VecFromMask(d, live), d, active + p);
           blends = hn::AndNot(finished, blends);
           if (hn::AllFalse(d, live)) {
-            --row_live[y];
-            --live_groups;
+            if (--row_live[y] == 0) live_rows &= ~(1u << y);
           }
         }
         // Lanes that do not blend add colour * 0: the same bytes as leaving them (colours start
