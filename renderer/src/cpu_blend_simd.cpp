@@ -1,14 +1,15 @@
 // CPU blend, SIMD kernel: the scalar kernel's rules on a vector of pixels of one tile row at a
 // time (Google Highway, compiled for every x86 target and dispatched at run time).
 //
-// Per pixel it runs the scalar kernel's operations in the same order (no fused multiply-add),
-// with one exception: alpha's exponential. The kernel computes opacity e^power as one exp2,
-// 2^(q * -log2(e)/2 + log2 opacity), by a short polynomial valid where it matters (see
-// exp2_nonpositive): relative error under kSimdAlphaMaxRelError (2e-6; glibc's expf and the
-// product with opacity: about 1.8e-7). Such an error can move alpha across 1/255 or T across
-// 1e-4, the same flips as between the CPU and CUDA backends (see test_cuda_render.cpp), so the
-// images stay within that bound of the scalar kernel's (test_cpu_simd.cpp, every real scene).
-// For a given CPU (target) and any thread count the bytes are the same.
+// Per pixel it runs the scalar kernel's operations, with two differences in rounding: u, w, q
+// and the colour sums use fused multiply-adds, and alpha = opacity e^power is one exp2,
+// 2^(q * -log2(e)/2 + log2 opacity), by a short polynomial (see exp2_nonpositive): relative
+// error under kSimdAlphaMaxRelError (2e-6; glibc's expf and the product with opacity: about
+// 1.8e-7). Such an error can move alpha across 1/255 or T across 1e-4, the same flips as
+// between the CPU and CUDA backends (see test_cuda_render.cpp), so the images stay within that
+// bound of the scalar kernel's (test_cpu_simd.cpp, every real scene). The pruning margins
+// (0.5 in q, a pixel) dwarf these roundings. For a given CPU (target) and any thread count the
+// bytes are the same.
 #include <algorithm>
 #include <cmath>
 
