@@ -98,7 +98,8 @@ void expect_simd_alpha_within_its_bound(const std::string& what) {
   std::vector<float> q, log2_opacity;
   std::vector<double> exact;
   for (int i = 0; i < kOpacities; ++i) {
-    const float opacity = i == kOpacities - 1 ? 1.0f : static_cast<float>(std::pow(255.0, -1.0 + double(i) / kOpacities));
+    const float opacity =
+        i == kOpacities - 1 ? 1.0f : static_cast<float>(std::pow(255.0, -1.0 + double(i) / kOpacities));
     const float lo = std::log2(opacity);  // as the project stage stores it
     const double q_edge = 2.0 * std::log(255.0 * double(opacity));  // exact alpha = 1/255 there
     for (int k = 0; k <= kSteps; ++k) {

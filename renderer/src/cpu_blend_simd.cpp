@@ -216,8 +216,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         hn::Store(hn::Mul(w3, dy), d, row_w + row);
         std::uint8_t bits[(gm::kTileSize + 7) / 8] = {};
         hn::StoreMaskBits(d, touched, bits);
-        touched_rows |= (static_cast<std::uint32_t>(bits[0]) | (lanes > 8 ? static_cast<std::uint32_t>(bits[1]) << 8 : 0u))
-                        << row;
+        const std::uint32_t row_bits = bits[0] | (lanes > 8 ? static_cast<std::uint32_t>(bits[1]) << 8 : 0u);
+        touched_rows |= row_bits << row;
       }
     }
     // The span pass covers whole vectors of rows: keep [y_first, y_last] (the rest may lie
