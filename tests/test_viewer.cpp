@@ -968,12 +968,14 @@ std::string playbot_dir() {
   return found.empty() ? found : std::filesystem::canonical(found).string();
 }
 
-// The viewer on pc_playbot in a `window`-sized window, its frames rendered at 2048x1200 on one
-// thread: a render (or comparison, or export frame) then takes seconds here, long enough for
-// a test's input to arrive while it runs, and a core stays free for the test's script.
-std::string slow_playbot_viewer_args(const std::string& dir, const std::string& window) {
-  return "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size " + window +
-         " --render-size 2048x1200 --log-input";
+// The viewer on pc_playbot in a `window`-sized window, its frames rendered at `render` size
+// on one thread: a render (or comparison, or export frame) then takes most of a second or
+// more here, long enough for a test's input to arrive while it runs, and a core stays free
+// for the test's script.
+std::string slow_playbot_viewer_args(const std::string& dir, const std::string& window,
+                                     const std::string& render = "2048x1200") {
+  return "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size " + window + " --render-size " + render +
+         " --log-input";
 }
 #endif
 
@@ -990,7 +992,8 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
   // H turns the heat map on (a new full frame starts rendering), then the "Tight box" checkbox
   // is clicked while that frame renders. 1024x600: the sections are open from 600 points up,
   // and the swap (llvmpipe drawing the window, Xvfb copying it) is most of a UI frame's time
-  // here; a window-sized frame on every core could finish before the click (the SIMD blend).
+  // here. The frame renders at 4096x2400 (about 2.5 s on one thread here): at 2048x1200 it
+  // took 0.65 s, about as long as the script takes to find and click the checkbox.
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
       "[ $status -eq 0 ] && { hold H \" key72 \" || status=11; }\n"
@@ -998,7 +1001,7 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
       "[ $status -eq 0 ] && { wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
       "[ $status -eq 0 ] && { close_window || status=15; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_rendering",
-                                      slow_playbot_viewer_args(dir, "1024x600"),
+                                      slow_playbot_viewer_args(dir, "1024x600", "4096x2400"),
                                       steps, 14);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 H, 12 click, 13 option not changed, 14 crash, 15 close)\n"
