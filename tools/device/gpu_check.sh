@@ -88,15 +88,15 @@ bench_quick() {
   bench_scene "$SCENES/pc_biker" bench_biker_quick --backend cuda -r 1920x1080 --configs baseline,flash --warmup 2 --repeat 5
 }
 
-bench_ab() {  # flash against flash with one switch off (AB_CONFIG, default flash-no_tile_sort), same run
+bench_ab() {  # flash against flash with one switch off (AB_CONFIG, default flash-no_dense_tiles_first), same run
   for scene in pc_biker pc_playbot; do
     log "bench A/B $scene"
     bench_scene "$SCENES/$scene" bench_ab_$scene --backend cuda -r 1920x1080,3840x2160 \
-      --configs flash,${AB_CONFIG:-flash-no_tile_sort},flash-no_sort_bits --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
+      --configs flash,${AB_CONFIG:-flash-no_dense_tiles_first} --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
   done
   log "bench A/B 7 x pc_playbot"
   bench_scene "$SCENES/pc_playbot" bench_ab_tile7 --backend cuda --tile 7 -r 1920x1080,3840x2160 \
-    --configs flash,${AB_CONFIG:-flash-no_tile_sort} --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
+    --configs flash,${AB_CONFIG:-flash-no_dense_tiles_first} --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
 }
 
 bench_regions() {  # warp-blend region widths: WIDTHS (default 8 16)
