@@ -308,7 +308,8 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_, &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
+            &values_[1], &ranges_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
+            &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
   }
 
   // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
@@ -516,8 +517,8 @@ class CudaRendererImpl final : public CudaRenderer {
     // it lists, so a chunk outside the view costs one thread rather than a block.
     list_chunks_ = args.chunk_cull && fused;
     if (list_chunks_)
-      chunk_list_.reserve(std::max<std::size_t>((n + cuda::kChunkSize - 1) / cuda::kChunkSize, 1) * sizeof(std::uint32_t),
-                          "chunk list");
+      chunk_list_.reserve(
+          std::max<std::size_t>((n + cuda::kChunkSize - 1) / cuda::kChunkSize, 1) * sizeof(std::uint32_t), "chunk list");
 
     // project (+ fused emit), then the frame's one read back: the pair count. Fused emission
     // that overflowed wrote nothing past the capacity; grow and run it again.
