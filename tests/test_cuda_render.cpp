@@ -163,6 +163,58 @@ TEST(CudaChunkCull, ChangesNothingButTheWork) {
   EXPECT_GT(culled, 0u) << "no chunk was culled: the test does not exercise the cull";
 }
 
+// Fused emission keeps a blend record per projected Gaussian, not per Gaussian. A renderer
+// that starts with room for one record must grow them on its first frame and run it again,
+// with every byte and count as a renderer that never had to, in every config (the baseline
+// keeps its per-Gaussian records).
+TEST(CudaRecords, GrowingFromOneRecordChangesNoByte) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = tiled_demo_scene();
+  setenv("FLASHGS_INITIAL_RECORDS", "1", 1);
+  auto growing = make_cuda_renderer();
+  unsetenv("FLASHGS_INITIAL_RECORDS");
+  auto roomy = make_cuda_renderer();  // the scene is below the default first capacity
+  std::vector<Camera> cameras = chunk_cull_cameras(*scene);
+  cameras.push_back(test::load_demo_cameras()[2].resized(320, 180));  // fewer than the last frame
+  for (int pass = 0; pass < 2; ++pass) {  // the second pass starts with grown buffers
+    growing->set_scene(scene);
+    roomy->set_scene(scene);
+    for (const Camera& camera : cameras)
+      for (const RenderOptions& o : all_configs()) {
+        const std::string what = "pass " + std::to_string(pass) + " " + camera.name + " " + o.label();
+        const Result a = render(*roomy, camera, o);
+        const Result b = render(*growing, camera, o);
+        EXPECT_TRUE(a.image.rgb == b.image.rgb) << what;
+        expect_same_counts(what, a.stats, b.stats);
+      }
+  }
+}
+
+// The flash path's working memory follows the projected Gaussians: the tiled scene's first
+// camera sees a fraction of it, and a renderer that starts with room for one record needs
+// less by at least half the records of the Gaussians it does not see.
+TEST(CudaRecords, MemoryFollowsTheProjectedGaussians) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = tiled_demo_scene();
+  const Camera camera = chunk_cull_cameras(*scene).front();
+  setenv("FLASHGS_INITIAL_RECORDS", "1", 1);
+  auto growing = make_cuda_renderer();
+  unsetenv("FLASHGS_INITIAL_RECORDS");
+  auto roomy = make_cuda_renderer();
+  growing->set_scene(scene);
+  roomy->set_scene(scene);
+  const Result a = render(*roomy, camera, RenderOptions{});
+  const Result b = render(*growing, camera, RenderOptions{});
+  std::printf("visible %llu of %zu: working memory %.1f MB (room for every Gaussian: %.1f MB)\n",
+              static_cast<unsigned long long>(b.stats.visible), scene->size(), b.stats.device_memory_bytes / 1e6,
+              a.stats.device_memory_bytes / 1e6);
+  ASSERT_LT(b.stats.visible * 3, scene->size()) << "the camera sees too much of the scene for this test";
+  const double unseen_record_bytes = static_cast<double>(scene->size() - b.stats.visible) * 48.0;
+  EXPECT_GT(static_cast<double>(a.stats.device_memory_bytes) - static_cast<double>(b.stats.device_memory_bytes),
+            unseen_record_bytes / 2);
+  EXPECT_TRUE(a.image.rgb == b.image.rgb);
+}
+
 TEST(CudaVsCpu, TiledSceneWithChunkCull) {
   FLASHGS_REQUIRE_CUDA();
   const auto scene = tiled_demo_scene();

@@ -153,13 +153,14 @@ std::uint32_t float_exponent(float v) {  // biased exponent field of a positive 
 
 // The 32-bit key format for a frame of `tiles` tiles whose visible depths lie in
 // [min_depth, max_depth]: the exponents that range spans, then as many mantissa bits as fit
-// (a tighter range leaves fewer Gaussians sharing a bin for the ranges pass to order).
+// in `key_bits` (a tighter range leaves fewer Gaussians sharing a bin for the ranges pass to
+// order; fewer key bits, fewer radix passes but more ties), at least 8 bits of depth.
 // Returns the 64-bit format (depth_bits 0) when the tiles leave too few bits for depth.
-cuda::KeyFormat compact_key_format(std::uint64_t tiles, double min_depth, double max_depth) {
+cuda::KeyFormat compact_key_format(std::uint64_t tiles, double min_depth, double max_depth, int key_bits) {
   cuda::KeyFormat k;
   const int tile_bits = std::max(bits_for(tiles), 1);
-  const int depth_bits = 32 - tile_bits;
-  if (depth_bits < 8) return k;
+  if (32 - tile_bits < 8) return k;
+  const int depth_bits = std::min(32 - tile_bits, std::max(8, key_bits - tile_bits));
   const double near = std::max(min_depth, double{gm::kNearZ});
   const float far = static_cast<float>(std::min(std::max(max_depth, near), 1e30));
   const std::uint32_t lo = float_exponent(static_cast<float>(std::min(near, 1e30))), hi = float_exponent(far);
@@ -191,6 +192,11 @@ class CudaRendererImpl final : public CudaRenderer {
     // last frame's fullest tile outlasted a wave of the blend, see dense_order_pays).
     if (const char* dense = std::getenv("FLASHGS_DENSE_TILES_FIRST"))
       dense_tiles_mode_ = std::atoi(dense) != 0 ? kAlways : kNever;
+    // FLASHGS_SORT_KEY_BITS: the compact key's length (tile and depth bin), 16 to 32.
+    if (const char* bits = std::getenv("FLASHGS_SORT_KEY_BITS")) sort_key_bits_ = std::max(16, std::min(32, std::atoi(bits)));
+    // FLASHGS_INITIAL_RECORDS: the blend records a first frame starts with (tests of growth).
+    if (const char* records = std::getenv("FLASHGS_INITIAL_RECORDS"))
+      initial_records_ = std::max<long long>(1, std::atoll(records));
     blend_resident_blocks_ = cuda::blend_resident_blocks();
     for (int set = 0; set < 2; ++set)
       for (int e = 0; e < kEventCount; ++e) {
@@ -230,8 +236,6 @@ class CudaRendererImpl final : public CudaRenderer {
     new_dc.reserve(m * sizeof(float2), "scene colours");
     if (stride_vec4 > 0) new_rest.reserve(n * stride_vec4 * sizeof(float4), "scene SH bands");
     new_chunks.reserve(std::max<std::size_t>(chunks, 1) * sizeof(cuda::ChunkBound), "scene chunk bounds");
-    // Per-Gaussian frame buffers of the fused path; the separate path's grow on first use.
-    blend_.reserve(m * sizeof(cuda::BlendGaussian), "per-Gaussian blend data");
 
     // Packed into the device layout chunk by chunk (no host copy of the whole scene).
     check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation");
@@ -307,9 +311,9 @@ class CudaRendererImpl final : public CudaRenderer {
                kEventCount };
 
   std::vector<DeviceBuffer*> working_buffers() {
-    return {&counters_, &blend_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
+    return {&counters_, &blend_, &record_ids_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
             &values_[1], &ranges_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
-            &large_footprints_, &large_ids_, &huge_footprints_, &huge_ids_};
+            &large_footprints_, &large_records_, &huge_footprints_, &huge_records_};
   }
 
   // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
@@ -347,19 +351,39 @@ class CudaRendererImpl final : public CudaRenderer {
     return std::sqrt(d2);
   }
 
-  static cuda::DeferredList deferred_list(const DeviceBuffer& footprints, const DeviceBuffer& ids) {
+  static cuda::DeferredList deferred_list(const DeviceBuffer& footprints, const DeviceBuffer& records) {
     cuda::DeferredList list;
     list.footprints = footprints.as<gm::Footprint>();
-    list.ids = ids.as<std::uint32_t>();
+    list.records = records.as<std::uint32_t>();
     list.capacity = static_cast<std::uint32_t>(
-        std::min(footprints.bytes() / sizeof(gm::Footprint), ids.bytes() / sizeof(std::uint32_t)));
+        std::min(footprints.bytes() / sizeof(gm::Footprint), records.bytes() / sizeof(std::uint32_t)));
     return list;
+  }
+
+  // Blend records the buffers hold: compact ones need an id each as well.
+  std::uint32_t record_capacity() const {
+    std::size_t records = blend_.bytes() / sizeof(cuda::BlendGaussian);
+    if (compact_records_) records = std::min(records, record_ids_.bytes() / sizeof(std::uint32_t));
+    return static_cast<std::uint32_t>(std::min<std::size_t>(records, UINT32_MAX));
+  }
+
+  // Compact records for at least `records` projected Gaussians (at most the scene's), with
+  // `headroom` (a quarter more: the pair buffers' policy) so that a moving camera does not
+  // grow them every few frames.
+  void grow_records(std::uint64_t records, bool headroom) {
+    if (records <= record_capacity()) return;
+    const std::uint64_t wanted = headroom ? std::max<std::uint64_t>(records + records / 4, 1u << 16) : records;
+    const std::uint64_t capacity = std::max<std::uint64_t>(1, std::min<std::uint64_t>(device_scene_.count, wanted));
+    blend_.reserve(capacity * sizeof(cuda::BlendGaussian), "blend records");
+    record_ids_.reserve(capacity * sizeof(std::uint32_t), "blend record ids");
   }
 
   cuda::FrameBuffers frame_buffers() const {
     cuda::FrameBuffers b;
     b.key_format = key_format_;
     b.blend = blend_.as<cuda::BlendGaussian>();
+    b.record_ids = compact_records_ ? record_ids_.as<std::uint32_t>() : nullptr;
+    b.record_capacity = record_capacity();
     b.footprints = footprints_.as<gm::Footprint>();
     b.pair_counts = pair_counts_.as<std::uint32_t>();
     b.pair_offsets = pair_offsets_.as<std::uint32_t>();
@@ -368,8 +392,8 @@ class CudaRendererImpl final : public CudaRenderer {
       b.values[k] = values_[k].as<std::uint32_t>();
     }
     b.pair_capacity = pair_capacity_;
-    b.large = deferred_list(large_footprints_, large_ids_);
-    b.huge = deferred_list(huge_footprints_, huge_ids_);
+    b.large = deferred_list(large_footprints_, large_records_);
+    b.huge = deferred_list(huge_footprints_, huge_records_);
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
     b.tile_order = tile_order_.as<std::uint32_t>();
@@ -479,28 +503,34 @@ class CudaRendererImpl final : public CudaRenderer {
       const double tan_y = std::max(cam.cy, cam.height - cam.cy) / cam.fy;
       const double cos_half_diagonal = 1.0 / std::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
       key_format_ = compact_key_format(tiles, (distance - bounds_radius_) * cos_half_diagonal,
-                                       distance + bounds_radius_);
+                                       distance + bounds_radius_, sort_key_bits_);
     } else {
       key_format_ = cuda::KeyFormat{};
     }
 
     ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
+    // Fused emission keeps a blend record per projected Gaussian (FrameBuffers::blend), the
+    // separate path one per Gaussian.
+    compact_records_ = fused;
+    if (fused) grow_records(std::min<std::uint64_t>(n, initial_records_), false);
+    else blend_.reserve(std::max<std::size_t>(n, 1) * sizeof(cuda::BlendGaussian), "per-Gaussian blend data");
     if (fused && !baseline && options.warp_cooperative_emit) {
-      // Lists of deferred Gaussians; a frame with more emits the rest in the preprocess kernel.
-      const std::size_t large_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 8192 + n / 8);
+      // Lists of deferred Gaussians, sized to the projected ones; a frame with more emits the
+      // rest in the preprocess kernel.
+      const std::size_t projected = record_capacity();
+      const std::size_t large_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 8192 + projected / 8);
       large_footprints_.reserve(large_cap * sizeof(gm::Footprint), "large-Gaussian footprints");
-      large_ids_.reserve(large_cap * sizeof(std::uint32_t), "large-Gaussian ids");
-      const std::size_t huge_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 4096 + n / 64);
+      large_records_.reserve(large_cap * sizeof(std::uint32_t), "large-Gaussian records");
+      const std::size_t huge_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 4096 + projected / 64);
       huge_footprints_.reserve(huge_cap * sizeof(gm::Footprint), "huge-Gaussian footprints");
-      huge_ids_.reserve(huge_cap * sizeof(std::uint32_t), "huge-Gaussian ids");
+      huge_records_.reserve(huge_cap * sizeof(std::uint32_t), "huge-Gaussian records");
     }
     if (!fused) {
       footprints_.reserve(std::max<std::size_t>(n, 1) * sizeof(gm::Footprint), "per-Gaussian footprints");
       pair_counts_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair counts");
       pair_offsets_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair offsets");
     }
-    blend_.reserve(std::max<std::size_t>(n, 1) * sizeof(cuda::BlendGaussian), "per-Gaussian blend data");
     grow_cub_temp();  // allocates only when the scene or pairs grew
 
     cuda::PreprocessArgs args{};
@@ -520,8 +550,8 @@ class CudaRendererImpl final : public CudaRenderer {
       chunk_list_.reserve(
           std::max<std::size_t>((n + cuda::kChunkSize - 1) / cuda::kChunkSize, 1) * sizeof(std::uint32_t), "chunk list");
 
-    // project (+ fused emit), then the frame's one read back: the pair count. Fused emission
-    // that overflowed wrote nothing past the capacity; grow and run it again.
+    // project (+ fused emit), then the frame's one read back: the pair and record counts.
+    // Fused emission that overflowed wrote nothing past the capacities; grow and run it again.
     // Event sets alternate between frames, so that a surface frame's statistics can report
     // the previous frame's stage times without waiting for its own.
     const int previous_set = event_set_;
@@ -547,8 +577,10 @@ class CudaRendererImpl final : public CudaRenderer {
       if (pairs > static_cast<std::uint64_t>(INT32_MAX))
         throw Error("cuda renderer: the frame needs " + std::to_string(pairs) +
                     " Gaussian-tile pairs, more than the 2^31 the sort can take");
-      if (pairs <= pair_capacity_) break;
+      const std::uint64_t records = readback_->counters.records;
+      if (pairs <= pair_capacity_ && (!compact_records_ || records <= record_capacity())) break;
       grow_pairs(pairs);
+      if (compact_records_) grow_records(records, true);
       if (!fused) break;  // nothing was written yet
       if (attempt > 0) throw Error("cuda renderer: internal error, pair count changed between identical runs");
     }
@@ -653,6 +685,7 @@ class CudaRendererImpl final : public CudaRenderer {
   int event_set_ = 0;
   bool last_frame_complete_ = false;  // the last frame recorded all its events
   bool list_chunks_ = false;          // this frame's preprocess walks a chunk list (FrameBuffers::chunk_list)
+  bool compact_records_ = false;      // this frame keeps a blend record per projected Gaussian
   std::shared_ptr<const Scene> scene_;
   cuda::DeviceScene device_scene_;
   std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;
@@ -666,6 +699,10 @@ class CudaRendererImpl final : public CudaRenderer {
   // 100M one's 2.8x on an H200) and costs a test per 256 Gaussians that cannot pay off when
   // the whole of a small scene is in view (pc_biker's and pc_playbot's orbit views).
   static constexpr std::size_t kChunkCullMinGaussians = std::size_t{1} << 20;
+  // Compact records a scene's first frame starts with (100 MB): a view of more Gaussians grows
+  // them once and runs again.
+  std::uint64_t initial_records_ = std::uint64_t{1} << 21;
+  int sort_key_bits_ = 32;  // of a compact key (compact_key_format)
   enum Mode { kAuto, kAlways, kNever };
   Mode chunk_cull_ = kAuto;
   Mode dense_tiles_mode_ = kAuto;
@@ -678,9 +715,9 @@ class CudaRendererImpl final : public CudaRenderer {
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
-  DeviceBuffer counters_, blend_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_order_,
+  DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_order_,
       tile_places_, chunk_list_, image_,
-      cub_temp_, large_footprints_, large_ids_, huge_footprints_, huge_ids_;
+      cub_temp_, large_footprints_, large_records_, huge_footprints_, huge_records_;
 };
 
 }  // namespace

@@ -117,29 +117,37 @@ struct FrameCounters {
   unsigned long long chunk_culled; // Gaussians of chunks outside the view (classified, not projected)
   unsigned int listed_chunks;      // chunks the chunk cull left to preprocess (launch_chunk_list)
   unsigned int tiles_by_class[kTileClasses];  // tiles per pair-count class (launch_tile_order)
+  unsigned int records;            // blend records wanted (compact records: may exceed capacity)
 };
 
 // Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
 // tile loops are spread over the whole GPU instead of holding the warp that met them.
 struct DeferredList {
   gm::Footprint* footprints = nullptr;  // [capacity]
-  std::uint32_t* ids = nullptr;         // [capacity] Gaussian id
+  std::uint32_t* records = nullptr;     // [capacity] blend record (the pairs' value)
   std::uint32_t capacity = 0;           // beyond it, the preprocess kernel emits them itself
 };
 
 // Buffers of the frame pipeline; every size is a high-water mark (grown, never shrunk).
 struct FrameBuffers {
-  // Per Gaussian (sized to the scene at set_scene).
-  BlendGaussian* blend = nullptr;         // [gaussians]
-  gm::Footprint* footprints = nullptr;    // [gaussians] separate-emission path only
+  // Blend records. Fused emission keeps one per projected Gaussian: record_ids[r] is record
+  // r's Gaussian and the pairs' values are record numbers, so the blend data grows with what
+  // the frame sees, not with the scene. The separate path (record_ids null) indexes them by
+  // Gaussian id. A frame that wants more than record_capacity writes none past it; the host
+  // sees FrameCounters::records, grows the buffers and runs the frame again.
+  BlendGaussian* blend = nullptr;         // [record_capacity]
+  std::uint32_t* record_ids = nullptr;    // [record_capacity], or null
+  std::uint32_t record_capacity = 0;
+  // Per Gaussian, separate-emission path only.
+  gm::Footprint* footprints = nullptr;    // [gaussians]
   std::uint32_t* pair_counts = nullptr;   // [gaussians] pairs per Gaussian (separate path)
   std::uint32_t* pair_offsets = nullptr;  // [gaussians] inclusive prefix sum of pair_counts
   // Deferred by the fused kernel: boxes of more than large_box_tiles (a warp per Gaussian) and
   // of more than kHugeBoxTiles tiles (a block per Gaussian).
   DeferredList large;
   DeferredList huge;
-  // Per pair: key (see KeyFormat; 32-bit keys use the front half), value = Gaussian id; two of
-  // each for the sort.
+  // Per pair: key (see KeyFormat; 32-bit keys use the front half), value = blend record; two
+  // of each for the sort.
   KeyFormat key_format;
   std::uint64_t* keys[2] = {nullptr, nullptr};    // [pair_capacity]
   std::uint32_t* values[2] = {nullptr, nullptr};  // [pair_capacity]
@@ -212,7 +220,7 @@ struct BlendArgs {
   BlendKernel kernel;
   bool exp2_alpha;
   int region_width;              // warp blend: a warp's region, 16 x 4 or 8 x 8 pixels
-  const std::uint32_t* values;   // sorted Gaussian ids
+  const std::uint32_t* values;   // sorted blend records
   const uint2* tile_ranges;
   const std::uint32_t* tile_order;  // warp blend: block b blends tile tile_order[b] (null: tile b)
   const BlendGaussian* gaussians;

@@ -113,7 +113,7 @@ __device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& wal
 // Writes the segment's passing tiles; lane c holds chunk c's ballot and its first offset.
 __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
                                    unsigned my_ballot, unsigned long long my_base, std::uint32_t depth_bits,
-                                   unsigned id, const gm::CameraParams& cam) {
+                                   unsigned record, const gm::CameraParams& cam) {
   const unsigned lane = lane_id();
   const unsigned lanes_below = (1u << lane) - 1u;
   const unsigned chunks = walk.chunks(s0);
@@ -124,7 +124,7 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
     const unsigned long long chunk_base = __shfl_sync(kFullMask, my_base, c);
     if (ballot & (1u << lane))
       store_pair(buf, chunk_base + __popc(ballot & lanes_below),
-                 static_cast<unsigned>(g.tile_y0 + static_cast<int>(y)) * cam.tiles_x + g.tile_x0 + x, depth_bits, id);
+                 static_cast<unsigned>(g.tile_y0 + static_cast<int>(y)) * cam.tiles_x + g.tile_x0 + x, depth_bits, record);
     walk.advance(x, y);
   }
 }
@@ -132,7 +132,7 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
 // The pairs of one Gaussian's box, emitted by the whole warp (all lanes call with the same
 // footprint), one atomic per segment; returns how many were wanted.
 __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g, std::uint32_t depth_bits,
-                                  unsigned id, const gm::CameraParams& cam, bool exact) {
+                                  unsigned record, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
   const BoxWalk walk(g);
   unsigned total = 0;
@@ -145,7 +145,7 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
     unsigned long long base = 0;
     if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
     base = __shfl_sync(kFullMask, base, 0) + (inclusive - my_count);  // lane c: chunk c's offset
-    warp_write_segment(buf, g, walk, s0, my_ballot, base, depth_bits, id, cam);
+    warp_write_segment(buf, g, walk, s0, my_ballot, base, depth_bits, record, cam);
     total += segment_total;
   }
   return total;
@@ -160,7 +160,7 @@ struct alignas(16) SmallBox {
   float edge_slope_x, edge_slope_y, threshold, mean_x;
   float mean_y;
   int tile_x0, tile_y0, box_w;
-  unsigned start, row_magic, id, depth_bits;  // row_magic: ceil(2^16 / box_w), t / box_w = (t row_magic) >> 16
+  unsigned start, row_magic, record, depth_bits;  // row_magic: ceil(2^16 / box_w), t / box_w = (t row_magic) >> 16
 };
 constexpr int kSmallTilesPerWarp = kWarp * kWarp;
 
@@ -180,7 +180,7 @@ __device__ __forceinline__ void small_box_tile(const SmallBox& b, unsigned t, in
 // All lanes call; my_box: this lane's box size (0: nothing to emit here). Returns this lane's
 // pair count.
 __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers& buf, const gm::Footprint& f,
-                                          unsigned my_box, std::uint32_t depth_bits, unsigned id,
+                                          unsigned my_box, std::uint32_t depth_bits, unsigned record,
                                           const gm::CameraParams& cam) {
   const unsigned lane = lane_id();
   const unsigned inclusive = warp_inclusive_sum(my_box);
@@ -191,7 +191,7 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
     s.boxes[lane] = SmallBox{make_float4(f.whiten[0], f.whiten[1], f.whiten[2], f.whiten[3]),
                              f.edge_slope_x, f.edge_slope_y, f.threshold, f.mean_x, f.mean_y, f.tile_x0, f.tile_y0,
                              box_w, start, (65536u + static_cast<unsigned>(box_w) - 1u) / static_cast<unsigned>(box_w),
-                             id, depth_bits};
+                             record, depth_bits};
     for (unsigned t = 0; t < my_box; ++t) s.owner[start + t] = static_cast<unsigned char>(lane);
   }
   __syncwarp();
@@ -246,7 +246,7 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
       small_box_tile(b, c * kWarp + lane - b.start, tx, ty);
       store_pair(buf, step_base + __popc(ballot & lanes_below),
                  static_cast<unsigned>(ty) * static_cast<unsigned>(cam.tiles_x) + static_cast<unsigned>(tx),
-                 b.depth_bits, b.id);
+                 b.depth_bits, b.record);
     }
   }
   __syncwarp();  // the scratch is free again
@@ -306,72 +306,89 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   // The flash path: boxes of at most large_box_tiles <= 32 tiles tested by the whole warp.
   const bool balanced = FUSED && args.warp_cooperative && args.exact_tile_test && args.large_box_tiles <= kWarp;
   unsigned small_box = 0;
+  float4 po{}, sd{};
   if (valid) {
-    const float4 po = __ldg(scene.position_opacity + i);
+    po = __ldg(scene.position_opacity + i);
     const float4 q = __ldg(scene.rotation + i);
-    const float4 sd = __ldg(scene.scale_dc_r + i);
+    sd = __ldg(scene.scale_dc_r + i);
     const float pos[3] = {po.x, po.y, po.z};
     const float scale[3] = {sd.x, sd.y, sd.z};
     const float quat[4] = {q.x, q.y, q.z, q.w};
     reason = gm::project(cam, args.geometry, pos, scale, quat, po.w, f);
-    if (reason == gm::kVisible) {
-      const float2 gb = __ldg(scene.dc_gb + i);
-      const float dc[3] = {sd.w, gb.x, gb.y};
-      float rgb[3];
-      colour<DEGREE>(scene, i, cam, pos, dc, rgb);
-      float4* out = reinterpret_cast<float4*>(buf.blend + i);
-      if (args.exp2_alpha) {
-        // w' = sqrt(log2(e) / 2) w, so o e^(-q/2) = exp2(log2 o - (u'^2 + v'^2)): one exp2.
-        const float hs = sqrtf(0.5f * kLog2e);
-        out[0] = make_float4(f.mean_x, f.mean_y, hs * f.whiten[0], hs * f.whiten[1]);
-        out[1] = make_float4(hs * f.whiten[2], hs * f.whiten[3], log2f(po.w), rgb[0]);
+  }
+  const bool visible = reason == gm::kVisible;  // (valid)
+  // This Gaussian's blend record, the value of its pairs: claimed by the warp with one atomic
+  // when records are compact, else its id.
+  unsigned record = i;
+  if (buf.record_ids) {
+    const unsigned ballot = __ballot_sync(kFullMask, visible);
+    unsigned base = 0;
+    if (ballot && lane == static_cast<unsigned>(__ffs(ballot) - 1)) base = atomicAdd(&buf.counters->records, __popc(ballot));
+    base = __shfl_sync(kFullMask, base, ballot ? __ffs(ballot) - 1 : 0);
+    record = base + __popc(ballot & ((1u << lane) - 1u));
+  }
+  if (visible && record < buf.record_capacity) {
+    const float pos[3] = {po.x, po.y, po.z};
+    const float2 gb = __ldg(scene.dc_gb + i);
+    const float dc[3] = {sd.w, gb.x, gb.y};
+    float rgb[3];
+    colour<DEGREE>(scene, i, cam, pos, dc, rgb);
+    if (buf.record_ids) buf.record_ids[record] = i;
+    float4* out = reinterpret_cast<float4*>(buf.blend + record);
+    if (args.exp2_alpha) {
+      // w' = sqrt(log2(e) / 2) w, so o e^(-q/2) = exp2(log2 o - (u'^2 + v'^2)): one exp2.
+      const float hs = sqrtf(0.5f * kLog2e);
+      out[0] = make_float4(f.mean_x, f.mean_y, hs * f.whiten[0], hs * f.whiten[1]);
+      out[1] = make_float4(hs * f.whiten[2], hs * f.whiten[3], log2f(po.w), rgb[0]);
+    } else {
+      out[0] = make_float4(f.mean_x, f.mean_y, f.whiten[0], f.whiten[1]);
+      out[1] = make_float4(f.whiten[2], f.whiten[3], po.w, rgb[0]);
+    }
+    // Rows farther than reach_y from the centre have q > 2 ln(255 o), i.e. alpha < 1/255
+    // (min over dx of q at offset dy is dy^2 / Sigma_yy); the margins cover rounding, so
+    // the blend may skip them without changing a pixel.
+    const float det_w = f.whiten[0] * f.whiten[3] - f.whiten[1] * f.whiten[2];
+    const float q_cut = 2.0f * logf(255.0f * po.w) + 0.01f;
+    const float conic_a = f.whiten[0] * f.whiten[0] + f.whiten[2] * f.whiten[2];
+    float reach_y = q_cut > 0.0f ? sqrtf(q_cut * conic_a) / fabsf(det_w) + 0.01f : -1.0f;
+    if (!(reach_y < 1e30f) && q_cut > 0.0f) reach_y = 1e30f;  // degenerate: never skip
+    out[2] = make_float4(rgb[1], rgb[2], reach_y, f.depth);
+  }
+  // A frame whose records overflowed still counts (and writes) its pairs: it runs again.
+  if (visible) {
+    const int box_w = f.tile_x1 - f.tile_x0;
+    const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
+    if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kHugeBoxTiles)) {
+      const unsigned slot = atomicAdd(&buf.counters->huge, 1u);
+      if (slot < buf.huge.capacity) {
+        buf.huge.footprints[slot] = f;
+        buf.huge.records[slot] = record;
+        deferred = true;
       } else {
-        out[0] = make_float4(f.mean_x, f.mean_y, f.whiten[0], f.whiten[1]);
-        out[1] = make_float4(f.whiten[2], f.whiten[3], po.w, rgb[0]);
-      }
-      // Rows farther than reach_y from the centre have q > 2 ln(255 o), i.e. alpha < 1/255
-      // (min over dx of q at offset dy is dy^2 / Sigma_yy); the margins cover rounding, so
-      // the blend may skip them without changing a pixel.
-      const float det_w = f.whiten[0] * f.whiten[3] - f.whiten[1] * f.whiten[2];
-      const float q_cut = 2.0f * logf(255.0f * po.w) + 0.01f;
-      const float conic_a = f.whiten[0] * f.whiten[0] + f.whiten[2] * f.whiten[2];
-      float reach_y = q_cut > 0.0f ? sqrtf(q_cut * conic_a) / fabsf(det_w) + 0.01f : -1.0f;
-      if (!(reach_y < 1e30f) && q_cut > 0.0f) reach_y = 1e30f;  // degenerate: never skip
-      out[2] = make_float4(rgb[1], rgb[2], reach_y, f.depth);
-
-      const int box_w = f.tile_x1 - f.tile_x0;
-      const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
-      if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kHugeBoxTiles)) {
-        const unsigned slot = atomicAdd(&buf.counters->huge, 1u);
-        if (slot < buf.huge.capacity) {
-          buf.huge.footprints[slot] = f;
-          buf.huge.ids[slot] = i;
-          deferred = true;
-        } else {
-          large = true;
-        }
-      } else if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(args.large_box_tiles)) {
         large = true;
-      } else if (!args.exact_tile_test) {
-        count = box;
-      } else if (balanced) {
-        small_box = box;
-      } else {
-        unsigned k = 0;
-        for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
-          for (int tx = f.tile_x0; tx < f.tile_x1; ++tx, ++k)
-            if (gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height)) {
-              ++count;
-              if (k < 32) passed_mask |= 1u << k;
-            }
       }
+    } else if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(args.large_box_tiles)) {
+      large = true;
+    } else if (!args.exact_tile_test) {
+      count = box;
+    } else if (balanced) {
+      small_box = box;
+    } else {
+      unsigned k = 0;
+      for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
+        for (int tx = f.tile_x0; tx < f.tile_x1; ++tx, ++k)
+          if (gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height)) {
+            ++count;
+            if (k < 32) passed_mask |= 1u << k;
+          }
     }
   }
 
   if constexpr (FUSED) {
     const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
     __shared__ SmallBoxScratch small_scratch[kBlock / kWarp];
-    if (balanced) count = warp_emit_small_boxes(small_scratch[threadIdx.x / kWarp], buf, f, small_box, depth_bits, i, cam);
+    if (balanced)
+      count = warp_emit_small_boxes(small_scratch[threadIdx.x / kWarp], buf, f, small_box, depth_bits, record, cam);
     // Thread-emitted Gaussians: one atomic per warp reserves all their pairs.
     const unsigned inclusive = warp_inclusive_sum(balanced ? 0u : count);
     const unsigned warp_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -386,13 +403,13 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
         for (unsigned m = passed_mask; m; m &= m - 1) {
           const unsigned k = __ffs(m) - 1;
           const unsigned tile = (f.tile_y0 + k / box_w) * cam.tiles_x + f.tile_x0 + k % box_w;
-          store_pair(buf, offset++, tile, depth_bits, i);
+          store_pair(buf, offset++, tile, depth_bits, record);
         }
       } else {
         for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
           for (int tx = f.tile_x0; tx < f.tile_x1; ++tx)
             if (touches(f, tx, ty, cam, args.exact_tile_test))
-              store_pair(buf, offset++, static_cast<unsigned>(ty) * cam.tiles_x + tx, depth_bits, i);
+              store_pair(buf, offset++, static_cast<unsigned>(ty) * cam.tiles_x + tx, depth_bits, record);
       }
     }
     // Large Gaussians: the warp tests 32 tiles at a time (FlashGS section 4.3). Lane c keeps
@@ -407,7 +424,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
       const unsigned slot = base + __popc(large_ballot & ((1u << lane) - 1u));
       if (large && slot < buf.large.capacity) {
         buf.large.footprints[slot] = f;
-        buf.large.ids[slot] = i;
+        buf.large.records[slot] = record;
         large = false;
         deferred = true;
       }
@@ -418,8 +435,8 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
       pending &= pending - 1;
       const gm::Footprint g = shfl_footprint(f, src);
       const std::uint32_t g_depth = __shfl_sync(kFullMask, depth_bits, src);
-      const unsigned g_id = __shfl_sync(kFullMask, i, src);
-      const unsigned total = warp_emit_box(buf, g, g_depth, g_id, cam, args.exact_tile_test);
+      const unsigned g_record = __shfl_sync(kFullMask, record, src);
+      const unsigned total = warp_emit_box(buf, g, g_depth, g_record, cam, args.exact_tile_test);
       if (static_cast<int>(lane) == src) count = total;
     }
   } else {
@@ -501,7 +518,7 @@ __global__ void __launch_bounds__(kBlock) large_emit_kernel(FrameBuffers buf, gm
         const gm::Footprint f = buf.large.footprints[k];
         const BoxWalk walk(f);
         if (walk.box <= kWarp * kWarp) my_ballot[j] = warp_test_segment(f, walk, 0, cam, exact);
-        else emitted = warp_emit_box(buf, f, sort_depth(buf.key_format, f.depth), buf.large.ids[k], cam, exact);
+        else emitted = warp_emit_box(buf, f, sort_depth(buf.key_format, f.depth), buf.large.records[k], cam, exact);
       }
       const unsigned my_count = __popc(my_ballot[j]);
       const unsigned inclusive = warp_inclusive_sum(my_count);
@@ -524,7 +541,7 @@ __global__ void __launch_bounds__(kBlock) large_emit_kernel(FrameBuffers buf, gm
       if (!__any_sync(kFullMask, my_ballot[j] != 0)) continue;  // nothing passed (or emitted already)
       const gm::Footprint f = buf.large.footprints[k];
       warp_write_segment(buf, f, BoxWalk(f), 0, my_ballot[j], base + my_offset[j],
-                         sort_depth(buf.key_format, f.depth), buf.large.ids[k], cam);
+                         sort_depth(buf.key_format, f.depth), buf.large.records[k], cam);
     }
   }
   if (lane == 0) {
@@ -550,7 +567,7 @@ __global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm:
   const unsigned lanes_below = (1u << lane) - 1u;
   for (unsigned h = blockIdx.x; h < count; h += gridDim.x) {
     const gm::Footprint f = buf.huge.footprints[h];
-    const unsigned id = buf.huge.ids[h];
+    const unsigned record = buf.huge.records[h];
     const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
     const unsigned box_w = static_cast<unsigned>(f.tile_x1 - f.tile_x0);
     const unsigned box = box_w * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
@@ -588,7 +605,7 @@ __global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm:
           if (ballot & (1u << lane)) {
             const unsigned t = s0 + c * kWarp + lane;
             store_pair(buf, segment_base + chunk_offsets[c] + __popc(ballot & lanes_below),
-                       (f.tile_y0 + t / box_w) * cam.tiles_x + f.tile_x0 + t % box_w, depth_bits, id);
+                       (f.tile_y0 + t / box_w) * cam.tiles_x + f.tile_x0 + t % box_w, depth_bits, record);
           }
         }
       }

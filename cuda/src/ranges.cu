@@ -1,7 +1,7 @@
 // Stage `ranges`: each tile's [start, end) in the sorted pairs, the blend's tile order (fullest
 // first), and runs of equal keys put in (depth, Gaussian id) order, so the blend order is
-// exactly the CPU's whatever the key format: equal 64-bit keys share their depth (the atomics of emission shuffled their ids), equal
-// compact keys share a quantised depth bin.
+// exactly the CPU's whatever the key format: equal 64-bit keys share their depth (the atomics
+// of emission shuffled their records), equal compact keys share a quantised depth bin.
 #include "device_common.cuh"
 #include "pipeline.h"
 
@@ -11,30 +11,37 @@ namespace {
 
 constexpr int kBlock = 256;
 
+// The blend records and which Gaussian each one is (ids null: record r is Gaussian r).
+struct Records {
+  const BlendGaussian* gaussians;
+  const std::uint32_t* ids;
+};
+
 // The blend order of a pair: its Gaussian's exact depth bits, then its id.
-__device__ __forceinline__ std::uint64_t blend_order(const BlendGaussian* gaussians, std::uint32_t id) {
-  return (static_cast<std::uint64_t>(__float_as_uint(gaussians[id].depth)) << 32) | id;
+__device__ __forceinline__ std::uint64_t blend_order(const Records& r, std::uint32_t record) {
+  const std::uint32_t id = r.ids ? r.ids[record] : record;
+  return (static_cast<std::uint64_t>(__float_as_uint(r.gaussians[record].depth)) << 32) | id;
 }
 
-// Sorts a run of ids in place by blend_order: insertion sort for the usual run of 2-3, heap
-// sort for the long runs of a planar scene seen head-on, where insertion would be quadratic.
-__device__ void sort_run(std::uint32_t* v, unsigned n, const BlendGaussian* gaussians) {
+// Sorts a run of records in place by blend_order: insertion sort for the usual run of 2-3,
+// heap sort for the long runs of a planar scene seen head-on, where insertion would be quadratic.
+__device__ void sort_run(std::uint32_t* v, unsigned n, const Records& records) {
   if (n <= 16) {
     for (unsigned a = 1; a < n; ++a) {
       const std::uint32_t x = v[a];
-      const std::uint64_t key = blend_order(gaussians, x);
+      const std::uint64_t key = blend_order(records, x);
       unsigned b = a;
-      for (; b > 0 && blend_order(gaussians, v[b - 1]) > key; --b) v[b] = v[b - 1];
+      for (; b > 0 && blend_order(records, v[b - 1]) > key; --b) v[b] = v[b - 1];
       v[b] = x;
     }
     return;
   }
-  auto sift = [v, gaussians](unsigned root, unsigned size) {
+  auto sift = [v, records](unsigned root, unsigned size) {
     for (;;) {
       unsigned child = 2 * root + 1;
       if (child >= size) return;
-      if (child + 1 < size && blend_order(gaussians, v[child + 1]) > blend_order(gaussians, v[child])) ++child;
-      if (blend_order(gaussians, v[root]) >= blend_order(gaussians, v[child])) return;
+      if (child + 1 < size && blend_order(records, v[child + 1]) > blend_order(records, v[child])) ++child;
+      if (blend_order(records, v[root]) >= blend_order(records, v[child])) return;
       const std::uint32_t t = v[root];
       v[root] = v[child];
       v[child] = t;
@@ -54,8 +61,7 @@ __device__ void sort_run(std::uint32_t* v, unsigned n, const BlendGaussian* gaus
 template <typename KEY>
 __global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, const KEY* __restrict__ keys,
                                                         int tile_shift, std::uint32_t* __restrict__ values,
-                                                        const BlendGaussian* __restrict__ gaussians,
-                                                        uint2* tile_ranges) {
+                                                        Records records, uint2* tile_ranges) {
   const std::uint64_t i = static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x;
   if (i >= pairs) return;
   const KEY key = keys[i];
@@ -68,7 +74,7 @@ __global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, con
   if (run_start && i + 1 < pairs && keys[i + 1] == key) {
     std::uint64_t end = i + 2;
     while (end < pairs && keys[end] == key) ++end;
-    sort_run(values + i, static_cast<unsigned>(end - i), gaussians);
+    sort_run(values + i, static_cast<unsigned>(end - i), records);
   }
 }
 
@@ -140,13 +146,12 @@ void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers&
   check_cuda(cudaMemsetAsync(b.tile_ranges, 0, tiles * sizeof(uint2), stream), "tile range reset");
   if (pairs == 0) return;
   const unsigned blocks = static_cast<unsigned>((pairs + kBlock - 1) / kBlock);
+  const Records records{b.blend, b.record_ids};
   if (b.key_format.depth_bits > 0)
     ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, reinterpret_cast<const std::uint32_t*>(b.keys[which]),
-                                                 b.key_format.depth_bits, b.values[which], b.blend,
-                                                 b.tile_ranges);
+                                                 b.key_format.depth_bits, b.values[which], records, b.tile_ranges);
   else
-    ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, b.keys[which], 32, b.values[which], b.blend,
-                                                 b.tile_ranges);
+    ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, b.keys[which], 32, b.values[which], records, b.tile_ranges);
   check_cuda(cudaGetLastError(), "ranges kernel launch");
 }
 

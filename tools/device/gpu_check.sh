@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
-#   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-ab bench
+#   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-ab bench-env bench
 #                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
 #                                       profile-blend profile-sass
 #                                       build-bg wait-build
@@ -97,6 +97,17 @@ bench_ab() {  # flash against flash with one switch off (AB_CONFIG, default flas
   log "bench A/B 7 x pc_playbot"
   bench_scene "$SCENES/pc_playbot" bench_ab_tile7 --backend cuda --tile 7 -r 1920x1080,3840x2160 \
     --configs flash,${AB_CONFIG:-flash-no_dense_tiles_first} --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
+}
+
+bench_env() {  # flash without and with the environment of ENV_AB (e.g. FLASHGS_SORT_KEY_BITS=24), same run
+  for scene in pc_biker pc_playbot; do
+    log "bench env: $scene, default"
+    bench_scene "$SCENES/$scene" bench_env_a_$scene --backend cuda -r 1920x1080,3840x2160 --configs flash \
+      --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
+    log "bench env: $scene, $ENV_AB"
+    (export $ENV_AB; bench_scene "$SCENES/$scene" bench_env_b_$scene --backend cuda -r 1920x1080,3840x2160 \
+      --configs flash --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res")
+  done
 }
 
 bench_regions() {  # warp-blend region widths: WIDTHS (default 8 16)
@@ -214,6 +225,7 @@ for step in "$@"; do
     sanitize) sanitize ;;
     bench-quick) bench_quick ;;
     bench-ab) bench_ab ;;
+    bench-env) bench_env ;;
     bench) bench ;;
     bench-regions) bench_regions ;;
     bench-large) bench_large ;;
