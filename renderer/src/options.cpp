@@ -17,10 +17,11 @@ RenderOptions RenderOptions::baseline() {
 }
 
 std::string RenderOptions::label() const {
-  if (is_baseline()) return "baseline";
-  std::string label = "flash";
-  for (const RenderSwitch& s : kRenderSwitches)
-    if (!(this->*(s.member))) label += std::string("-no_") + s.label;
+  std::string label = is_baseline() ? "baseline" : "flash";
+  if (!is_baseline())
+    for (const RenderSwitch& s : kRenderSwitches)
+      if (!(this->*(s.member))) label += std::string("-no_") + s.label;
+  if (fp16_sh) label += "-fp16_sh";
   return label;
 }
 
@@ -36,6 +37,7 @@ bool operator==(const RenderOptions& a, const RenderOptions& b) {
   for (const RenderSwitch& s : kRenderSwitches)
     if (a.*(s.member) != b.*(s.member)) return false;
   return a.algorithm == b.algorithm && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
+         a.fp16_sh == b.fp16_sh &&
          a.collect_tile_counts == b.collect_tile_counts && std::equal(a.background, a.background + 3, b.background);
 }
 

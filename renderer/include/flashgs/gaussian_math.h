@@ -448,6 +448,54 @@ FLASHGS_HD void sh_to_rgb(const float camera_position[3], const float position[3
   }
 }
 
+// IEEE binary16 bits of v, rounded to nearest even, from integer operations only so that the
+// host and the device encode bit for bit alike. Magnitudes above the half range clamp to
+// +-65504 (the largest half) instead of becoming infinite; NaN never reaches here (the loaders
+// reject non-finite values).
+FLASHGS_HD std::uint16_t float_to_half_bits(float v) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, 4);
+  const std::uint32_t sign = (bits >> 16) & 0x8000u;
+  const std::uint32_t magnitude = bits & 0x7fffffffu;
+  if (magnitude >= 0x477fe000u) return static_cast<std::uint16_t>(sign | 0x7bffu);  // >= 65504
+  if (magnitude >= 0x38800000u) {  // a normal half (>= 2^-14): drop 13 mantissa bits, ties to even
+    const std::uint32_t rounded = magnitude + 0xfffu + ((magnitude >> 13) & 1u);
+    return static_cast<std::uint16_t>(sign | ((rounded - 0x38000000u) >> 13));
+  }
+  // A half subnormal, m * 2^-24: the float's 24-bit significand shifted right, ties to even
+  // (a carry into bit 10 is the smallest normal half, as the encoding wants).
+  const std::uint32_t exponent = magnitude >> 23;
+  const std::uint32_t shift = 126u - exponent;  // 14 at 2^-15, 24 at 2^-25
+  if (exponent == 0u || shift > 24u) return static_cast<std::uint16_t>(sign);  // below half of 2^-24
+  const std::uint32_t significand = (magnitude & 0x7fffffu) | 0x800000u;
+  std::uint32_t q = significand >> shift;
+  const std::uint32_t rest = significand & ((1u << shift) - 1u), tie = 1u << (shift - 1u);
+  if (rest > tie || (rest == tie && (q & 1u))) ++q;
+  return static_cast<std::uint16_t>(sign | q);
+}
+
+// The float a binary16 value stands for (exact: every half is a float).
+FLASHGS_HD float half_bits_to_float(std::uint16_t h) {
+  const std::uint32_t sign = static_cast<std::uint32_t>(h & 0x8000u) << 16;
+  const std::uint32_t exponent = (h >> 10) & 0x1fu, mantissa = h & 0x3ffu;
+  std::uint32_t bits;
+  if (exponent == 0u) {
+    float magnitude = static_cast<float>(mantissa) * 5.9604644775390625e-8f;  // m * 2^-24, exact
+    std::memcpy(&bits, &magnitude, 4);
+    bits |= sign;
+  } else if (exponent == 31u) {
+    bits = sign | 0x7f800000u | (mantissa << 13);
+  } else {
+    bits = sign | ((exponent + 112u) << 23) | (mantissa << 13);
+  }
+  float out;
+  std::memcpy(&out, &bits, 4);
+  return out;
+}
+
+// v as the nearest half value (RenderOptions::fp16_sh), as a float.
+FLASHGS_HD float round_to_half(float v) { return half_bits_to_float(float_to_half_bits(v)); }
+
 // Sort key part for a depth: positive floats order like their bit patterns.
 FLASHGS_HD std::uint32_t depth_bits(float depth) {
   std::uint32_t bits;

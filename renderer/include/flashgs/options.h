@@ -34,6 +34,10 @@ struct RenderOptions {
   float tau = kDefaultTau;    // alpha below which a Gaussian contributes nothing
   float background[3] = {0.0f, 0.0f, 0.0f};
   int sh_degree_cap = 3;      // use at most this many SH bands (0..3)
+  // A precision option, not an exact switch: the scene's SH coefficients (DC and higher bands)
+  // are used as IEEE half values (gm::round_to_half), so that the CUDA backend can keep them in
+  // half the bytes. Off by default; `flashgs report` shows its error against the fp64 reference.
+  bool fp16_sh = false;
   bool collect_tile_counts = false;  // fill FrameStats::tile_pair_counts
 
   // The options of the original 3DGS rasterizer (every switch off).

@@ -37,6 +37,7 @@ struct FrameStats {
   StageTimes times;
   std::uint64_t device_memory_bytes = 0;  // backend working memory now (GPU; 0 on CPU)
   std::uint64_t device_peak_bytes = 0;    // high-water mark of the above
+  std::uint64_t scene_device_bytes = 0;   // the scene as the backend holds it (GPU; 0 on CPU)
   // The render stopped early on Renderer::set_cancel_flag's flag: the image is incomplete.
   bool cancelled = false;
 };
