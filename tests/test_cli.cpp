@@ -8,9 +8,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -217,6 +219,51 @@ TEST(CliBench, TiledSceneIsBenchedAndTooManyCopiesAreRefused) {
   const CliResult huge = run_cli("bench --tile 4096" + quick + dir + "/c.json", std::size_t{1} << 30);
   expect_one_line_error(huge, "--tile: 4096 copies need", "4096 copies");
   EXPECT_FALSE(fs::exists(dir + "/c.json"));
+}
+
+// fp16_sh in the sweeps: `report` has its row (group "precision", column fp16_sh set, an
+// error against the fp64 reference) beside flash's, and `bench` its row.
+std::vector<std::vector<std::string>> read_csv(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+TEST(CliReport, Fp16ShIsSweptWithItsErrorAgainstTheReference) {
+  const std::string dir = scratch_dir("report_fp16");
+  const CliResult r = run_cli("report --backend cpu -r 64x36 --camera-list 0 --repeat 1 --ref-window 16 -o " + dir);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto rows = read_csv(dir + "/report.csv");
+  ASSERT_GT(rows.size(), 2u);
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(rows[0].begin(), rows[0].end(), name);
+    EXPECT_NE(it, rows[0].end()) << "no column " << name;
+    return static_cast<std::size_t>(it - rows[0].begin());
+  };
+  const std::size_t config = column("config"), group = column("group"), fp16 = column("fp16_sh"),
+                    psnr = column("psnr_vs_fp64_db");
+  std::map<std::string, std::vector<std::string>> by_name;
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    if (rows[i].size() == rows[0].size()) by_name[rows[i][config]] = rows[i];
+  ASSERT_TRUE(by_name.count("fp16-sh")) << r.output;
+  ASSERT_TRUE(by_name.count("flash"));
+  EXPECT_EQ(by_name["fp16-sh"][group], "precision");
+  EXPECT_EQ(by_name["fp16-sh"][fp16], "1");
+  EXPECT_EQ(by_name["flash"][fp16], "0");
+  const double fp16_psnr = std::strtod(by_name["fp16-sh"][psnr].c_str(), nullptr);
+  EXPECT_GT(fp16_psnr, 40.0) << by_name["fp16-sh"][psnr];
+  EXPECT_NE(by_name["fp16-sh"][psnr], by_name["flash"][psnr]) << "fp16_sh must change the image";
+
+  const CliResult bench = run_cli("bench --backend cpu -r 32x18 --camera-list 0 --warmup 0 --repeat 1 --configs "
+                                  "flash-fp16_sh --json " + dir + "/b.json");
+  ASSERT_EQ(bench.exit_code, 0) << bench.output;
+  EXPECT_NE(bench.output.find("\n32x18      flash-fp16_sh "), std::string::npos) << bench.output;
 }
 
 TEST(CliGenerate, RefusesToOverwriteAScene) {

@@ -516,5 +516,44 @@ TEST(CudaEdgeCases, SceneTooLargeIsAnError) {
   EXPECT_GT(r.stats.kv_pairs, 0u);
 }
 
+// RenderOptions::fp16_sh: the GPU stores the higher SH bands as halves (8 bytes per 4
+// coefficients instead of 16) and evaluates the same half values as the CPU, so CUDA fp16
+// matches CPU fp16 within the usual bound; switching the option on one renderer re-packs the
+// scene, and fp32 -> fp16 -> fp32 gives the bytes of fresh renderers.
+void check_fp16_sh(const std::string& name, std::shared_ptr<const Scene> scene, const Camera& camera) {
+  RenderOptions fp16;
+  fp16.fp16_sh = true;
+  auto cpu = make_cpu_renderer();
+  cpu->set_scene(scene);
+  auto toggled = make_cuda_renderer();
+  toggled->set_scene(scene);
+  const Result fp32_first = render(*toggled, camera, RenderOptions{});
+  const Result half = render(*toggled, camera, fp16);
+  const Result fp32_again = render(*toggled, camera, RenderOptions{});
+  expect_match(name + " " + fp16.label(), render(*cpu, camera, fp16), half);
+  EXPECT_GT(compare_images(fp32_first.image, half.image).max_abs, 0.0) << name << ": fp16_sh changed nothing";
+  auto fresh = [&](const RenderOptions& o) {
+    auto gpu = make_cuda_renderer();
+    gpu->set_scene(scene);
+    return render(*gpu, camera, o);
+  };
+  EXPECT_EQ(fp32_first.image.rgb, fresh(RenderOptions{}).image.rgb) << name;
+  EXPECT_EQ(fp32_again.image.rgb, fp32_first.image.rgb) << name << ": fp32 after fp16";
+  EXPECT_EQ(half.image.rgb, fresh(fp16).image.rgb) << name;
+  // The higher bands in half the bytes, the rest of the scene unchanged.
+  const std::uint64_t groups_of_4 = (static_cast<std::uint64_t>(scene->sh_rest_per_gaussian()) + 3) / 4;
+  EXPECT_EQ(fp32_first.stats.scene_device_bytes - half.stats.scene_device_bytes, scene->size() * groups_of_4 * 8)
+      << name << ": fp32 " << fp32_first.stats.scene_device_bytes << " B, fp16 " << half.stats.scene_device_bytes
+      << " B";
+  EXPECT_EQ(fp32_again.stats.scene_device_bytes, fp32_first.stats.scene_device_bytes) << name;
+}
+
+TEST(CudaFp16Sh, MatchesTheCpuAndTogglesLikeFreshRenderers) {
+  FLASHGS_REQUIRE_CUDA();
+  check_fp16_sh("demo", test::load_demo_scene(), test::load_demo_cameras()[5].resized(1001, 563));
+  for (const std::string& name : test::shared_scene_names())
+    check_fp16_sh(name, test::load_shared_scene(name), test::load_shared_cameras(name)[0]);
+}
+
 }  // namespace
 }  // namespace flashgs

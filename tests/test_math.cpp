@@ -2,8 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <random>
+#include <vector>
 
 #include "flashgs/frame_params.h"
 #include "flashgs/gaussian_math.h"
@@ -211,6 +214,80 @@ TEST(SphericalHarmonics, BandOneFollowsTheViewDirection) {
   gm::sh_to_rgb<1>(cam, against_x, dc, rest, b);
   EXPECT_NEAR(a[0], std::max(0.0f, 0.5f - gm::kShC1), 1e-6);
   EXPECT_NEAR(b[0], 0.5f + gm::kShC1, 1e-6);
+}
+
+std::uint32_t float_bits(float v) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, 4);
+  return bits;
+}
+
+float float_from_bits(std::uint32_t bits) {
+  float v;
+  std::memcpy(&v, &bits, 4);
+  return v;
+}
+
+// GCC's conversion to _Float16 (round to nearest even, in hardware or libgcc), as bits.
+std::uint16_t gcc_half_bits(float v) {
+  const _Float16 h = static_cast<_Float16>(v);
+  std::uint16_t bits;
+  std::memcpy(&bits, &h, 2);
+  return bits;
+}
+
+// The values where a rounding goes wrong first: every half and the midpoints between
+// neighbours (ties, to even) with a float ulp either side, subnormals and the smallest values
+// included, and random floats of every exponent up to the half range, both signs.
+std::vector<float> half_rounding_cases() {
+  std::vector<float> cases;
+  cases.insert(cases.end(), {65504.0f, -65504.0f});
+  for (std::uint32_t h = 0; h < 0x7bffu; ++h) {  // up to the largest half, whose next is Inf
+    const float v = gm::half_bits_to_float(static_cast<std::uint16_t>(h));
+    const float next = gm::half_bits_to_float(static_cast<std::uint16_t>(h + 1));
+    const float tie = v + 0.5f * (next - v);  // exact: a float has 13 more mantissa bits
+    for (float c : {v, tie, std::nextafter(tie, 0.0f), std::nextafter(tie, 1e9f)}) {
+      cases.push_back(c);
+      cases.push_back(-c);
+    }
+  }
+  for (float tiny : {1e-45f, 1e-40f, 2.9802322e-8f, 2.9802326e-8f, 3e-8f, 5.9604645e-8f, 6.1035156e-5f})
+    cases.insert(cases.end(), {tiny, -tiny});
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<std::uint32_t> bits(0, 0x477fefffu);  // below 65520, where halves end
+  for (int i = 0; i < 1000000; ++i) cases.push_back(float_from_bits(bits(rng) | (i % 2 ? 0x80000000u : 0u)));
+  return cases;
+}
+
+TEST(HalfRounding, MatchesGccFloat16BitForBit) {
+  int mismatches = 0;
+  for (float v : half_rounding_cases()) {
+    const std::uint16_t ours = gm::float_to_half_bits(v), gcc = gcc_half_bits(v);
+    if (ours != gcc && ++mismatches <= 10)
+      ADD_FAILURE() << std::hexfloat << v << ": 0x" << std::hex << ours << ", GCC 0x" << gcc;
+  }
+  EXPECT_EQ(mismatches, 0);
+}
+
+TEST(HalfRounding, EveryHalfConvertsBackExactly) {
+  for (std::uint32_t h = 0; h < 0x10000u; ++h) {
+    if (((h >> 10) & 0x1fu) == 0x1fu) continue;  // Inf and NaN: never encoded
+    const std::uint16_t half = static_cast<std::uint16_t>(h);
+    _Float16 gcc;
+    std::memcpy(&gcc, &half, 2);
+    ASSERT_EQ(float_bits(gm::half_bits_to_float(half)), float_bits(static_cast<float>(gcc))) << std::hex << h;
+    ASSERT_EQ(gm::float_to_half_bits(gm::half_bits_to_float(half)), half) << std::hex << h;
+  }
+}
+
+// Beyond the half range the value clamps to the largest half instead of becoming infinite.
+TEST(HalfRounding, ValuesBeyondTheRangeClampTo65504) {
+  for (float v : {65504.0f, 65519.996f, 65520.0f, 1e6f, 3.4e38f}) {
+    EXPECT_EQ(gm::round_to_half(v), 65504.0f) << v;
+    EXPECT_EQ(gm::round_to_half(-v), -65504.0f) << v;
+  }
+  EXPECT_EQ(gm::round_to_half(65503.0f), 65504.0f);
+  EXPECT_EQ(gm::round_to_half(65487.0f), 65472.0f);  // below the midpoint 65488 of the last two halves
 }
 
 }  // namespace

@@ -18,7 +18,7 @@ namespace flashgs {
 
 // What a failed EXPECT_EQ on two option sets prints.
 void PrintTo(const RenderOptions& o, std::ostream* out) {
-  *out << o.label() << " (tau " << o.tau << ", SH cap " << o.sh_degree_cap << ")";
+  *out << o.label() << " (tau " << o.tau << ", SH cap " << o.sh_degree_cap << (o.fp16_sh ? ", fp16 SH" : "") << ")";
 }
 
 namespace {
@@ -102,6 +102,9 @@ TEST(OptionsTable, EqualitySeesTheFieldsBesideTheSwitches) {
   EXPECT_NE(o, flash);
   o = flash;
   o.collect_tile_counts = true;
+  EXPECT_NE(o, flash);
+  o = flash;
+  o.fp16_sh = true;
   EXPECT_NE(o, flash);
   o = flash;
   o.algorithm = Algorithm::baseline;
@@ -189,6 +192,35 @@ TEST(ReportSweep, EverySwitchIsSweptAloneAndLeftOut) {
       EXPECT_EQ(alone->options.*(other.member), other.backends != s.backends) << s.label << " / " << other.label;
     }
   }
+}
+
+// fp16_sh is a precision option, not a switch: off by default and for the baseline, seen by
+// both backends, named in the label, and swept by the report in a group of its own.
+TEST(OptionsTable, Fp16ShIsOffByDefaultAndNamedInTheLabel) {
+  EXPECT_FALSE(RenderOptions{}.fp16_sh);
+  EXPECT_FALSE(RenderOptions::baseline().fp16_sh);
+  RenderOptions o;
+  o.fp16_sh = true;
+  EXPECT_EQ(o.label(), "flash-fp16_sh");
+  for (Backend b : {Backend::cpu, Backend::cuda}) EXPECT_TRUE(o.seen_by(b).fp16_sh) << backend_name(b);
+  RenderOptions b = RenderOptions::baseline();
+  b.fp16_sh = true;
+  EXPECT_EQ(b.label(), "baseline-fp16_sh");
+}
+
+TEST(ReportSweep, Fp16ShIsSweptOnEveryBackend) {
+  int swept = 0;
+  for (const cli::SweepConfig& c : cli::sweep_configs()) {
+    if (!c.options.fp16_sh) continue;
+    ++swept;
+    EXPECT_EQ(c.name, "fp16-sh");
+    EXPECT_EQ(c.group, "precision");
+    EXPECT_FALSE(c.gpu_only);
+    RenderOptions expected;
+    expected.fp16_sh = true;
+    EXPECT_EQ(c.options, expected);
+  }
+  EXPECT_EQ(swept, 1);
 }
 
 }  // namespace

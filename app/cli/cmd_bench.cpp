@@ -43,10 +43,14 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The configurations by name (their labels): baseline, flash, and flash with one switch off.
+// The configurations by name (their labels): baseline, flash, flash with one switch off, and
+// flash with the SH as halves (fp16_sh, the one precision option that changes the scene's bytes).
 std::vector<std::pair<std::string, RenderOptions>> known_configs() {
   std::vector<std::pair<std::string, RenderOptions>> out;
   for (const RenderOptions& o : single_switch_configs()) out.emplace_back(o.label(), o);
+  RenderOptions fp16;
+  fp16.fp16_sh = true;
+  out.emplace_back(fp16.label(), fp16);
   return out;
 }
 
@@ -100,6 +104,7 @@ struct ConfigRun {
   std::vector<double> stage[6];  // per camera
   std::vector<double> kv, visible, psnr, max_abs;
   std::uint64_t memory_max = 0, peak_max = 0;
+  std::uint64_t scene_device_bytes = 0;  // the scene as the backend holds it (0 on the CPU)
   double upload_ms = 0, first_frame_ms = -1;  // wall clock: set_scene, and the first render
   nlohmann::json per_camera = nlohmann::json::array();
 };
@@ -202,6 +207,7 @@ void run(const BenchArgs& args) {
         r.visible.push_back(static_cast<double>(stats.visible));
         r.memory_max = std::max<std::uint64_t>(r.memory_max, stats.device_memory_bytes);
         r.peak_max = std::max<std::uint64_t>(r.peak_max, stats.device_peak_bytes);
+        r.scene_device_bytes = stats.scene_device_bytes;
         cam["kv_pairs"] = stats.kv_pairs;
         cam["visible"] = stats.visible;
         cam["culled"] = {{"near", stats.culled_near},
@@ -229,12 +235,14 @@ void run(const BenchArgs& args) {
         j["ms"][kStages[s]] = {{"median", median(r.stage[s])}, {"p95", percentile(r.stage[s], kTailPercentile)}};
       j["kv_pairs"] = {{"median", median(r.kv)}, {"max", *std::max_element(r.kv.begin(), r.kv.end())}};
       j["visible_median"] = median(r.visible);
-      j["memory_bytes"] = {{"working_max", r.memory_max}, {"peak", r.peak_max}};
+      j["memory_bytes"] = {{"working_max", r.memory_max}, {"peak", r.peak_max}, {"scene_device", r.scene_device_bytes}};
       j["upload_ms"] = r.upload_ms;
       j["first_frame_ms"] = r.first_frame_ms;
-      char upload_line[256];
-      std::snprintf(upload_line, sizeof upload_line, "%-10s %-28s scene upload %.1f ms, first frame %.1f ms (wall clock)\n",
-                    resolution.c_str(), r.name.c_str(), r.upload_ms, r.first_frame_ms);
+      char upload_line[320];
+      const std::string scene_bytes =
+          r.scene_device_bytes ? ", scene on the device " + format_bytes(r.scene_device_bytes) : std::string();
+      std::snprintf(upload_line, sizeof upload_line, "%-10s %-28s scene upload %.1f ms, first frame %.1f ms (wall clock)%s\n",
+                    resolution.c_str(), r.name.c_str(), r.upload_ms, r.first_frame_ms, scene_bytes.c_str());
       uploads += upload_line;
       const double psnr_min = *std::min_element(r.psnr.begin(), r.psnr.end());
       j["psnr_db_vs_baseline"] = {{"min", finite_or_null(psnr_min)}, {"median", finite_or_null(median(r.psnr))}};

@@ -40,6 +40,10 @@ std::vector<SweepConfig> sweep_configs() {
     o.tau = 1.0f / static_cast<float>(denominator);
     out.push_back({"tau=1/" + std::to_string(denominator), "tau", o, false});
   }
+  // Not exact: the SH coefficients as halves (fewer scene bytes on the GPU).
+  RenderOptions fp16;
+  fp16.fp16_sh = true;
+  out.push_back({"fp16-sh", "precision", fp16, false});
   add_group(gpu_only, "gpu-only-", "gpu alone", "gpu left out", true);
   return out;
 }

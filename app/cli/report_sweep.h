@@ -16,13 +16,14 @@ namespace flashgs::cli {
 
 struct SweepConfig {
   std::string name;   // e.g. "flash", "only-tight_bbox", "no-exact_tile_test", "tau=1/32"
-  std::string group;  // baseline | flash | alone | left out | tau | gpu alone | gpu left out
+  std::string group;  // baseline | flash | alone | left out | tau | precision | gpu alone | gpu left out
   RenderOptions options;
   bool gpu_only = false;  // a scheduling switch the CPU backend ignores: measured on CUDA only
 };
 
 // baseline; flash (everything on, default tau); each switch every backend honours alone and
-// each left out; tau = 1/128 ... 1/16; and each GPU-only switch alone and left out.
+// each left out; tau = 1/128 ... 1/16; the SH as halves (fp16_sh); and each GPU-only switch
+// alone and left out.
 std::vector<SweepConfig> sweep_configs();
 
 // Error of a set of images against another, pooled over cameras / windows.

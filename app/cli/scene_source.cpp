@@ -106,6 +106,7 @@ void RenderArgs::add_to(CLI::App* command) {
   command->add_option("--background", background, "background colour r,g,b in [0, 1]")
       ->delimiter(',')->expected(3)->check(finite_in(0.0, 1.0));
   command->add_option("--sh-degree", sh_degree, "use at most this many SH bands")->check(CLI::Range(0, 3));
+  command->add_flag("--fp16-sh", fp16_sh, "use the SH coefficients as half values (not exact; see flashgs report)");
   command->add_option("--backend", backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
 }
 
@@ -115,6 +116,7 @@ RenderOptions RenderArgs::options() const {
   o.tau = tau;
   for (int k = 0; k < 3; ++k) o.background[k] = background[k];
   o.sh_degree_cap = sh_degree;
+  o.fp16_sh = fp16_sh;
   return o;
 }
 

@@ -46,6 +46,7 @@ struct RenderArgs {
   float tau = kDefaultTau;
   std::vector<float> background = {0, 0, 0};
   int sh_degree = 3;
+  bool fp16_sh = false;
   std::string backend = "auto";
   void add_to(CLI::App* command);
   RenderOptions options() const;

@@ -74,6 +74,7 @@ bool apply_line(const std::string& key, const std::string& value, StoredSettings
     o.sh_degree_cap = int(v);
     return true;
   }
+  if (key == "fp16_sh") return parse_bool(value, &o.fp16_sh);
   if (key == "background") {
     std::stringstream ss(value);
     std::string part;
@@ -150,6 +151,7 @@ std::string write_settings_file(const std::string& path, const StoredSettings& s
   for (const RenderSwitch& sw : kRenderSwitches) out << "switch." << sw.cli_name << " = " << (o.*(sw.member) ? 1 : 0) << "\n";
   out << "tau = " << o.tau << "\n";
   out << "sh_degree_cap = " << o.sh_degree_cap << "\n";
+  out << "fp16_sh = " << o.fp16_sh << "\n";
   out << "background = " << o.background[0] << "," << o.background[1] << "," << o.background[2] << "\n";
   out << "navigation = " << (s.mode == NavigationMode::fly ? "fly" : "orbit") << "\n";
   out << "render_scale = " << s.render_scale << "\n";

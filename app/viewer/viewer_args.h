@@ -25,6 +25,7 @@ struct ViewerArgs {
   std::string algorithm = "flash";
   float tau = kDefaultTau;
   int sh_degree = 3;
+  bool fp16_sh = false;          // the SH coefficients as half values (RenderOptions::fp16_sh)
   std::vector<float> background = {0, 0, 0};
   bool heatmap = false;
   bool orbit = false;            // start in orbit mode

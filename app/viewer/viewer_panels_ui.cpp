@@ -294,6 +294,9 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
                          kClamp | ImGuiSliderFlags_Logarithmic))
     o.tau = 1.0f / inv_tau;
   ImGui::SliderInt("SH degree cap", &o.sh_degree_cap, 0, kMaxShDegree, "%d", kClamp);
+  ImGui::Checkbox("fp16 SH", &o.fp16_sh);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("the SH coefficients as half values: half the GPU bytes of the SH bands, not exact");
   ImGui::ColorEdit3("Background", o.background, ImGuiColorEditFlags_NoInputs);
   ImGui::SameLine();
   ImGui::Checkbox("Every frame", &s.continuous);

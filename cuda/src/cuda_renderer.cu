@@ -217,14 +217,25 @@ class CudaRendererImpl final : public CudaRenderer {
   std::string name() const override { return "cuda (" + device_name_ + ")"; }
   void* stream() const override { return stream_; }
 
+  // Uploaded in the SH precision of the last frame, so that a viewer in fp16 mode loads a
+  // new scene once.
   void set_scene(std::shared_ptr<const Scene> scene) override {
     if (!scene) throw Error("cuda renderer: null scene");
+    upload_scene(std::move(scene), device_scene_.sh_half);
+  }
+
+  // The scene on the device in the layout of DeviceScene, its SH as floats or (`sh_half`,
+  // RenderOptions::fp16_sh) as halves.
+  void upload_scene(std::shared_ptr<const Scene> scene, bool sh_half) {
     const std::size_t n = scene->size();
     if (n >= (std::size_t{1} << 32) - 1)
       throw Error("cuda renderer: " + std::to_string(n) + " Gaussians exceed the 32-bit Gaussian index");
     const int degree = scene->sh_degree;
     const int rest_floats = scene->sh_rest_per_gaussian();
     const int stride_vec4 = (rest_floats + 3) / 4;
+    const std::size_t rest_group_bytes = sh_half ? sizeof(uint2) : sizeof(float4);  // 4 coefficients
+    // Under fp16_sh the DC keeps its float slots but holds the half values.
+    const auto dc = [&](std::size_t k) { return sh_half ? gm::round_to_half(scene->sh_dc[k]) : scene->sh_dc[k]; };
 
     // Allocate the new scene next to the old one; on failure the old one stays.
     DeviceBuffer new_pos, new_rot, new_scale, new_dc, new_rest, new_chunks;
@@ -234,7 +245,7 @@ class CudaRendererImpl final : public CudaRenderer {
     new_rot.reserve(m * sizeof(float4), "scene rotations");
     new_scale.reserve(m * sizeof(float4), "scene scales");
     new_dc.reserve(m * sizeof(float2), "scene colours");
-    if (stride_vec4 > 0) new_rest.reserve(n * stride_vec4 * sizeof(float4), "scene SH bands");
+    if (stride_vec4 > 0) new_rest.reserve(n * stride_vec4 * rest_group_bytes, "scene SH bands");
     new_chunks.reserve(std::max<std::size_t>(chunks, 1) * sizeof(cuda::ChunkBound), "scene chunk bounds");
 
     // Packed into the device layout chunk by chunk (no host copy of the whole scene).
@@ -251,25 +262,33 @@ class CudaRendererImpl final : public CudaRenderer {
     });
     uploader.upload(new_scale.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
       const float* sv = &sc.scales[i * 3];
-      *static_cast<float4*>(dst) = make_float4(sv[0], sv[1], sv[2], sc.sh_dc[i * 3]);
+      *static_cast<float4*>(dst) = make_float4(sv[0], sv[1], sv[2], dc(i * 3));
     });
     uploader.upload(new_dc.as<void>(), sizeof(float2), n, [&](std::size_t i, void* dst) {
-      *static_cast<float2*>(dst) = make_float2(sc.sh_dc[i * 3 + 1], sc.sh_dc[i * 3 + 2]);
+      *static_cast<float2*>(dst) = make_float2(dc(i * 3 + 1), dc(i * 3 + 2));
     });
     if (stride_vec4 > 0)
-      uploader.upload(new_rest.as<void>(), stride_vec4 * sizeof(float4), n, [&](std::size_t i, void* dst) {
-        std::memset(dst, 0, sizeof(float4) * stride_vec4);
-        std::memcpy(dst, &sc.sh_rest[i * rest_floats], sizeof(float) * rest_floats);
+      uploader.upload(new_rest.as<void>(), stride_vec4 * rest_group_bytes, n, [&](std::size_t i, void* dst) {
+        std::memset(dst, 0, rest_group_bytes * stride_vec4);
+        const float* rest = &sc.sh_rest[i * rest_floats];
+        if (!sh_half) {
+          std::memcpy(dst, rest, sizeof(float) * rest_floats);
+          return;
+        }
+        std::uint16_t* halves = static_cast<std::uint16_t*>(dst);
+        for (int k = 0; k < rest_floats; ++k) halves[k] = gm::float_to_half_bits(rest[k]);
       });
     cuda::DeviceScene next;
     next.count = n;
     next.sh_degree = degree;
     next.rest_stride_vec4 = stride_vec4;
+    next.sh_half = sh_half;
     next.position_opacity = new_pos.as<float4>();
     next.rotation = new_rot.as<float4>();
     next.scale_dc_r = new_scale.as<float4>();
     next.dc_gb = new_dc.as<float2>();
-    next.sh_rest = new_rest.as<float4>();
+    next.sh_rest = sh_half ? nullptr : new_rest.as<float4>();
+    next.sh_rest_half = sh_half ? new_rest.as<uint2>() : nullptr;
     next.chunks = new_chunks.as<cuda::ChunkBound>();
     cuda::launch_chunk_bounds(next, next.chunks, stream_);
     uploader.finish();
@@ -482,6 +501,8 @@ class CudaRendererImpl final : public CudaRenderer {
   void run_frame(const Camera& camera, const RenderOptions& options, Image* out, std::uint64_t surface,
                  FrameStats* stats_out) {
     if (!scene_) throw Error("cuda renderer: no scene set");
+    // A frame in the other SH precision re-packs the scene from its host copy first.
+    if (options.fp16_sh != device_scene_.sh_half) upload_scene(scene_, options.fp16_sh);
     if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
     if (surface) check_surface(surface, camera);
     const gm::CameraParams cam = make_camera_params(camera);
@@ -669,6 +690,8 @@ class CudaRendererImpl final : public CudaRenderer {
     }
     stats.device_memory_bytes = working_bytes_;
     stats.device_peak_bytes = peak_bytes_;
+    stats.scene_device_bytes = scene_pos_.bytes() + scene_rot_.bytes() + scene_scale_.bytes() + scene_dc_.bytes() +
+                               scene_rest_.bytes() + scene_chunks_.bytes();
     if (options.collect_tile_counts) download_tile_counts(stats.tile_pair_counts);
     *stats_out = std::move(stats);
   }

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include <cuda_fp16.h>
+
 #include <cub/block/block_scan.cuh>
 
 #include "chunk_cull.cuh"
@@ -32,14 +34,26 @@ __device__ __forceinline__ void colour(const DeviceScene& scene, unsigned i, con
     constexpr int kRest = ((DEGREE + 1) * (DEGREE + 1) - 1) * 3;
     constexpr int kVec = (kRest + 3) / 4;
     float rest[kVec * 4];
-    const float4* src = scene.sh_rest + static_cast<std::size_t>(i) * scene.rest_stride_vec4;
+    const std::size_t first = static_cast<std::size_t>(i) * scene.rest_stride_vec4;
+    if (scene.sh_half) {
+      // fp16_sh: half the bytes; the conversion to float is exact, so the sum below is the CPU's.
 #pragma unroll
-    for (int k = 0; k < kVec; ++k) {
-      const float4 v = __ldg(src + k);
-      rest[4 * k + 0] = v.x;
-      rest[4 * k + 1] = v.y;
-      rest[4 * k + 2] = v.z;
-      rest[4 * k + 3] = v.w;
+      for (int k = 0; k < kVec; ++k) {
+        const uint2 v = __ldg(scene.sh_rest_half + first + k);
+        rest[4 * k + 0] = __half2float(__ushort_as_half(static_cast<unsigned short>(v.x & 0xffffu)));
+        rest[4 * k + 1] = __half2float(__ushort_as_half(static_cast<unsigned short>(v.x >> 16)));
+        rest[4 * k + 2] = __half2float(__ushort_as_half(static_cast<unsigned short>(v.y & 0xffffu)));
+        rest[4 * k + 3] = __half2float(__ushort_as_half(static_cast<unsigned short>(v.y >> 16)));
+      }
+    } else {
+#pragma unroll
+      for (int k = 0; k < kVec; ++k) {
+        const float4 v = __ldg(scene.sh_rest + first + k);
+        rest[4 * k + 0] = v.x;
+        rest[4 * k + 1] = v.y;
+        rest[4 * k + 2] = v.z;
+        rest[4 * k + 3] = v.w;
+      }
     }
     gm::sh_to_rgb<DEGREE>(cam.position, pos, dc, rest, rgb);
   }
