@@ -49,6 +49,10 @@ struct Frame {
   std::vector<gm::Footprint> footprints;   // [gaussians]
   std::vector<std::uint8_t> cull;          // [gaussians] gm::CullReason
   std::vector<BlendGaussian> blend_data;   // [gaussians]
+  // RenderOptions::fp16_sh: the SH of scene `half_sh_of` rounded to halves, made by its first
+  // such frame (the renderer resets half_sh_of with the scene).
+  const Scene* half_sh_of = nullptr;
+  std::vector<float> half_sh_dc, half_sh_rest;
 
   // Emission: each thread's pairs (tile, key) for its static chunk of Gaussians, and its
   // per-tile histogram. key = depth bits << 32 | Gaussian id. Only the first emit_chunks

@@ -8,24 +8,11 @@ namespace flashgs {
 namespace cpu {
 namespace {
 
-// The SH coefficients of one Gaussian as half values (RenderOptions::fp16_sh): the CUDA
-// backend stores them so, and both evaluate the same floats.
+// `dc` and `rest`: the scene's SH coefficients, or their half values (RenderOptions::fp16_sh).
 template <int DEGREE>
-struct HalfColour {
-  static constexpr int kRest = ((DEGREE + 1) * (DEGREE + 1) - 1) * 3;
-  float dc[3];
-  float rest[kRest > 0 ? kRest : 1];
-  HalfColour(const float* dc_in, const float* rest_in) {
-    for (int k = 0; k < 3; ++k) dc[k] = gm::round_to_half(dc_in[k]);
-    for (int k = 0; k < kRest; ++k) rest[k] = gm::round_to_half(rest_in[k]);
-  }
-};
-
-template <int DEGREE>
-void project_all(const Scene& scene, bool fp16_sh, Frame& frame) {
+void project_all(const Scene& scene, const float* dc, const float* rest, Frame& frame) {
   const std::int64_t n = static_cast<std::int64_t>(scene.size());
   const int rest_n = scene.sh_rest_per_gaussian();
-  const float* rest = scene.sh_rest.data();
   ParallelErrors errors;
 #pragma omp parallel for schedule(static) num_threads(frame.threads)
   for (std::int64_t i = 0; i < n; ++i)
@@ -52,16 +39,26 @@ void project_all(const Scene& scene, bool fp16_sh, Frame& frame) {
       g.row_slope = static_cast<float>(-(w0 * w1 + w2 * w3) / conic_a);
       g.inv_conic_a = static_cast<float>(1.0 / conic_a);
       g.q_cut = -2.0f * power_cut;  // exact: power_cut = -0.5 q_cut
-      const float* dc = &scene.sh_dc[i * 3];
-      const float* sh = DEGREE > 0 ? rest + i * rest_n : nullptr;
-      if (fp16_sh) {
-        const HalfColour<DEGREE> half(dc, sh);
-        gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], half.dc, half.rest, g.rgb);
-      } else {
-        gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], dc, sh, g.rgb);
-      }
+      gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], dc + i * 3,
+                            DEGREE > 0 ? rest + i * rest_n : nullptr, g.rgb);
     });
   errors.rethrow();
+}
+
+// The scene's SH coefficients as half values, rounded once per scene: a frame then costs what
+// an exact one does (the CUDA backend stores them as halves instead).
+void round_sh_to_halves(const Scene& scene, Frame& frame) {
+  if (frame.half_sh_of == &scene) return;
+  frame.half_sh_dc.resize(scene.sh_dc.size());
+  frame.half_sh_rest.resize(scene.sh_rest.size());
+  auto round_all = [&frame](const std::vector<float>& in, std::vector<float>& out) {
+    const std::int64_t n = static_cast<std::int64_t>(in.size());
+#pragma omp parallel for schedule(static) num_threads(frame.threads)
+    for (std::int64_t k = 0; k < n; ++k) out[k] = gm::round_to_half(in[k]);
+  };
+  round_all(scene.sh_dc, frame.half_sh_dc);
+  round_all(scene.sh_rest, frame.half_sh_rest);
+  frame.half_sh_of = &scene;
 }
 
 }  // namespace
@@ -75,11 +72,18 @@ void project(const Scene& scene, const RenderOptions& options, Frame& frame, Fra
   }
   // A scene pays only for the SH bands it has (and the viewer's cap).
   const int degree = std::max(0, std::min(scene.sh_degree, options.sh_degree_cap));
+  const float* dc = scene.sh_dc.data();
+  const float* rest = scene.sh_rest.data();
+  if (options.fp16_sh) {
+    round_sh_to_halves(scene, frame);
+    dc = frame.half_sh_dc.data();
+    rest = frame.half_sh_rest.data();
+  }
   switch (degree) {
-    case 0: project_all<0>(scene, options.fp16_sh, frame); break;
-    case 1: project_all<1>(scene, options.fp16_sh, frame); break;
-    case 2: project_all<2>(scene, options.fp16_sh, frame); break;
-    default: project_all<3>(scene, options.fp16_sh, frame); break;
+    case 0: project_all<0>(scene, dc, rest, frame); break;
+    case 1: project_all<1>(scene, dc, rest, frame); break;
+    case 2: project_all<2>(scene, dc, rest, frame); break;
+    default: project_all<3>(scene, dc, rest, frame); break;
   }
   std::uint64_t near = 0, offscreen = 0, low_opacity = 0, degenerate = 0;
   const std::int64_t count = static_cast<std::int64_t>(n);

@@ -33,7 +33,10 @@ class CpuRenderer final : public Renderer {
   std::string name() const override {
     return "cpu (" + std::to_string(frame_.threads) + " threads, " + kernel_name_ + " blend)";
   }
-  void set_scene(std::shared_ptr<const Scene> scene) override { scene_ = std::move(scene); }
+  void set_scene(std::shared_ptr<const Scene> scene) override {
+    scene_ = std::move(scene);
+    frame_.half_sh_of = nullptr;  // another scene may live at the old one's address
+  }
 
   void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats_out) override {
     // A frame too large for this machine's memory (e.g. 65536^2: 51 GB of float RGB) is a
