@@ -20,8 +20,8 @@ std::string format_stats(const FrameStats& s) {
                 s.times.sort_ms, s.times.ranges_ms, s.times.blend_ms, s.times.total_ms);
   std::string out = text;
   if (s.device_peak_bytes) {
-    std::snprintf(text, sizeof text, "device mem: %.1f MB now, %.1f MB peak (above the scene)\n",
-                  s.device_memory_bytes / 1e6, s.device_peak_bytes / 1e6);
+    std::snprintf(text, sizeof text, "device mem: %.1f MB now, %.1f MB peak (above the scene); scene %.1f MB\n",
+                  s.device_memory_bytes / 1e6, s.device_peak_bytes / 1e6, s.scene_device_bytes / 1e6);
     out += text;
   }
   return out;
