@@ -501,10 +501,10 @@ class CudaRendererImpl final : public CudaRenderer {
   void run_frame(const Camera& camera, const RenderOptions& options, Image* out, std::uint64_t surface,
                  FrameStats* stats_out) {
     if (!scene_) throw Error("cuda renderer: no scene set");
-    // A frame in the other SH precision re-packs the scene from its host copy first.
-    if (options.fp16_sh != device_scene_.sh_half) upload_scene(scene_, options.fp16_sh);
     if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
     if (surface) check_surface(surface, camera);
+    // A frame in the other SH precision re-packs the scene from its host copy first.
+    if (options.fp16_sh != device_scene_.sh_half) upload_scene(scene_, options.fp16_sh);
     const gm::CameraParams cam = make_camera_params(camera);
     const std::uint64_t tiles = static_cast<std::uint64_t>(cam.tiles_x) * cam.tiles_y;
     const std::uint64_t pixels = static_cast<std::uint64_t>(cam.width) * cam.height;
