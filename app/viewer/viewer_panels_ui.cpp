@@ -293,7 +293,10 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
   if (ImGui::SliderFloat(tau_label, &inv_tau, 1.0f / kTauRange.max, 1.0f / kTauRange.min, "%.0f",
                          kClamp | ImGuiSliderFlags_Logarithmic))
     o.tau = 1.0f / inv_tau;
+  // On one row with its checkbox: a row more would push the panels' last buttons off a 720-px window.
+  ImGui::SetNextItemWidth(ui(96));
   ImGui::SliderInt("SH degree cap", &o.sh_degree_cap, 0, kMaxShDegree, "%d", kClamp);
+  ImGui::SameLine();
   ImGui::Checkbox("fp16 SH", &o.fp16_sh);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("the SH coefficients as half values: half the GPU bytes of the SH bands, not exact");
