@@ -277,6 +277,18 @@ TEST(CudaSanitizer, Frames) {
           std::accumulate(r.stats.tile_pair_counts.begin(), r.stats.tile_pair_counts.end(), std::uint64_t{0});
       EXPECT_EQ(sum, r.stats.kv_pairs) << camera.name << " " << o.label();
     }
+  // The SH bands as halves (fp16_sh), on the demo scene: it has higher bands to read, the
+  // sanitizer's real scene (pc_biker) has none.
+  auto demo_gpu = make_cuda_renderer();
+  const auto demo = test::load_demo_scene();
+  demo_gpu->set_scene(demo);
+  RenderOptions half_sh;
+  half_sh.fp16_sh = true;
+  for (const Camera& camera : sanitizer_cameras(*demo, test::load_demo_cameras()))
+    for (const RenderOptions& o : {half_sh, RenderOptions{}}) {  // and back: the scene is re-packed twice
+      const Result r = render(*demo_gpu, camera, o);
+      EXPECT_EQ(count_non_finite(r.image), 0u) << camera.name << " " << o.label();
+    }
 }
 
 TEST(CudaDeterminism, SameFrameTwiceGivesTheSameBytes) {
