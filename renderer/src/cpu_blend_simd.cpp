@@ -146,28 +146,29 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
 
   // The tile's vectors ("slots"): lane group j of row y is bit j * kTileSize + y of a 64-bit
   // set (16 rows x at most 4 groups), so that a row mask shifted by j * kTileSize is group j's.
-  // Per pixel: transmittance, colour, and whether it still blends (all bits set) - pixels
+  // Per slot, one vector each, next to each other (one base address per slot): the pixels'
+  // image x, transmittance, colour, and whether they still blend (all bits set) - pixels
   // outside the image start finished. A slot whose lanes have all finished leaves live_slots,
   // and the tile stops when none is left.
   static_assert(gm::kTileSize <= 16, "64 slot bits: 16 rows of at most 4 lane groups");
-  HWY_ALIGN float transmittance[kTilePixels], red[kTilePixels], green[kTilePixels], blue[kTilePixels];
-  HWY_ALIGN float active[kTilePixels];
-  HWY_ALIGN float pixel_x[gm::kTileSize];  // the image x of each column
+  enum SlotField { kX, kT, kRed, kGreen, kBlue, kActive, kSlotFields };
+  HWY_ALIGN float slot_state[kSlotFields * kTilePixels];
+  const auto slot_field = [&](int slot, SlotField field) { return slot_state + (slot * kSlotFields + field) * lanes_i; };
   std::uint64_t live_slots = 0;
   const auto tile_width = hn::Set(d, static_cast<float>(tile_w));
   for (int y = 0; y < gm::kTileSize; ++y)
     for (int v = 0; v < groups_per_row; ++v) {
-      const int p = y * gm::kTileSize + v * lanes_i;
-      const auto inside = hn::And(hn::Lt(hn::Iota(d, static_cast<float>(v * lanes_i)), tile_width),
-                                  y < tile_h ? hn::FirstN(d, lanes) : hn::FirstN(d, 0));
-      hn::Store(hn::Set(d, 1.0f), d, transmittance + p);
-      hn::Store(hn::Zero(d), d, red + p);
-      hn::Store(hn::Zero(d), d, green + p);
-      hn::Store(hn::Zero(d), d, blue + p);
-      hn::Store(hn::VecFromMask(d, inside), d, active + p);
-      if (!hn::AllFalse(d, inside)) live_slots |= std::uint64_t{1} << (v * gm::kTileSize + y);
+      const int slot = v * gm::kTileSize + y;
+      const auto column = hn::Iota(d, static_cast<float>(v * lanes_i));
+      const auto inside = hn::And(hn::Lt(column, tile_width), y < tile_h ? hn::FirstN(d, lanes) : hn::FirstN(d, 0));
+      hn::Store(hn::Add(column, hn::Set(d, static_cast<float>(x_begin))), d, slot_field(slot, kX));
+      hn::Store(hn::Set(d, 1.0f), d, slot_field(slot, kT));
+      hn::Store(hn::Zero(d), d, slot_field(slot, kRed));
+      hn::Store(hn::Zero(d), d, slot_field(slot, kGreen));
+      hn::Store(hn::Zero(d), d, slot_field(slot, kBlue));
+      hn::Store(hn::VecFromMask(d, inside), d, slot_field(slot, kActive));
+      if (!hn::AllFalse(d, inside)) live_slots |= std::uint64_t{1} << slot;
     }
-  for (int x = 0; x < gm::kTileSize; ++x) pixel_x[x] = static_cast<float>(x_begin + x);
 
   if (job.count > 0) gather(frame, job, y_begin, tile_h, g);
   // For the current Gaussian, per row: the row's terms of u and w (whiten[1] dy, whiten[3] dy).
@@ -231,43 +232,44 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
     // pc_playbot: 29% fewer mispredicts for 5% more instructions).
     for (; slots != 0; slots &= slots - 1u) {
       const int slot = static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero64(slots));
-      const int y = slot % gm::kTileSize, local_x = slot / gm::kTileSize * lanes_i;
-      const int p = y * gm::kTileSize + local_x;
-      const auto dx = hn::Sub(hn::Load(d, pixel_x + local_x), centre_x);
+      const int y = slot % gm::kTileSize;
+      float* state = slot_field(slot, kX);
+      const auto dx = hn::Sub(hn::Load(d, state + kX * lanes), centre_x);
       const auto u = hn::MulAdd(w0, dx, hn::Set(d, row_u[y])), w = hn::MulAdd(w2, dx, hn::Set(d, row_w[y]));
       const auto q = hn::MulAdd(u, u, hn::Mul(w, w));
       // Only the exact test: a lane outside the row's span or below power_cut has alpha <
       // 1/255 for certain (the margins the scalar kernel's pruning relies on), so it fails
       // this test as surely as it would have been skipped there.
-      auto live = hn::MaskFromVec(hn::Load(d, active + p));
+      auto live = hn::MaskFromVec(hn::Load(d, state + kActive * lanes));
       const auto alpha = hn::Min(alpha_max, exp2_nonpositive(d, hn::MulAdd(q, minus_half_log2e, log2_opacity)));
       auto blends = hn::And(live, hn::Ge(alpha, alpha_min));
-      const auto t = hn::Load(d, transmittance + p);
+      const auto t = hn::Load(d, state + kT * lanes);
       const auto next_t = hn::Mul(t, hn::Sub(one, alpha));
       const auto finished = hn::And(blends, hn::Lt(next_t, t_min));
       if (!hn::AllFalse(d, finished)) {
         live = hn::AndNot(finished, live);
-        hn::Store(hn::VecFromMask(d, live), d, active + p);
+        hn::Store(hn::VecFromMask(d, live), d, state + kActive * lanes);
         blends = hn::AndNot(finished, blends);
         if (hn::AllFalse(d, live)) live_slots &= ~(std::uint64_t{1} << slot);
       }
       // Lanes that do not blend add colour * 0: the same bytes as leaving them (colours start
       // at +0 and stay >= 0), for one select instead of three.
       const auto weight = hn::IfThenElseZero(blends, hn::Mul(alpha, t));
-      hn::Store(hn::MulAdd(r, weight, hn::Load(d, red + p)), d, red + p);
-      hn::Store(hn::MulAdd(gr, weight, hn::Load(d, green + p)), d, green + p);
-      hn::Store(hn::MulAdd(b, weight, hn::Load(d, blue + p)), d, blue + p);
-      hn::Store(hn::IfThenElse(blends, next_t, t), d, transmittance + p);
+      hn::Store(hn::MulAdd(r, weight, hn::Load(d, state + kRed * lanes)), d, state + kRed * lanes);
+      hn::Store(hn::MulAdd(gr, weight, hn::Load(d, state + kGreen * lanes)), d, state + kGreen * lanes);
+      hn::Store(hn::MulAdd(b, weight, hn::Load(d, state + kBlue * lanes)), d, state + kBlue * lanes);
+      hn::Store(hn::IfThenElse(blends, next_t, t), d, state + kT * lanes);
     }
   }
   const float* background = job.background;
   for (int y = 0; y < tile_h; ++y)
     for (int x = 0; x < tile_w; ++x) {
-      const int p = y * gm::kTileSize + x;
+      const int slot = x / lanes_i * gm::kTileSize + y, lane = x % lanes_i;
+      const float t = slot_field(slot, kT)[lane];
       float* out = rgb + (static_cast<std::size_t>(y_begin + y) * width + x_begin + x) * 3;
-      out[0] = red[p] + transmittance[p] * background[0];
-      out[1] = green[p] + transmittance[p] * background[1];
-      out[2] = blue[p] + transmittance[p] * background[2];
+      out[0] = slot_field(slot, kRed)[lane] + t * background[0];
+      out[1] = slot_field(slot, kGreen)[lane] + t * background[1];
+      out[2] = slot_field(slot, kBlue)[lane] + t * background[2];
     }
 }
 
