@@ -139,6 +139,12 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   const std::size_t lanes = hn::Lanes(d);
   const int lanes_i = static_cast<int>(lanes);
   const int groups_per_row = gm::kTileSize / lanes_i;
+  // One lane (HWY_SCALAR, a CPU without SIMD): 256 slots would overflow the 64-bit slot sets,
+  // and a vector of one pixel has nothing over the scalar kernel, which blends instead.
+  if (lanes < 4) {
+    blend_tile_scalar(frame, job, rgb);
+    return;
+  }
   const int width = frame.camera.width, height = frame.camera.height;
   const int x_begin = job.tile_x * gm::kTileSize, y_begin = job.tile_y * gm::kTileSize;
   const int tile_w = std::min(gm::kTileSize, width - x_begin);
@@ -152,6 +158,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   // and the tile stops when none is left.
   static_assert(gm::kTileSize <= 16, "64 slot bits: 16 rows of at most 4 lane groups");
   enum SlotField { kX, kT, kRed, kGreen, kBlue, kActive, kSlotFields };
+  constexpr int kMaxSlots = 64;
   HWY_ALIGN float slot_state[kSlotFields * kTilePixels];
   const auto slot_field = [&](int slot, SlotField field) { return slot_state + (slot * kSlotFields + field) * lanes_i; };
   std::uint64_t live_slots = 0;
@@ -171,8 +178,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
     }
 
   if (job.count > 0) gather(frame, job, y_begin, tile_h, g);
-  // For the current Gaussian, per row: the row's terms of u and w (whiten[1] dy, whiten[3] dy).
-  HWY_ALIGN float row_u[gm::kTileSize], row_w[gm::kTileSize];
+  // For the current Gaussian, per slot: its row's terms of u and w (whiten[1] dy, whiten[3] dy).
+  HWY_ALIGN float slot_u[kMaxSlots], slot_w[kMaxSlots];
   // A row mask repeated for every lane group: the slots of those rows.
   std::uint64_t every_group = 0;
   for (int v = 0; v < groups_per_row; ++v) every_group |= std::uint64_t{1} << (v * gm::kTileSize);
@@ -205,8 +212,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         const auto last = min_like_std(tile_right, hn::Floor(hn::Add(centre, half)));
         // The scalar kernel skips a row unless row_q <= q_reach (false for NaN) and first <= last.
         const auto touched = hn::And(hn::Le(row_q, q_reach_v), hn::Le(first, last));
-        hn::Store(hn::Mul(w1, dy), d, row_u + row);
-        hn::Store(hn::Mul(w3, dy), d, row_w + row);
+        const auto u_term = hn::Mul(w1, dy), w_term = hn::Mul(w3, dy);
         // Group j holds columns [j lanes, (j + 1) lanes): the span meets it unless it ends
         // before or starts after.
         for (int v = 0; v < groups_per_row; ++v) {
@@ -216,6 +222,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
           hn::StoreMaskBits(d, meets, bits);
           const std::uint64_t row_bits = bits[0] | (lanes > 8 ? static_cast<std::uint64_t>(bits[1]) << 8 : 0u);
           touched_slots |= row_bits << (row + v * gm::kTileSize);
+          hn::Store(u_term, d, slot_u + v * gm::kTileSize + row);
+          hn::Store(w_term, d, slot_w + v * gm::kTileSize + row);
         }
       }
     }
@@ -232,10 +240,9 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
     // pc_playbot: 29% fewer mispredicts for 5% more instructions).
     for (; slots != 0; slots &= slots - 1u) {
       const int slot = static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero64(slots));
-      const int y = slot % gm::kTileSize;
       float* state = slot_field(slot, kX);
       const auto dx = hn::Sub(hn::Load(d, state + kX * lanes), centre_x);
-      const auto u = hn::MulAdd(w0, dx, hn::Set(d, row_u[y])), w = hn::MulAdd(w2, dx, hn::Set(d, row_w[y]));
+      const auto u = hn::MulAdd(w0, dx, hn::Set(d, slot_u[slot])), w = hn::MulAdd(w2, dx, hn::Set(d, slot_w[slot]));
       const auto q = hn::MulAdd(u, u, hn::Mul(w, w));
       // Only the exact test: a lane outside the row's span or below power_cut has alpha <
       // 1/255 for certain (the margins the scalar kernel's pruning relies on), so it fails
@@ -261,15 +268,25 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       hn::Store(hn::IfThenElse(blends, next_t, t), d, state + kT * lanes);
     }
   }
+  // Colour plus the transmittance's share of the background, as the scalar kernel (no FMA),
+  // interleaved into the image's rows; a partial lane group at the right edge pixel by pixel.
   const float* background = job.background;
+  const auto bg_r = hn::Set(d, background[0]), bg_g = hn::Set(d, background[1]), bg_b = hn::Set(d, background[2]);
   for (int y = 0; y < tile_h; ++y)
-    for (int x = 0; x < tile_w; ++x) {
-      const int slot = x / lanes_i * gm::kTileSize + y, lane = x % lanes_i;
-      const float t = slot_field(slot, kT)[lane];
-      float* out = rgb + (static_cast<std::size_t>(y_begin + y) * width + x_begin + x) * 3;
-      out[0] = slot_field(slot, kRed)[lane] + t * background[0];
-      out[1] = slot_field(slot, kGreen)[lane] + t * background[1];
-      out[2] = slot_field(slot, kBlue)[lane] + t * background[2];
+    for (int v = 0; v * lanes_i < tile_w; ++v) {
+      const int slot = v * gm::kTileSize + y;
+      float* out = rgb + (static_cast<std::size_t>(y_begin + y) * width + x_begin + v * lanes_i) * 3;
+      const auto t = hn::Load(d, slot_field(slot, kT));
+      const auto out_r = hn::Add(hn::Load(d, slot_field(slot, kRed)), hn::Mul(t, bg_r));
+      const auto out_g = hn::Add(hn::Load(d, slot_field(slot, kGreen)), hn::Mul(t, bg_g));
+      const auto out_b = hn::Add(hn::Load(d, slot_field(slot, kBlue)), hn::Mul(t, bg_b));
+      if ((v + 1) * lanes_i <= tile_w) {
+        hn::StoreInterleaved3(out_r, out_g, out_b, d, out);
+      } else {
+        HWY_ALIGN float pixels[3 * gm::kTileSize];
+        hn::StoreInterleaved3(out_r, out_g, out_b, d, pixels);
+        std::copy(pixels, pixels + 3 * (tile_w - v * lanes_i), out);
+      }
     }
 }
 
