@@ -160,7 +160,9 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   enum SlotField { kX, kT, kRed, kGreen, kBlue, kActive, kSlotFields };
   constexpr int kMaxSlots = 64;
   HWY_ALIGN float slot_state[kSlotFields * kTilePixels];
-  const auto slot_field = [&](int slot, SlotField field) { return slot_state + (slot * kSlotFields + field) * lanes_i; };
+  const auto slot_field = [&](int slot, SlotField field) {
+    return slot_state + (slot * kSlotFields + field) * lanes_i;
+  };
   std::uint64_t live_slots = 0;
   const auto tile_width = hn::Set(d, static_cast<float>(tile_w));
   for (int y = 0; y < gm::kTileSize; ++y)
