@@ -181,7 +181,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
 
   if (job.count > 0) gather(frame, job, y_begin, tile_h, g);
   // For the current Gaussian, per slot: its row's terms of u and w (whiten[1] dy, whiten[3] dy).
-  HWY_ALIGN float slot_u[kMaxSlots], slot_w[kMaxSlots];
+  // (A row past the tile spills into the next group's first rows or the padding.)
+  HWY_ALIGN float slot_u[kMaxSlots + gm::kTileSize], slot_w[kMaxSlots + gm::kTileSize];
   // A row mask repeated for every lane group: the slots of those rows.
   std::uint64_t every_group = 0;
   for (int v = 0; v < groups_per_row; ++v) every_group |= std::uint64_t{1} << (v * gm::kTileSize);
@@ -205,7 +206,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       const auto slope = hn::Set(d, gauss.row_slope), inv_conic_a = hn::Set(d, gauss.inv_conic_a);
       const auto mean_y_v = hn::Set(d, mean_y), w1 = hn::Set(d, gauss.whiten[1]), w3 = hn::Set(d, gauss.whiten[3]);
       const auto centre_x = hn::Set(d, mean_x);
-      for (int row = y_first / lanes_i * lanes_i; row <= y_last; row += lanes_i) {
+      for (int row = y_first; row <= y_last; row += lanes_i) {
         const auto dy = hn::Sub(hn::Iota(d, static_cast<float>(y_begin + row)), mean_y_v);
         const auto row_q = hn::Mul(hn::Mul(coeff, dy), dy);
         const auto centre = hn::Sub(hn::Add(centre_x, hn::Mul(slope, dy)), tile_left);
@@ -224,13 +225,14 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
           hn::StoreMaskBits(d, meets, bits);
           const std::uint64_t row_bits = bits[0] | (lanes > 8 ? static_cast<std::uint64_t>(bits[1]) << 8 : 0u);
           touched_slots |= row_bits << (row + v * gm::kTileSize);
-          hn::Store(u_term, d, slot_u + v * gm::kTileSize + row);
-          hn::Store(w_term, d, slot_w + v * gm::kTileSize + row);
+          hn::StoreU(u_term, d, slot_u + v * gm::kTileSize + row);
+          hn::StoreU(w_term, d, slot_w + v * gm::kTileSize + row);
         }
       }
     }
-    // The span pass covers whole vectors of rows: keep [y_first, y_last] (the rest may lie
-    // below the image, or in the next group's bits).
+    // The span pass covers whole vectors of rows from y_first: keep [y_first, y_last]. Rows
+    // past the tile's last land in the next group's rows below y_first (bits and u, w terms
+    // alike), which this drops, so nothing of the Gaussian's own slots is overwritten.
     const std::uint32_t in_range = ((2u << y_last) - 1u) & ~((1u << y_first) - 1u);
     std::uint64_t slots = touched_slots & (in_range * every_group) & live_slots;
     if (slots == 0) continue;
