@@ -218,10 +218,11 @@ class CudaRendererImpl final : public CudaRenderer {
   void* stream() const override { return stream_; }
 
   // Uploaded in the SH precision of the last frame, so that a viewer in fp16 mode loads a
-  // new scene once.
+  // new scene once. The bounds are the scene's, so a later re-pack of its SH keeps them.
   void set_scene(std::shared_ptr<const Scene> scene) override {
     if (!scene) throw Error("cuda renderer: null scene");
     upload_scene(std::move(scene), device_scene_.sh_half);
+    compute_bounds(*scene_);
   }
 
   // The scene on the device in the layout of DeviceScene, its SH as floats or (`sh_half`,
@@ -300,7 +301,6 @@ class CudaRendererImpl final : public CudaRenderer {
     scene_rest_.swap(new_rest);
     scene_chunks_.swap(new_chunks);
     device_scene_ = next;
-    compute_bounds(*scene);
     scene_ = std::move(scene);
     last_tiles_ = 0;
   }
