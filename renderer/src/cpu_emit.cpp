@@ -2,15 +2,20 @@
 // the exact test: only tiles the ellipse touches).
 #include <algorithm>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "cpu_frame.h"
 #include "parallel_errors.h"
 
 namespace flashgs {
 namespace cpu {
+namespace {
+
+// Chunks per thread: a scene's pairs are far from even along its Gaussian order (pc_playbot's
+// sixteenths hold 2k to 152k pairs of one view), so equal static shares left threads idle;
+// several chunks each, taken dynamically, even that out.
+constexpr int kChunksPerThread = 8;
+constexpr std::int64_t kMinChunkGaussians = 4096;
+
+}  // namespace
 
 void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats) {
   const std::int64_t n = static_cast<std::int64_t>(scene.size());
@@ -19,44 +24,37 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
   const int width = frame.camera.width, height = frame.camera.height, tiles_x = frame.camera.tiles_x;
   std::uint64_t visible = 0, ellipse_missed = 0;
 
-  // Static contiguous chunks: thread t of a team of T owns Gaussians [t n / T, (t + 1) n / T),
-  // so the pair lists, concatenated in thread order, are in Gaussian order whatever the timing.
-  // T is the team OpenMP grants, which may be smaller than frame.threads (OMP_THREAD_LIMIT,
-  // OMP_DYNAMIC, a render called inside another parallel region).
+  // Chunk c holds Gaussians [c n / C, (c + 1) n / C): the pair lists, concatenated in chunk
+  // order, are in Gaussian order however the chunks were scheduled (sort_by_tile relies on it).
+  const int chunks = static_cast<int>(
+      std::max<std::int64_t>(1, std::min<std::int64_t>(std::int64_t{frame.threads} * kChunksPerThread,
+                                                       n / kMinChunkGaussians)));
+  frame.emit_chunks = chunks;
+  // Grown only: shrinking would free the inner vectors' capacity.
+  if (frame.chunk_tiles.size() < static_cast<std::size_t>(chunks)) {
+    frame.chunk_tiles.resize(chunks);
+    frame.chunk_keys.resize(chunks);
+    frame.chunk_tile_counts.resize(chunks);
+  }
   ParallelErrors errors;
-#pragma omp parallel num_threads(frame.threads) reduction(+ : visible, ellipse_missed)
-  {
-#ifdef _OPENMP
-    const int t = omp_get_thread_num(), team = omp_get_num_threads();
-#else
-    const int t = 0, team = 1;
-#endif
-#pragma omp single
-    errors.capture([&] {
-      frame.emit_chunks = team;
-      // Grown only: shrinking would free the inner vectors' capacity.
-      if (frame.thread_tiles.size() < static_cast<std::size_t>(team)) {
-        frame.thread_tiles.resize(team);
-        frame.thread_keys.resize(team);
-        frame.thread_tile_counts.resize(team);
-      }
-    });
+#pragma omp parallel for schedule(dynamic, 1) num_threads(frame.threads) reduction(+ : visible, ellipse_missed)
+  for (int c = 0; c < chunks; ++c)
     errors.capture([&] {
       // The outputs as this thread's locals (swapped in and back, capacity kept): the vectors'
       // headers sit side by side in frame, and a push_back to one would invalidate the cache
       // line of the others' (false sharing cost more than the work at 2 threads).
       std::vector<std::uint32_t> out_tiles, counts;
       std::vector<std::uint64_t> out_keys;
-      out_tiles.swap(frame.thread_tiles[t]);
-      out_keys.swap(frame.thread_keys[t]);
-      counts.swap(frame.thread_tile_counts[t]);
+      out_tiles.swap(frame.chunk_tiles[c]);
+      out_keys.swap(frame.chunk_keys[c]);
+      counts.swap(frame.chunk_tile_counts[c]);
       out_tiles.clear();
       out_keys.clear();
       counts.assign(tiles, 0);
       std::uint64_t my_visible = 0, my_missed = 0;
       const gm::Footprint* footprints = frame.footprints.data();
       std::uint8_t* cull = frame.cull.data();
-      const std::int64_t begin = n * t / team, end = n * (t + 1) / team;
+      const std::int64_t begin = n * c / chunks, end = n * (c + 1) / chunks;
       for (std::int64_t i = begin; i < end; ++i) {
         if (cull[i] != gm::kVisible) continue;
         const gm::Footprint& f = footprints[i];
@@ -80,15 +78,14 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
       }
       visible += my_visible;
       ellipse_missed += my_missed;
-      out_tiles.swap(frame.thread_tiles[t]);
-      out_keys.swap(frame.thread_keys[t]);
-      counts.swap(frame.thread_tile_counts[t]);
+      out_tiles.swap(frame.chunk_tiles[c]);
+      out_keys.swap(frame.chunk_keys[c]);
+      counts.swap(frame.chunk_tile_counts[c]);
     });
-  }
   errors.rethrow();
   stats.visible = visible;
   std::uint64_t pairs = 0;
-  for (int t = 0; t < frame.emit_chunks; ++t) pairs += frame.thread_keys[t].size();
+  for (int c = 0; c < chunks; ++c) pairs += frame.chunk_keys[c].size();
   stats.kv_pairs = pairs;
   stats.culled_offscreen += ellipse_missed;  // project counted the boxes that missed the image
 }

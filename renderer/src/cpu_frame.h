@@ -54,13 +54,13 @@ struct Frame {
   const Scene* half_sh_of = nullptr;
   std::vector<float> half_sh_dc, half_sh_rest;
 
-  // Emission: each thread's pairs (tile, key) for its static chunk of Gaussians, and its
-  // per-tile histogram. key = depth bits << 32 | Gaussian id. Only the first emit_chunks
-  // entries (the team the emit region was granted) belong to this frame.
+  // Emission: the pairs (tile, key) of each chunk of consecutive Gaussians, and the chunk's
+  // per-tile histogram (then, after sort_by_tile's ranges, its write cursor per tile).
+  // key = depth bits << 32 | Gaussian id. Only the first emit_chunks entries belong to this frame.
   int emit_chunks = 0;
-  std::vector<std::vector<std::uint32_t>> thread_tiles;
-  std::vector<std::vector<std::uint64_t>> thread_keys;
-  std::vector<std::vector<std::uint32_t>> thread_tile_counts;  // [thread][tile]
+  std::vector<std::vector<std::uint32_t>> chunk_tiles;
+  std::vector<std::vector<std::uint64_t>> chunk_keys;
+  std::vector<std::vector<std::uint32_t>> chunk_tile_counts;  // [chunk][tile]
 
   std::vector<std::uint64_t> tile_start;   // [tiles + 1] offsets into sorted_keys
   std::vector<std::uint64_t> sorted_keys;  // [pairs], tile-major, (depth, id) within a tile

@@ -58,36 +58,48 @@ void sort_tile_keys(std::uint64_t* keys, std::size_t n, std::vector<std::uint64_
 
 void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms) {
   using Clock = std::chrono::steady_clock;
-  const int chunks = frame.emit_chunks;  // the emit stage's per-thread pair lists
+  const int chunks = frame.emit_chunks;  // the emit stage's pair lists
   const std::size_t tiles = static_cast<std::size_t>(frame.camera.tiles_x) * frame.camera.tiles_y;
 
-  // Ranges: tile_start from the per-thread histograms, and each thread's write cursor per tile.
+  // Ranges: each chunk's histogram becomes its write cursor within each tile (the pairs of
+  // earlier chunks first), tile_start[tile + 1] the tile's total, then a scan of the totals.
   const auto ranges_begin = Clock::now();
   frame.tile_start.assign(tiles + 1, 0);
-  std::uint64_t running = 0;
-  for (std::size_t tile = 0; tile < tiles; ++tile) {
-    frame.tile_start[tile] = running;
-    for (int t = 0; t < chunks; ++t) {
-      const std::uint32_t c = frame.thread_tile_counts[t][tile];
-      frame.thread_tile_counts[t][tile] = static_cast<std::uint32_t>(running - frame.tile_start[tile]);
-      running += c;
+  std::uint64_t* tile_start = frame.tile_start.data();
+  constexpr std::int64_t kTilesPerTask = 1024;
+  const std::int64_t tasks = (static_cast<std::int64_t>(tiles) + kTilesPerTask - 1) / kTilesPerTask;
+  // In parallel only when there is enough to share: a parallel region's start and barrier
+  // cost more than a few hundred thousand additions (and a time slice on a loaded machine).
+  const bool share = static_cast<std::uint64_t>(tiles) * static_cast<std::uint64_t>(chunks) > (1u << 20);
+#pragma omp parallel for schedule(static) num_threads(frame.threads) if (share)
+  for (std::int64_t task = 0; task < tasks; ++task) {
+    const std::size_t begin = static_cast<std::size_t>(task * kTilesPerTask);
+    const std::size_t end = std::min(tiles, begin + static_cast<std::size_t>(kTilesPerTask));
+    for (int c = 0; c < chunks; ++c) {
+      std::uint32_t* counts = frame.chunk_tile_counts[c].data();
+      for (std::size_t tile = begin; tile < end; ++tile) {
+        const std::uint32_t count = counts[tile];
+        counts[tile] = static_cast<std::uint32_t>(tile_start[tile + 1]);
+        tile_start[tile + 1] += count;
+      }
     }
   }
-  frame.tile_start[tiles] = running;
+  for (std::size_t tile = 0; tile < tiles; ++tile) tile_start[tile + 1] += tile_start[tile];
+  const std::uint64_t pairs = tile_start[tiles];
   *ranges_ms = std::chrono::duration<double, std::milli>(Clock::now() - ranges_begin).count();
 
-  if (frame.sorted_keys.size() < running) frame.sorted_keys.resize(running);
+  if (frame.sorted_keys.size() < pairs) frame.sorted_keys.resize(pairs);
   std::uint64_t* sorted = frame.sorted_keys.data();
   ParallelErrors errors;
-#pragma omp parallel for schedule(static, 1) num_threads(frame.threads)
-  for (int t = 0; t < chunks; ++t)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(frame.threads)
+  for (int c = 0; c < chunks; ++c)
     errors.capture([&] {
-      const std::vector<std::uint32_t>& tile_of = frame.thread_tiles[t];
-      const std::vector<std::uint64_t>& keys = frame.thread_keys[t];
-      std::vector<std::uint32_t>& cursor = frame.thread_tile_counts[t];
+      const std::vector<std::uint32_t>& tile_of = frame.chunk_tiles[c];
+      const std::vector<std::uint64_t>& keys = frame.chunk_keys[c];
+      std::uint32_t* cursor = frame.chunk_tile_counts[c].data();
       for (std::size_t k = 0; k < keys.size(); ++k) {
         const std::uint32_t tile = tile_of[k];
-        sorted[frame.tile_start[tile] + cursor[tile]++] = keys[k];
+        sorted[tile_start[tile] + cursor[tile]++] = keys[k];
       }
     });
   errors.rethrow();

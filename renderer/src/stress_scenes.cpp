@@ -363,11 +363,11 @@ StressCase stacked_case() {
 StressCase equal_depth_case() {
   StressCase c;
   c.name = "equal_depth";
-  c.description = "2000 Gaussians at exactly the same depth, overlapping: the order (and image) must not depend "
-                  "on threads or timing";
+  c.description = "10000 Gaussians at exactly the same depth, overlapping: the order (and image) must not depend "
+                  "on threads or timing (enough of them that the CPU emits them in several chunks)";
   Scene& s = c.scene;
   Rng rng(31);
-  for (int k = 0; k < 2000; ++k) {
+  for (int k = 0; k < 10000; ++k) {
     float q[4], rgb[3];
     random_quaternion(rng, q);
     hue(rng.uniform(), rgb);
