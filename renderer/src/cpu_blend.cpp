@@ -13,16 +13,25 @@ namespace flashgs {
 namespace cpu {
 namespace {
 
-// Tiles by pair count, most first (ties by index), so the long tiles start at once and the
-// short ones fill in at the end instead of one core finishing a dense tile alone.
+// Tiles by the bit length of their pair count, longest first (by index within a class), so
+// the long tiles start at once and the short ones fill in at the end instead of one core
+// finishing a dense tile alone. A counting sort: a comparison sort of the tiles took 0.7 ms
+// at 1080p and 3.6 ms at 4K on one core, while the blend of a 4K frame on 16 cores is ~60 ms.
 void order_tiles_by_pairs(Frame& frame, std::size_t tiles) {
-  frame.tile_order.resize(tiles);
-  for (std::size_t i = 0; i < tiles; ++i) frame.tile_order[i] = static_cast<std::uint32_t>(i);
+  constexpr int kClasses = 65;  // bit lengths 0 (an empty tile) .. 64
+  std::size_t class_start[kClasses + 1] = {};
   const std::uint64_t* start = frame.tile_start.data();
-  std::sort(frame.tile_order.begin(), frame.tile_order.end(), [start](std::uint32_t a, std::uint32_t b) {
-    const std::uint64_t pairs_a = start[a + 1] - start[a], pairs_b = start[b + 1] - start[b];
-    return pairs_a != pairs_b ? pairs_a > pairs_b : a < b;
-  });
+  auto class_of = [start](std::size_t tile) {
+    std::uint64_t pairs = start[tile + 1] - start[tile];
+    int bits = 0;
+    for (; pairs; pairs >>= 1) ++bits;
+    return kClasses - 1 - bits;  // the longest class first
+  };
+  for (std::size_t tile = 0; tile < tiles; ++tile) class_start[class_of(tile) + 1]++;
+  for (int c = 0; c < kClasses; ++c) class_start[c + 1] += class_start[c];
+  frame.tile_order.resize(tiles);
+  for (std::size_t tile = 0; tile < tiles; ++tile)
+    frame.tile_order[class_start[class_of(tile)]++] = static_cast<std::uint32_t>(tile);
 }
 
 }  // namespace

@@ -66,7 +66,7 @@ struct Frame {
   std::vector<std::uint64_t> sorted_keys;  // [pairs], tile-major, (depth, id) within a tile
   std::vector<std::vector<std::uint64_t>> sort_scratch;  // [threads] the per-tile radix sort's buffer
 
-  std::vector<std::uint32_t> tile_order;       // [tiles] the blend's schedule: most pairs first
+  std::vector<std::uint32_t> tile_order;       // [tiles] the blend's schedule: longest pair counts first
   std::vector<TileGaussians> tile_gaussians;   // [threads] the SIMD blend's per-tile gather
 };
 
