@@ -53,6 +53,11 @@ struct Frame {
   // such frame (the renderer resets half_sh_of with the scene).
   const Scene* half_sh_of = nullptr;
   std::vector<float> half_sh_dc, half_sh_rest;
+  // BlendGaussian's opacity-only terms (log2_opacity, q_cut) of scene `opacity_terms_of` with
+  // `opacity_terms_size` Gaussians, made by its first frame (the renderer resets it with the scene).
+  const Scene* opacity_terms_of = nullptr;
+  std::size_t opacity_terms_size = 0;
+  std::vector<float> log2_opacity, q_cut;  // [gaussians]
 
   // Emission: the pairs (tile, key) of each chunk of consecutive Gaussians, and the chunk's
   // per-tile histogram (then, after sort_by_tile's ranges, its write cursor per tile).
@@ -78,7 +83,29 @@ struct TileJob {
   const float* background;  // [3]
 };
 
-void project(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats);
+// Which kernel projects: both give the same bytes (the SIMD one runs gm::project's operations
+// per lane, in its order); the scalar one is the reference the tests compare with.
+enum class ProjectKernel { simd, scalar };
+void project(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats,
+             ProjectKernel kernel = ProjectKernel::simd);
+// Projects Gaussians [begin, end) into frame.footprints, cull and blend_data; `dc` and `rest`
+// are the scene's SH coefficients or their halves (fp16_sh), `degree` the bands used. The
+// scalar reference (cpu_project.cpp) and the SIMD kernel (cpu_project_simd.cpp; without
+// Highway it is the scalar one).
+void project_block_scalar(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
+                          std::int64_t begin, std::int64_t end);
+void project_block_simd(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
+                        std::int64_t begin, std::int64_t end);
+// BlendGaussian's row-pruning terms from its whitened rows, in double: (a c - b^2) / a =
+// det(W)^2 / a (Lagrange's identity); det(W) = w0 w3 - w1 w2 adds two non-negative terms, so a
+// needle (a nearly singular conic) keeps an accurate row minimum.
+inline void set_row_pruning(BlendGaussian& g) {
+  const double w0 = g.whiten[0], w1 = g.whiten[1], w2 = g.whiten[2], w3 = g.whiten[3];
+  const double conic_a = w0 * w0 + w2 * w2, det_w = w0 * w3 - w1 * w2;
+  g.row_q_coeff = static_cast<float>(det_w * det_w / conic_a);
+  g.row_slope = static_cast<float>(-(w0 * w1 + w2 * w3) / conic_a);
+  g.inv_conic_a = static_cast<float>(1.0 / conic_a);
+}
 void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats);
 // Sorts by tile, then depth, then Gaussian id; fills tile_start (the ranges stage).
 void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms);

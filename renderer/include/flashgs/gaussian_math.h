@@ -148,16 +148,22 @@ FLASHGS_HD void to_view(const CameraParams& cam, const float p[3], float v[3]) {
 // x/z and y/z clamped to the view frustum widened by 30% of its half-size on each side:
 // 3DGS's limit 1.3 tan(fov / 2), written for any principal point (identical to it when the
 // principal point is the image centre; the image spans pixel edges -0.5 .. width - 0.5).
-FLASHGS_HD void frustum_clamped_direction(const CameraParams& cam, float x_over_z, float y_over_z,
-                                          float& tx, float& ty) {
+// The limits as {x_lo, x_hi, y_lo, y_hi}: per camera, so the CPU's SIMD project computes them once.
+FLASHGS_HD void frustum_limits(const CameraParams& cam, float limits[4]) {
   const float margin_x = static_cast<float>(model::kFrustumMargin) * static_cast<float>(cam.width);
   const float margin_y = static_cast<float>(model::kFrustumMargin) * static_cast<float>(cam.height);
-  const float x_lo = -(cam.cx + 0.5f + margin_x) / cam.fx;
-  const float x_hi = (static_cast<float>(cam.width) - 0.5f - cam.cx + margin_x) / cam.fx;
-  const float y_lo = -(cam.cy + 0.5f + margin_y) / cam.fy;
-  const float y_hi = (static_cast<float>(cam.height) - 0.5f - cam.cy + margin_y) / cam.fy;
-  tx = clampf(x_over_z, x_lo, x_hi);
-  ty = clampf(y_over_z, y_lo, y_hi);
+  limits[0] = -(cam.cx + 0.5f + margin_x) / cam.fx;
+  limits[1] = (static_cast<float>(cam.width) - 0.5f - cam.cx + margin_x) / cam.fx;
+  limits[2] = -(cam.cy + 0.5f + margin_y) / cam.fy;
+  limits[3] = (static_cast<float>(cam.height) - 0.5f - cam.cy + margin_y) / cam.fy;
+}
+
+FLASHGS_HD void frustum_clamped_direction(const CameraParams& cam, float x_over_z, float y_over_z,
+                                          float& tx, float& ty) {
+  float limits[4];
+  frustum_limits(cam, limits);
+  tx = clampf(x_over_z, limits[0], limits[1]);
+  ty = clampf(y_over_z, limits[2], limits[3]);
 }
 
 // The culls that need only the view-space centre and the opacity, in project()'s order
