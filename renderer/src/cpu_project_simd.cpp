@@ -97,7 +97,7 @@ struct Lanes {
   HWY_ALIGN float conic_a[kMax], conic_b[kMax], conic_c[kMax];
   HWY_ALIGN float w0[kMax], w1[kMax], w2[kMax], w3[kMax];
   HWY_ALIGN float edge_slope_x[kMax], edge_slope_y[kMax];
-  HWY_ALIGN float red[kMax], green[kMax], blue[kMax];
+  HWY_ALIGN float sh_basis[16][kMax];  // gm::sh_basis, per lane
 };
 
 // A lane's cull reason: the first one that applies, as in gm::project's early returns.
@@ -289,67 +289,69 @@ bool project_vector(const Scene& scene, const Frame& frame, std::int64_t i, Lane
   return true;
 }
 
-// gm::sh_to_rgb<DEGREE> for the lanes of Gaussians [i, i + lanes): the same basis expressions,
-// the sum over k in the same order. The higher bands are gathered (stride rest_n per lane).
+// gm::sh_basis<DEGREE> for the lanes of Gaussians [i, i + lanes), the same expressions (and
+// sh_to_rgb's normalised direction). The sums over the coefficients follow per visible lane.
 template <int DEGREE>
-void sh_vector(const Scene& scene, const Frame& frame, const float* dc, const float* rest, std::int64_t i,
-               Lanes& out) {
+void sh_basis_vector(const Scene& scene, const Frame& frame, std::int64_t i, Lanes& out) {
+  if (DEGREE == 0) return;  // basis[0] is a constant
   const FloatTag d;
-  const IntTag di;
   FloatVec basis[16];
-  basis[0] = hn::Set(d, gm::kShC0);
-  if (DEGREE > 0) {
-    FloatVec x, y, z;
-    hn::LoadInterleaved3(d, &scene.positions[i * 3], x, y, z);
-    x = hn::Sub(x, hn::Set(d, frame.camera.position[0]));
-    y = hn::Sub(y, hn::Set(d, frame.camera.position[1]));
-    z = hn::Sub(z, hn::Set(d, frame.camera.position[2]));
-    const FloatVec len2 = dot3(x, y, z, x, y, z);
-    const FloatVec inv =
-        hn::IfThenElse(hn::Gt(len2, hn::Zero(d)), hn::Div(hn::Set(d, 1.0f), hn::Sqrt(len2)), hn::Zero(d));
-    x = hn::Mul(x, inv);
-    y = hn::Mul(y, inv);
-    z = hn::Mul(z, inv);
-    basis[1] = hn::Mul(hn::Set(d, -gm::kShC1), y);
-    basis[2] = hn::Mul(hn::Set(d, gm::kShC1), z);
-    basis[3] = hn::Mul(hn::Set(d, -gm::kShC1), x);
-    if (DEGREE > 1) {
-      const FloatVec xx = hn::Mul(x, x), yy = hn::Mul(y, y), zz = hn::Mul(z, z);
-      auto c = [&](float constant) { return hn::Set(d, constant); };
-      basis[4] = hn::Mul(hn::Mul(c(gm::kShC2_0), x), y);
-      basis[5] = hn::Mul(hn::Mul(c(gm::kShC2_1), y), z);
-      basis[6] = hn::Mul(c(gm::kShC2_2), hn::Sub(hn::Sub(hn::Mul(c(2.0f), zz), xx), yy));
-      basis[7] = hn::Mul(hn::Mul(c(gm::kShC2_3), x), z);
-      basis[8] = hn::Mul(c(gm::kShC2_4), hn::Sub(xx, yy));
-      if (DEGREE > 2) {
-        const FloatVec four_zz_xx_yy = hn::Sub(hn::Sub(hn::Mul(c(4.0f), zz), xx), yy);
-        basis[9] = hn::Mul(hn::Mul(c(gm::kShC3_0), y), hn::Sub(hn::Mul(c(3.0f), xx), yy));
-        basis[10] = hn::Mul(hn::Mul(hn::Mul(c(gm::kShC3_1), x), y), z);
-        basis[11] = hn::Mul(hn::Mul(c(gm::kShC3_2), y), four_zz_xx_yy);
-        basis[12] = hn::Mul(hn::Mul(c(gm::kShC3_3), z),
-                            hn::Sub(hn::Sub(hn::Mul(c(2.0f), zz), hn::Mul(c(3.0f), xx)), hn::Mul(c(3.0f), yy)));
-        basis[13] = hn::Mul(hn::Mul(c(gm::kShC3_4), x), four_zz_xx_yy);
-        basis[14] = hn::Mul(hn::Mul(c(gm::kShC3_5), z), hn::Sub(xx, yy));
-        basis[15] = hn::Mul(hn::Mul(c(gm::kShC3_6), x), hn::Sub(xx, hn::Mul(c(3.0f), yy)));
-      }
+  FloatVec x, y, z;
+  hn::LoadInterleaved3(d, &scene.positions[i * 3], x, y, z);
+  x = hn::Sub(x, hn::Set(d, frame.camera.position[0]));
+  y = hn::Sub(y, hn::Set(d, frame.camera.position[1]));
+  z = hn::Sub(z, hn::Set(d, frame.camera.position[2]));
+  const FloatVec len2 = dot3(x, y, z, x, y, z);
+  const FloatVec inv =
+      hn::IfThenElse(hn::Gt(len2, hn::Zero(d)), hn::Div(hn::Set(d, 1.0f), hn::Sqrt(len2)), hn::Zero(d));
+  x = hn::Mul(x, inv);
+  y = hn::Mul(y, inv);
+  z = hn::Mul(z, inv);
+  basis[1] = hn::Mul(hn::Set(d, -gm::kShC1), y);
+  basis[2] = hn::Mul(hn::Set(d, gm::kShC1), z);
+  basis[3] = hn::Mul(hn::Set(d, -gm::kShC1), x);
+  if (DEGREE > 1) {
+    const FloatVec xx = hn::Mul(x, x), yy = hn::Mul(y, y), zz = hn::Mul(z, z);
+    auto c = [&](float constant) { return hn::Set(d, constant); };
+    basis[4] = hn::Mul(hn::Mul(c(gm::kShC2_0), x), y);
+    basis[5] = hn::Mul(hn::Mul(c(gm::kShC2_1), y), z);
+    basis[6] = hn::Mul(c(gm::kShC2_2), hn::Sub(hn::Sub(hn::Mul(c(2.0f), zz), xx), yy));
+    basis[7] = hn::Mul(hn::Mul(c(gm::kShC2_3), x), z);
+    basis[8] = hn::Mul(c(gm::kShC2_4), hn::Sub(xx, yy));
+    if (DEGREE > 2) {
+      const FloatVec four_zz_xx_yy = hn::Sub(hn::Sub(hn::Mul(c(4.0f), zz), xx), yy);
+      basis[9] = hn::Mul(hn::Mul(c(gm::kShC3_0), y), hn::Sub(hn::Mul(c(3.0f), xx), yy));
+      basis[10] = hn::Mul(hn::Mul(hn::Mul(c(gm::kShC3_1), x), y), z);
+      basis[11] = hn::Mul(hn::Mul(c(gm::kShC3_2), y), four_zz_xx_yy);
+      basis[12] = hn::Mul(hn::Mul(c(gm::kShC3_3), z),
+                          hn::Sub(hn::Sub(hn::Mul(c(2.0f), zz), hn::Mul(c(3.0f), xx)), hn::Mul(c(3.0f), yy)));
+      basis[13] = hn::Mul(hn::Mul(c(gm::kShC3_4), x), four_zz_xx_yy);
+      basis[14] = hn::Mul(hn::Mul(c(gm::kShC3_5), z), hn::Sub(xx, yy));
+      basis[15] = hn::Mul(hn::Mul(c(gm::kShC3_6), x), hn::Sub(xx, hn::Mul(c(3.0f), yy)));
     }
   }
-  FloatVec channel[3];
-  hn::LoadInterleaved3(d, dc + i * 3, channel[0], channel[1], channel[2]);
-  const int rest_n = scene.sh_rest_per_gaussian();
-  const IntVec offsets = hn::Mul(hn::Iota(di, 0), hn::Set(di, rest_n));
-  const float* lane_rest = DEGREE > 0 ? rest + i * rest_n : nullptr;
-  float* rgb[3] = {out.red, out.green, out.blue};
-  for (int ch = 0; ch < 3; ++ch) {
-    FloatVec sum = hn::Mul(basis[0], channel[ch]);
-    for (int k = 1; k < (DEGREE + 1) * (DEGREE + 1); ++k)
-      sum = hn::Add(sum, hn::Mul(basis[k], hn::GatherIndex(d, lane_rest + (k - 1) * 3 + ch, offsets)));
-    hn::Store(max_as_scalar(hn::Add(sum, hn::Set(d, 0.5f)), hn::Zero(d)), d, rgb[ch]);
-  }
+  for (int k = 1; k < (DEGREE + 1) * (DEGREE + 1); ++k) hn::Store(basis[k], d, out.sh_basis[k]);
+}
+
+// gm::sh_to_rgb's sums for one Gaussian, its three channels in the lanes of one 4-lane vector:
+// basis[0] dc, then + basis[k] rest[k - 1] for k = 1, 2, ... (the scalar order per channel). Each
+// load takes 4 floats where the Gaussian has 3 from there on: the 4th (the next coefficient, or
+// the next Gaussian's) lands in the unused lane; the scene's last Gaussian never comes here.
+template <int DEGREE>
+HWY_INLINE void sh_sums(const float* dc, const float* rest, const Lanes& v, std::size_t lane, float* rgb) {
+  const hn::FixedTag<float, 4> d4;
+  auto sum = hn::Mul(hn::Set(d4, gm::kShC0), hn::LoadU(d4, dc));
+  for (int k = 1; k < (DEGREE + 1) * (DEGREE + 1); ++k)
+    sum = hn::Add(sum, hn::Mul(hn::Set(d4, v.sh_basis[k][lane]), hn::LoadU(d4, rest + (k - 1) * 3)));
+  const auto shifted = hn::Add(sum, hn::Set(d4, 0.5f));
+  hn::StoreU(hn::IfThenElse(hn::Gt(shifted, hn::Zero(d4)), shifted, hn::Zero(d4)), d4, rgb);
 }
 
 // The visible lanes into Frame's arrays, as the scalar reference writes them.
-void store_lanes(const Scene& scene, Frame& frame, std::int64_t i, std::size_t lanes, const Lanes& v) {
+template <int DEGREE>
+void store_lanes(const Scene& scene, const float* dc, const float* rest, Frame& frame, std::int64_t i,
+                 std::size_t lanes, const Lanes& v) {
+  const int rest_n = scene.sh_rest_per_gaussian();
   for (std::size_t l = 0; l < lanes; ++l) {
     const std::int64_t id = i + static_cast<std::int64_t>(l);
     frame.cull[id] = static_cast<std::uint8_t>(v.reason[l]);
@@ -377,9 +379,9 @@ void store_lanes(const Scene& scene, Frame& frame, std::int64_t i, std::size_t l
     g.mean_y = f.mean_y;
     for (int k = 0; k < 4; ++k) g.whiten[k] = f.whiten[k];
     g.opacity = scene.opacities[id];
-    g.rgb[0] = v.red[l];
-    g.rgb[1] = v.green[l];
-    g.rgb[2] = v.blue[l];
+    HWY_ALIGN float rgb[4];
+    sh_sums<DEGREE>(dc + id * 3, DEGREE > 0 ? rest + id * rest_n : nullptr, v, l, rgb);
+    for (int ch = 0; ch < 3; ++ch) g.rgb[ch] = rgb[ch];
     g.log2_opacity = frame.log2_opacity[id];
     g.q_cut = frame.q_cut[id];
     set_row_pruning(g);  // in double, per visible Gaussian
@@ -393,8 +395,8 @@ void project_vectors(const Scene& scene, const float* dc, const float* rest, Fra
   Lanes v;
   for (std::int64_t i = begin; i < end; i += lanes) {
     if (project_vector<kOpacityRadius, kTightBox, kBaseline>(scene, frame, i, v))
-      sh_vector<DEGREE>(scene, frame, dc, rest, i, v);
-    store_lanes(scene, frame, i, static_cast<std::size_t>(lanes), v);
+      sh_basis_vector<DEGREE>(scene, frame, i, v);
+    store_lanes<DEGREE>(scene, dc, rest, frame, i, static_cast<std::size_t>(lanes), v);
   }
 }
 
@@ -419,7 +421,9 @@ void project_vectors_of_degree(const Scene& scene, const float* dc, const float*
 void ProjectBlock(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
                   std::int64_t begin, std::int64_t end) {
   const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(FloatTag()));
-  const std::int64_t vector_end = begin + (end - begin) / lanes * lanes;
+  // The scene's last Gaussian goes to the scalar code: sh_sums reads a float past its coefficients.
+  const std::int64_t vector_limit = std::min(end, static_cast<std::int64_t>(scene.size()) - 1);
+  const std::int64_t vector_end = begin + std::max<std::int64_t>(0, vector_limit - begin) / lanes * lanes;
   switch (degree) {
     case 0: project_vectors_of_degree<0>(scene, dc, rest, frame, begin, vector_end); break;
     case 1: project_vectors_of_degree<1>(scene, dc, rest, frame, begin, vector_end); break;
