@@ -12,6 +12,7 @@
 
 #include "cpu_frame.h"  // cpu::project and its kernels
 #include "flashgs/frame_params.h"
+#include "flashgs/renderer.h"
 #include "flashgs/stress_scenes.h"
 #include "test_support.h"
 
@@ -223,6 +224,49 @@ TEST(CpuProjectSimd, RealScenesGiveTheScalarBytes) {
                 totals.visible(), totals.culled());
     EXPECT_GT(totals.visible(), 0u) << name;
   }
+}
+
+// The opacity terms are cached per scene (Frame::opacity_terms_of). A frame after the scene
+// grew in place recomputes them: its results are a fresh frame's.
+TEST(CpuProjectOpacityTerms, FollowASceneThatChangesSizeInPlace) {
+  const auto demo = test::load_demo_scene();
+  const Camera camera = test::load_demo_cameras()[0];
+  const RenderOptions options;
+  Scene scene = first_gaussians(*demo, 1000);
+  cpu::Frame frame;
+  frame.camera = make_camera_params(camera);
+  frame.geometry = make_geometry_params(options);
+  FrameStats stats;
+  cpu::project(scene, options, frame, stats);
+  scene = first_gaussians(*demo, 2000);  // the same address, more Gaussians
+  for (float& opacity : scene.opacities) opacity *= 0.5f;
+  cpu::project(scene, options, frame, stats);
+  const Projected fresh = project(scene, camera, options, cpu::ProjectKernel::simd, 1);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < scene.size(); ++i)
+    if (fresh.cull[i] == gm::kVisible)
+      differ += std::memcmp(&fresh.blend_data[i], &frame.blend_data[i], sizeof(cpu::BlendGaussian)) != 0;
+  EXPECT_GT(fresh.reasons[gm::kVisible], 0u);
+  EXPECT_EQ(differ, 0u);
+}
+
+// A scene edited in place and set again (the same pointer, the same size): the renderer
+// recomputes its opacity terms, and renders what a fresh renderer does.
+TEST(CpuProjectOpacityTerms, FollowASceneSetAgainAfterAnEdit) {
+  auto scene = std::make_shared<Scene>(*test::load_demo_scene());
+  const Camera camera = test::load_demo_cameras()[0].resized(320, 180);
+  auto renderer = make_cpu_renderer(1);
+  renderer->set_scene(scene);
+  Image before, after, fresh;
+  renderer->render(camera, RenderOptions{}, before, nullptr);
+  for (float& opacity : scene->opacities) opacity *= 0.5f;
+  renderer->set_scene(scene);
+  renderer->render(camera, RenderOptions{}, after, nullptr);
+  auto other = make_cpu_renderer(1);
+  other->set_scene(scene);
+  other->render(camera, RenderOptions{}, fresh, nullptr);
+  EXPECT_NE(before.rgb, fresh.rgb);  // the edit shows
+  EXPECT_EQ(after.rgb, fresh.rgb);
 }
 
 }  // namespace
