@@ -109,7 +109,9 @@ class CullReasons {
     m_reason = hn::IfThenElse(newly, hn::Set(IntTag(), reason), m_reason);
     m_open = hn::AndNot(newly, m_open);
   }
-  void cull_where(hn::Mask<IntTag> culled, gm::CullReason reason) { cull_where(hn::RebindMask(FloatTag(), culled), reason); }
+  void cull_where(hn::Mask<IntTag> culled, gm::CullReason reason) {
+    cull_where(hn::RebindMask(FloatTag(), culled), reason);
+  }
   bool none_left() const { return hn::AllFalse(IntTag(), m_open); }
   IntVec reasons() const { return m_reason; }
 
@@ -243,16 +245,20 @@ bool project_vector(const Scene& scene, const Frame& frame, std::int64_t i, Lane
     // 3DGS getRect, as gm::project: clamped in float, then truncated.
     const FloatVec tiles_x = hn::Set(d, static_cast<float>(cam.tiles_x));
     const FloatVec tiles_y = hn::Set(d, static_cast<float>(cam.tiles_y));
-    auto tile_of = [&](FloatVec edge, FloatVec tiles) { return hn::ConvertTo(di, clamp(hn::Div(edge, ts), zero, tiles)); };
+    auto tile_of = [&](FloatVec edge, FloatVec tiles) {
+      return hn::ConvertTo(di, clamp(hn::Div(edge, ts), zero, tiles));
+    };
     tile_x0 = tile_of(hn::Sub(mean_x, half_x), tiles_x);
     tile_x1 = tile_of(hn::Sub(hn::Add(hn::Add(mean_x, half_x), ts), one), tiles_x);
     tile_y0 = tile_of(hn::Sub(mean_y, half_y), tiles_y);
     tile_y1 = tile_of(hn::Sub(hn::Add(hn::Add(mean_y, half_y), ts), one), tiles_y);
   } else {
     const FloatVec px0 = max_as_scalar(hn::Ceil(hn::Sub(mean_x, half_x)), zero);
-    const FloatVec px1 = min_as_scalar(hn::Floor(hn::Add(mean_x, half_x)), hn::Set(d, static_cast<float>(cam.width - 1)));
+    const FloatVec last_x = hn::Set(d, static_cast<float>(cam.width - 1));
+    const FloatVec last_y = hn::Set(d, static_cast<float>(cam.height - 1));
+    const FloatVec px1 = min_as_scalar(hn::Floor(hn::Add(mean_x, half_x)), last_x);
     const FloatVec py0 = max_as_scalar(hn::Ceil(hn::Sub(mean_y, half_y)), zero);
-    const FloatVec py1 = min_as_scalar(hn::Floor(hn::Add(mean_y, half_y)), hn::Set(d, static_cast<float>(cam.height - 1)));
+    const FloatVec py1 = min_as_scalar(hn::Floor(hn::Add(mean_y, half_y)), last_y);
     cull.cull_where(hn::Not(hn::And(hn::Le(px0, px1), hn::Le(py0, py1))), gm::kCulledOffscreen);
     // Pixel indices >= 0 on every lane still open: / kTileSize is a shift.
     static_assert(gm::kTileSize == 16, "the shifts below divide by 16");
