@@ -104,7 +104,9 @@ void project(const Scene& scene, const RenderOptions& options, Frame& frame, Fra
   const std::int64_t count = static_cast<std::int64_t>(n), blocks = (count + kBlock - 1) / kBlock;
   const auto project_block = kernel == ProjectKernel::simd ? project_block_simd : project_block_scalar;
   ParallelErrors errors;
-#pragma omp parallel for schedule(static) num_threads(frame.threads)
+  // Taken dynamically: the visible Gaussians, which cost the most, are uneven along the scene's
+  // order (pc_playbot camera 0 at 1080p: 63% of them in the first half).
+#pragma omp parallel for schedule(dynamic, 1) num_threads(frame.threads)
   for (std::int64_t b = 0; b < blocks; ++b)
     errors.capture([&] {
       project_block(scene, dc, rest, degree, frame, b * kBlock, std::min(count, (b + 1) * kBlock));
