@@ -3,6 +3,7 @@
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-ab bench-env bench
 #                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
+#                                       cpu-simd-tests build-prev bench-cpu-prev
 #                                       profile-blend profile-sass
 #                                       build-bg wait-build
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
@@ -44,7 +45,7 @@ build() {
     -DCMAKE_PREFIX_PATH="$ROOT/.deps/sysroot/usr" \
     -DCMAKE_CUDA_ARCHITECTURES=90 -DFLASHGS_BUILD_APP=OFF -DFLASHGS_SHARED_SCENES="$SCENES" \
     -DFLASHGS_GTEST_SOURCE_DIR="$ROOT/.deps/googletest" > "$OUT/build.log" 2>&1 &&
-    ninja -C build-dev flashgs test_cuda_render test_stress_gpu >> "$OUT/build.log" 2>&1
+    ninja -C build-dev flashgs test_cuda_render test_stress_gpu test_cpu_simd test_cpu_project_simd >> "$OUT/build.log" 2>&1
   local rc=$?
   log "device build rc=$rc"
   if [ $rc -eq 0 ]; then
@@ -140,14 +141,32 @@ bench() {
   bench_scene /tmp/tile7 bench_tile7 --backend cuda -r 1920x1080,3840x2160 --configs baseline,flash --warmup 2 --repeat 5
 }
 
-bench_cpu() {  # the CPU backend on 1, 2 and every host thread (CPU_THREADS)
+bench_cpu() {  # the CPU backend on 1, 2 and every host thread (CPU_THREADS); TAG prefixes the files
   for threads in ${CPU_THREADS:-1 2 $(nproc)}; do
-    log "bench cpu pc_playbot 1080p, $threads threads"
-    OMP_NUM_THREADS=$threads bench_scene "$SCENES/pc_playbot" bench_playbot_cpu_t$threads --backend cpu -r 1920x1080 \
-      --configs baseline,flash --camera-list 0,10,20 --warmup 1 --repeat 3 | grep -E "^[0-9]+x"
-    log "bench cpu pc_biker 1280x800, $threads threads"
-    OMP_NUM_THREADS=$threads bench_scene "$SCENES/pc_biker" bench_biker_cpu_t$threads --backend cpu -r 1280x800 \
-      --configs baseline,flash --camera-list 0,10,20 --warmup 1 --repeat 3 | grep -E "^[0-9]+x"
+    log "bench cpu ${TAG:-}pc_playbot 1080p, $threads threads"
+    OMP_NUM_THREADS=$threads bench_scene "$SCENES/pc_playbot" ${TAG:-}bench_playbot_cpu_t$threads --backend cpu \
+      -r 1920x1080 --configs baseline,flash --camera-list 0,10,20 --warmup 1 --repeat 3 | grep -E "^[0-9]+x"
+    log "bench cpu ${TAG:-}pc_biker 1280x800, $threads threads"
+    OMP_NUM_THREADS=$threads bench_scene "$SCENES/pc_biker" ${TAG:-}bench_biker_cpu_t$threads --backend cpu \
+      -r 1280x800 --configs baseline,flash --camera-list 0,10,20 --warmup 1 --repeat 3 | grep -E "^[0-9]+x"
+  done
+}
+
+build_prev() {  # an earlier tree's flashgs (CPU backend only) into /tmp/prev/b, for an A/B in the same run:
+  # .deps/prev.tar.gz (made with `git archive <commit> -- . ':!docs' ':!assets' | gzip`)
+  rm -rf /tmp/prev && mkdir -p /tmp/prev && tar xzf "$ROOT/.deps/prev.tar.gz" -C /tmp/prev &&
+    cmake -S /tmp/prev -B /tmp/prev/b -G Ninja -DCMAKE_BUILD_TYPE=Release -DFLASHGS_WITH_CUDA=OFF \
+      -DFLASHGS_HEADER_DEPS_DIR="$ROOT/.deps/include" -DCMAKE_PREFIX_PATH="$ROOT/.deps/sysroot/usr" \
+      -DFLASHGS_BUILD_APP=OFF -DFLASHGS_BUILD_TESTS=OFF > "$OUT/build_prev.log" 2>&1 &&
+    ninja -C /tmp/prev/b flashgs >> "$OUT/build_prev.log" 2>&1
+  log "build of the earlier tree rc=$?"
+}
+
+cpu_simd_tests() {  # the SIMD kernels against the scalar ones on every target this host runs (AVX-512 here)
+  for t in test_cpu_simd test_cpu_project_simd; do
+    log "$t"
+    "$ROOT/build-dev/tests/$t" > "$OUT/$t.log" 2>&1
+    log "$t rc=$? $(grep -E '^\[  (PASSED|FAILED)' "$OUT/$t.log" | tr '\n' ' ')"
   done
 }
 
@@ -231,6 +250,9 @@ for step in "$@"; do
     bench-large) bench_large ;;
     bench-prev) (FLASHGS=$BIN/flashgs_prev TAG=prev_ bench_regions) ;;  # a carried earlier build, to compare
     bench-cpu) bench_cpu ;;
+    build-prev) build_prev ;;
+    bench-cpu-prev) (FLASHGS=/tmp/prev/b/app/flashgs TAG=prev_ bench_cpu) ;;
+    cpu-simd-tests) cpu_simd_tests ;;
     bench-scale) bench_scale ;;
     report) report ;;
     profile) profile ;;
