@@ -150,19 +150,22 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   const int tile_w = std::min(gm::kTileSize, width - x_begin);
   const int tile_h = std::min(gm::kTileSize, height - y_begin);
 
-  // The tile's vectors ("slots"): lane group j of row y is bit j * kTileSize + y of a 64-bit
-  // set (16 rows x at most 4 groups), so that a row mask shifted by j * kTileSize is group j's.
-  // Per slot, one vector each, next to each other (one base address per slot): the pixels'
-  // image x, transmittance, colour, and whether they still blend (all bits set) - pixels
-  // outside the image start finished. A slot whose lanes have all finished leaves live_slots,
-  // and the tile stops when none is left.
-  static_assert(gm::kTileSize <= 16, "64 slot bits: 16 rows of at most 4 lane groups");
+  // The tile's vectors ("slots"): lane group j of row y is slot j * kTileSize + y (16 rows x at
+  // most 4 groups), bit `slot` of a 64-bit set. Per slot, one vector each, next to each other
+  // (one base address per slot): the pixels' image x, transmittance, colour, and whether they
+  // still blend (all bits set) - pixels outside the image start finished. A slot whose lanes
+  // have all finished leaves live_slots (and slot_live, the same as a word per slot, which the
+  // span pass reads a vector of rows at a time), and the tile stops when none is left.
+  static_assert(gm::kTileSize <= 16, "64 slots: 16 rows of at most 4 lane groups");
   enum SlotField { kX, kT, kRed, kGreen, kBlue, kActive, kSlotFields };
   constexpr int kMaxSlots = 64;
   HWY_ALIGN float slot_state[kSlotFields * kTilePixels];
   const auto slot_field = [&](int slot, SlotField field) {
     return slot_state + (slot * kSlotFields + field) * lanes_i;
   };
+  const hn::RebindToUnsigned<FloatTag> du;
+  // Padded: a vector of rows from a Gaussian's first row may run past the last group's row 15.
+  HWY_ALIGN std::uint32_t slot_live[kMaxSlots + gm::kTileSize] = {};
   std::uint64_t live_slots = 0;
   const auto tile_width = hn::Set(d, static_cast<float>(tile_w));
   for (int y = 0; y < gm::kTileSize; ++y)
@@ -176,27 +179,32 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       hn::Store(hn::Zero(d), d, slot_field(slot, kGreen));
       hn::Store(hn::Zero(d), d, slot_field(slot, kBlue));
       hn::Store(hn::VecFromMask(d, inside), d, slot_field(slot, kActive));
-      if (!hn::AllFalse(d, inside)) live_slots |= std::uint64_t{1} << slot;
+      if (!hn::AllFalse(d, inside)) {
+        live_slots |= std::uint64_t{1} << slot;
+        slot_live[slot] = ~0u;
+      }
     }
 
   if (job.count > 0) gather(frame, job, y_begin, tile_h, g);
-  // The Gaussians blend in batches of up to kBatch that meet a live slot, slot by slot: a
+  // The Gaussians blend in batches of up to kBatch that touch a live slot, slot by slot: a
   // slot's state stays in registers while the batch's Gaussians that touch it blend in order,
   // so it is loaded and stored once per batch instead of once per Gaussian. Per pixel the
   // Gaussians and the operations are those of one Gaussian at a time, in the same order.
-  // Per batch member: its broadcast constants (one vector each, read as memory operands),
-  // its rows' terms of u and w (whiten[1] dy, whiten[3] dy; a vector of rows from y_first
-  // may run past row 15 into the padding), and per slot the set of members that touch it.
-  constexpr int kBatch = 16;
-  enum MemberField { kCentreX, kW0, kW2, kLog2Opacity, kMemberRed, kMemberGreen, kMemberBlue, kMemberFields };
-  HWY_ALIGN float member_constants[kBatch * kMemberFields * gm::kTileSize];
-  HWY_ALIGN float member_u[kBatch][2 * gm::kTileSize], member_w[kBatch][2 * gm::kTileSize];
-  std::uint32_t slot_members[kMaxSlots] = {};
+  // Per batch member, one record: its broadcast constants (one vector each, read as memory
+  // operands; one spare), then its rows' terms of u and w (whiten[1] dy, whiten[3] dy; a
+  // vector of rows from y_first may run past row 15). Per slot, the set of members that touch
+  // it (bit j: member j), written by the span pass a vector of rows at a time.
+  constexpr int kBatch = 32;
   static_assert(kBatch <= 32, "member sets of 32 bits");
-  // A row mask repeated for every lane group: the slots of those rows.
-  std::uint64_t every_group = 0;
-  for (int v = 0; v < groups_per_row; ++v) every_group |= std::uint64_t{1} << (v * gm::kTileSize);
+  enum MemberField { kCentreX, kW0, kW2, kLog2Opacity, kMemberRed, kMemberGreen, kMemberBlue, kMemberFields = 8 };
+  constexpr std::size_t kRowTerms = 2 * gm::kTileSize;
+  const std::size_t u_terms = kMemberFields * lanes, w_terms = u_terms + kRowTerms;
+  const std::size_t member_stride = w_terms + kRowTerms;
+  HWY_ALIGN float member_records[kBatch * (kMemberFields * gm::kTileSize + 2 * kRowTerms)];
+  HWY_ALIGN std::uint32_t slot_members[kMaxSlots + gm::kTileSize] = {};
+  const int slot_count = groups_per_row * gm::kTileSize;
   const auto zero = hn::Zero(d), one = hn::Set(d, 1.0f), minus_half_log2e = hn::Set(d, -kHalfLog2E);
+  const auto no_members = hn::Zero(du);
   const auto tile_left = hn::Set(d, static_cast<float>(x_begin));
   const auto tile_right = hn::Set(d, static_cast<float>(tile_w - 1));
   const auto alpha_max = hn::Set(d, gm::kAlphaMax), alpha_min = hn::Set(d, gm::kAlphaMin);
@@ -204,68 +212,69 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   std::uint64_t k = 0;
   while (k < job.count && live_slots != 0) {
     int members = 0;
-    std::uint64_t batch_slots = 0;
     for (; k < job.count && members < kBatch; ++k) {
       const int y_first = g.row_first[k], y_last = g.row_last[k];
       if (y_first > y_last) continue;
       const BlendGaussian& gauss = frame.blend_data[static_cast<std::uint32_t>(job.keys[k])];
       const float mean_x = gauss.mean_x, mean_y = gauss.mean_y;
-      const float q_reach = gauss.q_cut + 0.5f;
-      // Bit of slot (group j, row y): row y's span of pixels that can reach power_cut meets
-      // group j. Only these slots, and only while live, are visited.
-      std::uint64_t touched_slots = 0;
+      float* member = member_records + static_cast<std::size_t>(members) * member_stride;
+      // The slots whose row's span of pixels that can reach power_cut meets their group, and
+      // which are live, get this member's bit.
+      auto touches_any = no_members;
       {
         // The scalar kernel's row spans, computed the same way for a vector of rows at a time.
-        const auto q_reach_v = hn::Set(d, q_reach), coeff = hn::Set(d, gauss.row_q_coeff);
+        const auto q_reach = hn::Set(d, gauss.q_cut + 0.5f), coeff = hn::Set(d, gauss.row_q_coeff);
         const auto slope = hn::Set(d, gauss.row_slope), inv_conic_a = hn::Set(d, gauss.inv_conic_a);
         const auto mean_y_v = hn::Set(d, mean_y), w1 = hn::Set(d, gauss.whiten[1]), w3 = hn::Set(d, gauss.whiten[3]);
         const auto centre_x = hn::Set(d, mean_x);
+        const auto member_bit = hn::Set(du, 1u << members);
         for (int row = y_first; row <= y_last; row += lanes_i) {
           const auto dy = hn::Sub(hn::Iota(d, static_cast<float>(y_begin + row)), mean_y_v);
           const auto row_q = hn::Mul(hn::Mul(coeff, dy), dy);
           const auto centre = hn::Sub(hn::Add(centre_x, hn::Mul(slope, dy)), tile_left);
           const auto half =
-              hn::Add(hn::Sqrt(hn::Mul(max_like_std(zero, hn::Sub(q_reach_v, row_q)), inv_conic_a)), one);
+              hn::Add(hn::Sqrt(hn::Mul(max_like_std(zero, hn::Sub(q_reach, row_q)), inv_conic_a)), one);
           const auto first = max_like_std(zero, hn::Ceil(hn::Sub(centre, half)));
           const auto last = min_like_std(tile_right, hn::Floor(hn::Add(centre, half)));
-          // The scalar kernel skips a row unless row_q <= q_reach (false for NaN) and first <= last.
-          const auto touched = hn::And(hn::Le(row_q, q_reach_v), hn::Le(first, last));
-          hn::StoreU(hn::Mul(w1, dy), d, member_u[members] + row);
-          hn::StoreU(hn::Mul(w3, dy), d, member_w[members] + row);
+          // The scalar kernel skips a row unless row_q <= q_reach (false for NaN) and first <=
+          // last, and rows past y_last (past the tile, or outside its row range).
+          const auto touched = hn::And(hn::FirstN(d, static_cast<std::size_t>(y_last + 1 - row)),
+                                       hn::And(hn::Le(row_q, q_reach), hn::Le(first, last)));
+          hn::StoreU(hn::Mul(w1, dy), d, member + u_terms + row);
+          hn::StoreU(hn::Mul(w3, dy), d, member + w_terms + row);
           // Group j holds columns [j lanes, (j + 1) lanes): the span meets it unless it ends
           // before or starts after.
           for (int v = 0; v < groups_per_row; ++v) {
-            const auto meets =
-                hn::And(touched, hn::And(hn::Lt(first, hn::Set(d, static_cast<float>((v + 1) * lanes_i))),
-                                         hn::Ge(last, hn::Set(d, static_cast<float>(v * lanes_i)))));
-            std::uint8_t bits[(gm::kTileSize + 7) / 8] = {};
-            hn::StoreMaskBits(d, meets, bits);
-            const std::uint64_t row_bits = bits[0] | (lanes > 8 ? static_cast<std::uint64_t>(bits[1]) << 8 : 0u);
-            touched_slots |= row_bits << (row + v * gm::kTileSize);
+            const auto meets = hn::And(touched, hn::And(hn::Lt(first, hn::Set(d, static_cast<float>((v + 1) * lanes_i))),
+                                                         hn::Ge(last, hn::Set(d, static_cast<float>(v * lanes_i)))));
+            const int slot = v * gm::kTileSize + row;
+            const auto touches = hn::IfThenElseZero(hn::RebindMask(du, meets), hn::LoadU(du, slot_live + slot));
+            touches_any = hn::Or(touches_any, touches);
+            hn::StoreU(hn::Or(hn::LoadU(du, slot_members + slot), hn::And(touches, member_bit)), du,
+                       slot_members + slot);
           }
         }
       }
-      // The span pass covers whole vectors of rows from y_first: keep [y_first, y_last]. Rows
-      // past the tile's last land in the next group's rows below y_first, which this drops.
-      const std::uint32_t in_range = ((2u << y_last) - 1u) & ~((1u << y_first) - 1u);
-      std::uint64_t slots = touched_slots & (in_range * every_group) & live_slots;
-      if (slots == 0) continue;
-      float* constants = member_constants + members * kMemberFields * lanes;
-      hn::Store(hn::Set(d, mean_x), d, constants + kCentreX * lanes);
-      hn::Store(hn::Set(d, gauss.whiten[0]), d, constants + kW0 * lanes);
-      hn::Store(hn::Set(d, gauss.whiten[2]), d, constants + kW2 * lanes);
-      hn::Store(hn::Set(d, gauss.log2_opacity), d, constants + kLog2Opacity * lanes);
-      hn::Store(hn::Set(d, gauss.rgb[0]), d, constants + kMemberRed * lanes);
-      hn::Store(hn::Set(d, gauss.rgb[1]), d, constants + kMemberGreen * lanes);
-      hn::Store(hn::Set(d, gauss.rgb[2]), d, constants + kMemberBlue * lanes);
-      batch_slots |= slots;
-      for (const std::uint32_t member_bit = 1u << members; slots != 0; slots &= slots - 1u)
-        slot_members[hwy::Num0BitsBelowLS1Bit_Nonzero64(slots)] |= member_bit;
+      if (hn::AllTrue(du, hn::Eq(touches_any, no_members))) continue;  // no live slot: not a member
+      hn::Store(hn::Set(d, mean_x), d, member + kCentreX * lanes);
+      hn::Store(hn::Set(d, gauss.whiten[0]), d, member + kW0 * lanes);
+      hn::Store(hn::Set(d, gauss.whiten[2]), d, member + kW2 * lanes);
+      hn::Store(hn::Set(d, gauss.log2_opacity), d, member + kLog2Opacity * lanes);
+      hn::Store(hn::Set(d, gauss.rgb[0]), d, member + kMemberRed * lanes);
+      hn::Store(hn::Set(d, gauss.rgb[1]), d, member + kMemberGreen * lanes);
+      hn::Store(hn::Set(d, gauss.rgb[2]), d, member + kMemberBlue * lanes);
       ++members;
+    }
+    // The slots some member touches.
+    std::uint64_t batch_slots = 0;
+    for (int slot = 0; slot < slot_count; slot += lanes_i) {
+      std::uint8_t bits[(gm::kTileSize + 7) / 8] = {};
+      hn::StoreMaskBits(du, hn::Not(hn::Eq(hn::Load(du, slot_members + slot), no_members)), bits);
+      batch_slots |= (bits[0] | (lanes > 8 ? static_cast<std::uint64_t>(bits[1]) << 8 : 0u)) << slot;
     }
     for (; batch_slots != 0; batch_slots &= batch_slots - 1u) {
       const int slot = static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero64(batch_slots));
-      const int row = slot % gm::kTileSize;
+      const std::size_t row = static_cast<std::size_t>(slot % gm::kTileSize);
       float* state = slot_field(slot, kX);
       const auto x = hn::Load(d, state + kX * lanes);
       auto t = hn::Load(d, state + kT * lanes);
@@ -274,15 +283,15 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       auto live = hn::MaskFromVec(hn::Load(d, state + kActive * lanes));
       std::uint32_t slot_batch = slot_members[slot];
       slot_members[slot] = 0;
-      // No early outs per visit (no lane above power_cut): the masks below make those lanes
-      // no-ops, and the branches mispredicted more than the work they saved (callgrind on
-      // pc_playbot: 29% fewer mispredicts for 5% more instructions).
+      // No early outs per visit (no lane above power_cut, a lane finishing): the masks below
+      // make those lanes no-ops, and the branches mispredicted more than the work they saved
+      // (callgrind on pc_playbot, session 5: 29% fewer mispredicts for 5% more instructions).
       for (; slot_batch != 0; slot_batch &= slot_batch - 1u) {
-        const int member = static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero32(slot_batch));
-        const float* constants = member_constants + member * kMemberFields * lanes;
+        const std::size_t offset = hwy::Num0BitsBelowLS1Bit_Nonzero32(slot_batch) * member_stride;
+        const float* constants = member_records + offset;
         const auto dx = hn::Sub(x, hn::Load(d, constants + kCentreX * lanes));
-        const auto u = hn::MulAdd(hn::Load(d, constants + kW0 * lanes), dx, hn::Set(d, member_u[member][row]));
-        const auto w = hn::MulAdd(hn::Load(d, constants + kW2 * lanes), dx, hn::Set(d, member_w[member][row]));
+        const auto u = hn::MulAdd(hn::Load(d, constants + kW0 * lanes), dx, hn::Set(d, constants[u_terms + row]));
+        const auto w = hn::MulAdd(hn::Load(d, constants + kW2 * lanes), dx, hn::Set(d, constants[w_terms + row]));
         const auto q = hn::MulAdd(u, u, hn::Mul(w, w));
         // Only the exact test: a lane outside the row's span or below power_cut has alpha <
         // 1/255 for certain (the margins the scalar kernel's pruning relies on), so it fails
@@ -290,18 +299,13 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         const auto alpha = hn::Min(
             alpha_max,
             exp2_nonpositive(d, hn::MulAdd(q, minus_half_log2e, hn::Load(d, constants + kLog2Opacity * lanes))));
-        auto blends = hn::And(live, hn::Ge(alpha, alpha_min));
+        const auto visible = hn::Ge(alpha, alpha_min);
         const auto next_t = hn::Mul(t, hn::Sub(one, alpha));
-        const auto finished = hn::And(blends, hn::Lt(next_t, t_min));
-        if (!hn::AllFalse(d, finished)) {
-          live = hn::AndNot(finished, live);
-          // No lane left: the slot is done (its remaining members would add nothing).
-          if (hn::AllFalse(d, live)) {
-            live_slots &= ~(std::uint64_t{1} << slot);
-            break;
-          }
-          blends = hn::AndNot(finished, blends);
-        }
+        // A live lane whose alpha passes but whose T would drop below the minimum finishes
+        // instead of blending; the others that pass blend.
+        const auto too_dark = hn::Lt(next_t, t_min);
+        const auto blends = hn::AndNot(too_dark, hn::And(live, visible));
+        live = hn::AndNot(hn::And(visible, too_dark), live);
         // Lanes that do not blend add colour * 0: the same bytes as leaving them (colours
         // start at +0 and stay >= 0), for one select instead of three.
         const auto weight = hn::IfThenElseZero(blends, hn::Mul(alpha, t));
@@ -315,6 +319,10 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       hn::Store(green, d, state + kGreen * lanes);
       hn::Store(blue, d, state + kBlue * lanes);
       hn::Store(hn::VecFromMask(d, live), d, state + kActive * lanes);
+      if (hn::AllFalse(d, live)) {
+        live_slots &= ~(std::uint64_t{1} << slot);
+        slot_live[slot] = 0;
+      }
     }
   }
   // Colour plus the transmittance's share of the background, as the scalar kernel (no FMA),
