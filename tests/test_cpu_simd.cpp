@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <future>
 #include <thread>
+#include <vector>
 
 #ifdef FLASHGS_HAVE_HWY
 #include <hwy/targets.h>
@@ -85,6 +86,68 @@ TEST(CpuSimdBlend, EveryTargetThisCpuRunsMatchesTheScalarKernel) {
   hwy::SetSupportedTargetsForTest(0);  // back to what the CPU supports
 #else
   GTEST_SKIP() << "built without Highway: the scalar kernel only";
+#endif
+}
+
+// A crowd of Gaussians in front of a small camera: footprints from under a pixel to several
+// tiles, opacities from faint to 1, so that each tile holds hundreds of them (several of the
+// SIMD kernel's batches), consecutive ones share some vectors of pixels and not others, and
+// pixels finish (T below 1e-4) at every point of a batch, many on a batch's first members.
+std::shared_ptr<const Scene> crowded_scene() {
+  auto scene = std::make_shared<Scene>();
+  constexpr int kCount = 6000;
+  std::uint32_t state = 12345;
+  const auto uniform = [&state](float lo, float hi) {
+    state = state * 1664525u + 1013904223u;
+    return lo + (hi - lo) * static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
+  };
+  for (int i = 0; i < kCount; ++i) {
+    const float z = uniform(-1.0f, 1.0f);
+    scene->positions.insert(scene->positions.end(), {uniform(-1.2f, 1.2f), uniform(-0.8f, 0.8f), z});
+    const float size = std::exp2(uniform(-7.0f, -2.0f));
+    scene->scales.insert(scene->scales.end(), {size * uniform(0.3f, 1.0f), size * uniform(0.3f, 1.0f), size});
+    const float qw = uniform(-1, 1), qx = uniform(-1, 1), qy = uniform(-1, 1), qz = uniform(-1, 1);
+    const float norm = std::sqrt(qw * qw + qx * qx + qy * qy + qz * qz) + 1e-6f;
+    scene->rotations.insert(scene->rotations.end(), {qw / norm, qx / norm, qy / norm, qz / norm});
+    scene->opacities.push_back(i % 3 == 0 ? 1.0f : uniform(0.02f, 0.98f));
+    scene->sh_dc.insert(scene->sh_dc.end(), {uniform(-1.7f, 1.7f), uniform(-1.7f, 1.7f), uniform(-1.7f, 1.7f)});
+  }
+  return scene;
+}
+
+Camera crowded_camera() {
+  const float eye[3] = {0.0f, 0.0f, -3.0f}, target[3] = {0.0f, 0.0f, 0.0f}, up[3] = {0.0f, -1.0f, 0.0f};
+  return look_at_camera(eye, target, up, 93, 61, 60.0f);  // partial tiles on two edges
+}
+
+// The SIMD kernel blends a batch of Gaussians vector by vector (cpu_blend_simd.cpp): on the
+// crowded scene, on every target this CPU runs, it matches the scalar kernel within the
+// bound, and its bytes are the same for any thread count.
+TEST(CpuSimdBlend, CrowdedTilesMatchTheScalarKernelOnEveryTarget) {
+  const auto scene = crowded_scene();
+  const Camera camera = crowded_camera();
+  const Frame scalar = render(scene, camera, RenderOptions{}, CpuBlend::scalar, 1);
+  ASSERT_GT(scalar.stats.kv_pairs, 100u * 24u) << "hundreds of Gaussians per tile";
+#ifdef FLASHGS_HAVE_HWY
+  const std::vector<std::int64_t> targets = hwy::SupportedAndGeneratedTargets();
+#else
+  const std::vector<std::int64_t> targets = {0};
+#endif
+  for (const std::int64_t target : targets) {
+#ifdef FLASHGS_HAVE_HWY
+    hwy::SetSupportedTargetsForTest(target);
+    const std::string what = std::string("crowded ") + hwy::TargetName(target);
+#else
+    const std::string what = "crowded";
+#endif
+    expect_simd_matches_scalar(scene, camera, what);
+    const Frame one = render(scene, camera, RenderOptions{}, CpuBlend::simd, 1);
+    for (const int threads : {2, 3})
+      EXPECT_EQ(render(scene, camera, RenderOptions{}, CpuBlend::simd, threads).image.rgb, one.image.rgb)
+          << what << ", " << threads << " threads";
+  }
+#ifdef FLASHGS_HAVE_HWY
+  hwy::SetSupportedTargetsForTest(0);
 #endif
 }
 
