@@ -69,8 +69,9 @@ void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms) {
   constexpr std::int64_t kTilesPerTask = 1024;
   const std::int64_t tasks = (static_cast<std::int64_t>(tiles) + kTilesPerTask - 1) / kTilesPerTask;
   // In parallel only when there is enough to share: a parallel region's start and barrier
-  // cost more than a few hundred thousand additions (and a time slice on a loaded machine).
-  const bool share = static_cast<std::uint64_t>(tiles) * static_cast<std::uint64_t>(chunks) > (1u << 20);
+  // cost more than a few ten thousand additions (a 1080p frame's 8160 tiles x 16 chunks on 2
+  // threads took 0.14 ms alone, 128 chunks on 16 threads 0.93 ms, on the H200 host).
+  const bool share = static_cast<std::uint64_t>(tiles) * static_cast<std::uint64_t>(chunks) > (1u << 16);
 #pragma omp parallel for schedule(static) num_threads(frame.threads) if (share)
   for (std::int64_t task = 0; task < tasks; ++task) {
     const std::size_t begin = static_cast<std::size_t>(task * kTilesPerTask);
