@@ -181,7 +181,7 @@ bench_scale() {  # pc_playbot copied SCALE_COPIES times in memory (default 20 60
 report() {  # the error-vs-time report of pc_playbot on each backend of REPORT_BACKENDS (default cuda cpu)
   for backend in ${REPORT_BACKENDS:-cuda cpu}; do
     log "report pc_playbot $backend"
-    "$FLASHGS" report "$SCENES/pc_playbot/point_cloud.ply" --backend $backend --title pc_playbot \
+    timeout ${REPORT_TIMEOUT:-600} "$FLASHGS" report "$SCENES/pc_playbot/point_cloud.ply" --backend $backend --title pc_playbot \
       -o "$OUT/report_$backend" > "$OUT/report_$backend.txt" 2>&1
     log "report $backend rc=$?"
   done
