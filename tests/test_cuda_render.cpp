@@ -268,7 +268,7 @@ TEST(CudaSanitizer, Frames) {
   const bool quick = std::getenv("FLASHGS_SANITIZER_QUICK") != nullptr;
   for (const Camera& camera : sanitizer_cameras(*scene, cameras))
     for (RenderOptions o : all_configs()) {
-      if (quick && !(o.is_baseline() || o.label() == "flash" || !o.pipelined_blend))
+      if (quick && !(o.is_baseline() || o.label() == "flash" || !o.pipelined_blend || !o.macro_bins))
         continue;
       o.collect_tile_counts = true;
       const Result r = render(*gpu, camera, o);
@@ -369,6 +369,44 @@ TEST(CudaTileOrder, DenseTilesFirstChangesNoByte) {
   for (const std::string& name : test::shared_scene_names()) {
     const std::vector<Camera> cameras = test::load_shared_cameras(name);
     check(name, test::load_shared_scene(name), {cameras[0].resized(1920, 1080), cameras[10].resized(1920, 1080)});
+  }
+}
+
+// Macro bins (2x2 tiles per sort key) must change no byte and no tile's pair count, alone
+// and with every other switch off in turn (each emission path, both blend loops), on odd sizes
+// (bins over the image's edge), 4K and a camera inside the scene (huge boxes), while sorting
+// fewer pairs than tile keys would.
+TEST(CudaMacroBins, ChangeNoByteAndNoTileCount) {
+  FLASHGS_REQUIRE_CUDA();
+  auto check = [](const std::string& name, std::shared_ptr<const Scene> scene, const std::vector<Camera>& cameras) {
+    auto gpu = make_cuda_renderer();
+    gpu->set_scene(scene);
+    for (const Camera& camera : cameras)
+      for (RenderOptions binned : all_configs()) {
+        if (binned.is_baseline() || !binned.macro_bins) continue;
+        binned.collect_tile_counts = true;
+        RenderOptions per_tile = binned;
+        per_tile.macro_bins = false;
+        const Result a = render(*gpu, camera, per_tile);
+        const Result b = render(*gpu, camera, binned);
+        const std::string what = name + " " + camera.name + " " + std::to_string(camera.width) + "x" +
+                                 std::to_string(camera.height) + " " + binned.label();
+        expect_same_counts(what, a.stats, b.stats);
+        EXPECT_EQ(a.stats.max_tile_pairs, b.stats.max_tile_pairs) << what;
+        EXPECT_TRUE(a.stats.tile_pair_counts == b.stats.tile_pair_counts) << what << ": tile counts differ";
+        EXPECT_EQ(a.stats.sorted_pairs, a.stats.kv_pairs) << what;
+        if (a.stats.kv_pairs > 0) EXPECT_LT(b.stats.sorted_pairs, a.stats.kv_pairs) << what;
+        EXPECT_TRUE(a.image.rgb == b.image.rgb) << what << ": macro bins changed the image";
+      }
+  };
+  const auto demo = test::load_demo_scene();
+  const auto demo_cameras = test::load_demo_cameras();
+  check("demo", demo, {demo_cameras[0].resized(1001, 563), demo_cameras[3].resized(17, 9),
+                       demo_cameras[5].resized(3840, 2160), inside_camera(*demo, 1001, 563)});
+  for (const std::string& name : test::shared_scene_names()) {
+    const std::vector<Camera> cameras = test::load_shared_cameras(name);
+    const auto scene = test::load_shared_scene(name);
+    check(name, scene, {cameras[0].resized(1001, 563), inside_camera(*scene, 1919, 1079)});
   }
 }
 

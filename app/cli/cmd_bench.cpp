@@ -102,7 +102,7 @@ struct ConfigRun {
   RenderOptions options;
   std::unique_ptr<Renderer> renderer;
   std::vector<double> stage[6];  // per camera
-  std::vector<double> kv, visible, psnr, max_abs;
+  std::vector<double> kv, sorted, visible, psnr, max_abs;
   std::uint64_t memory_max = 0, peak_max = 0;
   std::uint64_t scene_device_bytes = 0;  // the scene as the backend holds it (0 on the CPU)
   double upload_ms = 0, first_frame_ms = -1;  // wall clock: set_scene, and the first render
@@ -204,11 +204,13 @@ void run(const BenchArgs& args) {
           cam[std::string(kStages[s]) + "_ms"] = m;
         }
         r.kv.push_back(static_cast<double>(stats.kv_pairs));
+        r.sorted.push_back(static_cast<double>(stats.sorted_pairs));
         r.visible.push_back(static_cast<double>(stats.visible));
         r.memory_max = std::max<std::uint64_t>(r.memory_max, stats.device_memory_bytes);
         r.peak_max = std::max<std::uint64_t>(r.peak_max, stats.device_peak_bytes);
         r.scene_device_bytes = stats.scene_device_bytes;
         cam["kv_pairs"] = stats.kv_pairs;
+        cam["sorted_pairs"] = stats.sorted_pairs;
         cam["visible"] = stats.visible;
         cam["culled"] = {{"near", stats.culled_near},
                          {"offscreen", stats.culled_offscreen},
@@ -234,6 +236,7 @@ void run(const BenchArgs& args) {
       for (int s = 0; s < 6; ++s)
         j["ms"][kStages[s]] = {{"median", median(r.stage[s])}, {"p95", percentile(r.stage[s], kTailPercentile)}};
       j["kv_pairs"] = {{"median", median(r.kv)}, {"max", *std::max_element(r.kv.begin(), r.kv.end())}};
+      j["sorted_pairs_median"] = median(r.sorted);
       j["visible_median"] = median(r.visible);
       j["memory_bytes"] = {{"working_max", r.memory_max}, {"peak", r.peak_max}, {"scene_device", r.scene_device_bytes}};
       j["upload_ms"] = r.upload_ms;

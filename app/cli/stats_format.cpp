@@ -8,12 +8,12 @@ namespace flashgs::cli {
 std::string format_stats(const FrameStats& s) {
   char text[1024];
   std::snprintf(text, sizeof text,
-                "kv pairs:   %llu (max %u in one tile, %dx%d tiles)\n"
+                "kv pairs:   %llu (max %u in one tile, %dx%d tiles; %llu sorted)\n"
                 "gaussians:  %llu in scene, %llu visible; culled: %llu near, %llu off screen, "
                 "%llu below tau, %llu degenerate\n"
                 "time ms:    project %.3f  emit %.3f  sort %.3f  ranges %.3f  blend %.3f  total %.3f\n",
                 static_cast<unsigned long long>(s.kv_pairs), s.max_tile_pairs, s.tiles_x, s.tiles_y,
-                static_cast<unsigned long long>(s.gaussians), static_cast<unsigned long long>(s.visible),
+                static_cast<unsigned long long>(s.sorted_pairs), static_cast<unsigned long long>(s.gaussians), static_cast<unsigned long long>(s.visible),
                 static_cast<unsigned long long>(s.culled_near), static_cast<unsigned long long>(s.culled_offscreen),
                 static_cast<unsigned long long>(s.culled_low_opacity),
                 static_cast<unsigned long long>(s.culled_degenerate), s.times.project_ms, s.times.emit_ms,

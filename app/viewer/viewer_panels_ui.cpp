@@ -274,32 +274,33 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
   ImGui::SameLine();
   ImGui::TextDisabled("(B)");
   switch_algorithm(o, algo == 0 ? Algorithm::baseline : Algorithm::flash);
-  ImGui::BeginDisabled(o.is_baseline());
   // Two columns: the switches that change the Gaussian-tile pairs (geometry) and those that
-  // only change how fast the kernels make and blend them.
+  // only change how fast the kernels make and blend them; under the shorter geometry column,
+  // the precision options, so that the panels' last buttons stay on a 720-px window.
   if (ImGui::BeginTable("opts", 2, ImGuiTableFlags_SizingStretchSame)) {
     for (const bool geometry : {true, false}) {
       ImGui::TableNextColumn();
+      ImGui::BeginDisabled(o.is_baseline());
       ImGui::TextDisabled(geometry ? "geometry" : "GPU kernels");
       for (const RenderSwitch& sw : kRenderSwitches)
         if (sw.changes_pairs == geometry) switch_checkbox(sw, o, m.backend);
+      ImGui::EndDisabled();
+      if (!geometry) continue;
+      ImGui::TextDisabled("precision");
+      ImGui::SetNextItemWidth(ui(40));
+      ImGui::SliderInt("SH degree cap", &o.sh_degree_cap, 0, kMaxShDegree, "%d", kClamp);
+      ImGui::Checkbox("fp16 SH", &o.fp16_sh);
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("the SH coefficients as half values: half the GPU bytes of the SH bands, not exact");
     }
     ImGui::EndTable();
   }
-  ImGui::EndDisabled();
   float inv_tau = 1.0f / o.tau;
   char tau_label[64];
   std::snprintf(tau_label, sizeof tau_label, "1/tau (tau %.5f)###tau", o.tau);
   if (ImGui::SliderFloat(tau_label, &inv_tau, 1.0f / kTauRange.max, 1.0f / kTauRange.min, "%.0f",
                          kClamp | ImGuiSliderFlags_Logarithmic))
     o.tau = 1.0f / inv_tau;
-  // On one row with its checkbox: a row more would push the panels' last buttons off a 720-px window.
-  ImGui::SetNextItemWidth(ui(96));
-  ImGui::SliderInt("SH degree cap", &o.sh_degree_cap, 0, kMaxShDegree, "%d", kClamp);
-  ImGui::SameLine();
-  ImGui::Checkbox("fp16 SH", &o.fp16_sh);
-  if (ImGui::IsItemHovered())
-    ImGui::SetTooltip("the SH coefficients as half values: half the GPU bytes of the SH bands, not exact");
   ImGui::ColorEdit3("Background", o.background, ImGuiColorEditFlags_NoInputs);
   ImGui::SameLine();
   ImGui::Checkbox("Every frame", &s.continuous);

@@ -111,6 +111,52 @@ struct alignas(16) RegionGaussian {
   float red, green, blue, pad1;
 };
 
+// A tile's blend records in list order, up to 32 at a time (lane j gets the j-th): its bin's
+// pair values, read whole when a bin is the tile.
+struct TileList {
+  const std::uint32_t* values;
+  unsigned cursor, end;
+  __device__ void fill() {}
+  __device__ unsigned take(unsigned lane, unsigned& record) {
+    const unsigned n = min(static_cast<unsigned>(kWarp), end - cursor);
+    if (lane < n) record = values[cursor + lane];
+    cursor += n;
+    return n;
+  }
+};
+
+// The same for a tile of a larger bin: the bin's values that carry the tile's bit, gathered
+// 32 values per step into a per-warp ring in shared memory, so that every batch the blend
+// stages is full of the tile's own Gaussians (about 45% of a 2x2 bin's values are).
+// fill() keeps at least 32 queued while the bin has values left: at most 31 + 32 in the ring.
+struct BinTileList {
+  static constexpr unsigned kRing = 2 * kWarp;
+  const std::uint32_t* values;
+  unsigned* ring;  // [kRing], this warp's
+  unsigned cursor, end, bit;
+  unsigned head, tail;  // queued: ring[head..tail) mod kRing
+  __device__ void fill() {
+    const unsigned lane = lane_id();
+    while (tail - head < kWarp && cursor < end) {  // warp-uniform
+      const unsigned i = cursor + lane;
+      const std::uint32_t v = i < end ? values[i] : 0u;
+      const bool mine = (v & bit) != 0;
+      const unsigned ballot = __ballot_sync(kFullMask, mine);
+      if (mine) ring[(tail + __popc(ballot & ((1u << lane) - 1u))) % kRing] = v & kRecordMask;
+      tail += __popc(ballot);
+      cursor += kWarp;
+    }
+    __syncwarp();
+  }
+  __device__ unsigned take(unsigned lane, unsigned& record) {
+    const unsigned n = min(static_cast<unsigned>(kWarp), tail - head);
+    if (lane < n) record = ring[(head + lane) % kRing];
+    head += n;
+    __syncwarp();  // read before the next fill overwrites
+    return n;
+  }
+};
+
 // The column a finished pixel moves to: every later Gaussian's alpha there is exactly 0 (q
 // overflows to infinity; a finite factor, so 0 * x stays 0 and no NaN appears), so it adds
 // nothing and keeps its transmittance, the background's weight, without a liveness test.
@@ -132,7 +178,9 @@ constexpr float kFinishedX = 1e30f;
 // (at least one lane of the warp passes the cut on almost every visit, so a branch skipped
 // nothing and cost its own instructions); a finished pixel moves to kFinishedX, so later
 // Gaussians add exactly nothing to it. Otherwise the arithmetic is the CPU's, term for term.
-template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE>
+// BINNED: the pairs are keyed by bins of 2x2 tiles (BinGrid); the 4 blocks of a bin blend its
+// tiles, each walking the bin's list for the values that carry its bit (BinTileList).
+template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE, bool BINNED>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
   constexpr int kRegionH = 64 / REGION_W;
   constexpr int kLanesX = REGION_W / kLanePixelsX;
@@ -142,9 +190,14 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   // A block is one tile, its warps the tile's regions.
   static_assert(kWarpsPerBlock == kRegionsPerTile, "a block must be one tile");
-  const unsigned tile = a.tile_order ? a.tile_order[blockIdx.x] : blockIdx.x;
-  if (tile >= static_cast<unsigned>(a.tiles_x) * static_cast<unsigned>(a.tiles_y)) return;  // whole warp
-  const int tx = static_cast<int>(tile % a.tiles_x), ty = static_cast<int>(tile / a.tiles_x);
+  constexpr int kShift = BINNED ? kMacroBinShift : 0;
+  const unsigned block_bin = blockIdx.x >> (2 * kShift);
+  const unsigned bin = a.tile_order ? a.tile_order[block_bin] : block_bin;
+  if (bin >= static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y)) return;  // whole block
+  const unsigned tile_in_bin = blockIdx.x & ((1u << (2 * kShift)) - 1u);
+  const int tx = static_cast<int>(bin % a.bins.x) * (1 << kShift) + static_cast<int>(tile_in_bin & ((1u << kShift) - 1u));
+  const int ty = static_cast<int>(bin / a.bins.x) * (1 << kShift) + static_cast<int>(tile_in_bin >> kShift);
+  if (tx >= a.tiles_x || ty >= a.tiles_y) return;  // a bin over the image's edge: whole block
   const int region_in_tile = static_cast<int>(warp);
   // The region's pixel-centre rectangle, clipped to the image, and this lane's pixels.
   const float region_x0 = static_cast<float>(tx * kTile + (region_in_tile % kRegionsX) * REGION_W);
@@ -166,17 +219,29 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     lane_x[p] = !EXP2 || (live & (1u << p)) ? static_cast<float>(x0 + p) - region_x0 : kFinishedX;
   }
   const unsigned inside = live;
-  const uint2 range = a.tile_ranges[tile];
+  const uint2 range = a.tile_ranges[bin];
+  __shared__ unsigned ring[BINNED ? kWarpsPerBlock : 1][BinTileList::kRing];
+  using List = std::conditional_t<BINNED, BinTileList, TileList>;
+  List list;
+  if constexpr (BINNED) {
+    list = BinTileList{a.values, ring[warp], range.x, range.y, 1u << (tile_in_bin + kBinTileBitsShift), 0u, 0u};
+  } else {
+    list = TileList{a.values, range.x, range.y};
+  }
+  // This batch's records (n of them, lane j the j-th) and, PIPELINED, their Gaussians.
+  unsigned record = 0;
+  list.fill();
+  unsigned n = list.take(lane, record);
   BlendGaussian next{};
-  if (PIPELINED && range.x + lane < range.y) next = load_gaussian(a.gaussians + a.values[range.x + lane]);
-  for (unsigned base = range.x; base < range.y; base += kWarp) {
+  if (PIPELINED && lane < n) next = load_gaussian(a.gaussians + record);
+  while (n > 0) {
     if constexpr (EXP2) {
       live = 0;
 #pragma unroll
       for (int p = 0; p < kLanePixelsX; ++p) live |= lane_x[p] != kFinishedX ? 1u << p : 0u;
     }
     if (!__any_sync(kFullMask, live)) break;
-    if (!PIPELINED && base + lane < range.y) next = load_gaussian(a.gaussians + a.values[base + lane]);
+    if (!PIPELINED && lane < n) next = load_gaussian(a.gaussians + record);
     __syncwarp();
     unsigned relevant = 0xffffffffu;
     if constexpr (EXP2) {
@@ -186,7 +251,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
                                          next.blue, 0.0f};
       bool meets = false;
       const float cut = (next.opacity - kLog2AlphaMin) * 1.00001f + 1e-4f;  // q' of alpha = 1/255
-      if (base + lane < range.y && cut > 0.0f) {
+      if (lane < n && cut > 0.0f) {
         const float w[4] = {next.w0, next.w1, next.w2, next.w3};
         // Fast divisions: the cut's margin covers their error (it moves the edge minimiser
         // along a flat valley, changing q to second order only).
@@ -203,9 +268,10 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       batch[warp][lane] = next;
     }
     __syncwarp();
-    if (PIPELINED && base + kWarp + lane < range.y)
-      next = load_gaussian(a.gaussians + a.values[base + kWarp + lane]);
-    const unsigned n = min(static_cast<unsigned>(kWarp), range.y - base);
+    list.fill();
+    unsigned next_record = 0;
+    const unsigned next_n = list.take(lane, next_record);
+    if (PIPELINED && lane < next_n) next = load_gaussian(a.gaussians + next_record);
     if (n < kWarp) relevant &= (1u << n) - 1u;
     for (unsigned m = relevant; m && (EXP2 || live); m &= m - 1) {
       const Staged& g = batch[warp][__ffs(m) - 1];
@@ -257,6 +323,8 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
         }
       }
     }
+    n = next_n;
+    record = next_record;
   }
 #pragma unroll
   for (int p = 0; p < kLanePixelsX; ++p)
@@ -265,16 +333,26 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
                            cb[p] + t[p] * a.background[2]);
 }
 
-template <int REGION_W, bool SURFACE>
-void launch_warp_tile(const BlendArgs& a, unsigned tiles, cudaStream_t stream) {
-  const unsigned regions = tiles * kRegionsPerTile;
-  const unsigned blocks = (regions + kWarpsPerBlock - 1) / kWarpsPerBlock;
+template <int REGION_W, bool SURFACE, bool BINNED>
+void launch_warp_tile(const BlendArgs& a, cudaStream_t stream) {
+  // A block per tile of each bin (tiles of bins over the image's edge return at once).
+  const unsigned blocks = static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y) << (2 * a.bins.shift);
   const unsigned threads = kWarpsPerBlock * kWarp;
   const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
-  if (pipelined && a.exp2_alpha) blend_warp_tile_kernel<REGION_W, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (pipelined) blend_warp_tile_kernel<REGION_W, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (a.exp2_alpha) blend_warp_tile_kernel<REGION_W, false, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else blend_warp_tile_kernel<REGION_W, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  if (pipelined && a.exp2_alpha)
+    blend_warp_tile_kernel<REGION_W, true, true, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
+  else if (pipelined)
+    blend_warp_tile_kernel<REGION_W, true, false, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
+  else if (a.exp2_alpha)
+    blend_warp_tile_kernel<REGION_W, false, true, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
+  else
+    blend_warp_tile_kernel<REGION_W, false, false, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
+}
+
+template <bool SURFACE, bool BINNED>
+void launch_warp_tile_for_region(const BlendArgs& a, cudaStream_t stream) {
+  if (a.region_width == 16) launch_warp_tile<16, SURFACE, BINNED>(a, stream);
+  else launch_warp_tile<8, SURFACE, BINNED>(a, stream);
 }
 
 template <bool SURFACE>
@@ -284,8 +362,8 @@ void launch_for_output(const BlendArgs& a, cudaStream_t stream) {
     blend_per_pixel_kernel<SURFACE><<<tiles, kTile * kTile, 0, stream>>>(a);
     return;
   }
-  if (a.region_width == 16) launch_warp_tile<16, SURFACE>(a, tiles, stream);
-  else launch_warp_tile<8, SURFACE>(a, tiles, stream);
+  if (a.bins.shift == kMacroBinShift) launch_warp_tile_for_region<SURFACE, true>(a, stream);
+  else launch_warp_tile_for_region<SURFACE, false>(a, stream);
 }
 
 }  // namespace
@@ -294,7 +372,7 @@ std::uint64_t blend_resident_blocks() {
   int device = 0, sms = 0, per_sm = 0;
   check_cuda(cudaGetDevice(&device), "device query");
   check_cuda(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "device query");
-  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false>,
+  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false, true>,
                                                            kWarpsPerBlock * kWarp, 0),
              "occupancy query");
   return static_cast<std::uint64_t>(std::max(1, sms * per_sm));

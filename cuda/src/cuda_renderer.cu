@@ -77,6 +77,7 @@ using PinnedHandle = CudaHandle<void*, cudaFreeHost>;
 struct HostReadback {
   cuda::FrameCounters counters;    // after the preprocess: pairs and culls of this frame
   std::uint32_t tile_max[2] = {};  // FrameCounters::max_tile_pairs, per event set
+  unsigned long long tile_pairs[2] = {};  // FrameCounters::tile_pairs, per event set
 };
 
 // One device allocation; grows (discarding its content) but never shrinks. The owner's byte
@@ -315,13 +316,21 @@ class CudaRendererImpl final : public CudaRenderer {
   }
 
   void download_tile_counts(std::vector<std::uint32_t>& counts) override {
+    counts.resize(last_tiles_);
+    if (last_tile_counts_) {  // a binned frame's, from launch_tile_stats
+      if (last_tiles_)
+        check_cuda(cudaMemcpyAsync(counts.data(), tile_counts_.as<void>(), last_tiles_ * sizeof(std::uint32_t),
+                                   cudaMemcpyDeviceToHost, stream_),
+                   "tile count download");
+      check_cuda(cudaStreamSynchronize(stream_), "tile count download");
+      return;
+    }
     std::vector<uint2> ranges(last_tiles_);
     if (last_tiles_)
       check_cuda(cudaMemcpyAsync(ranges.data(), ranges_.as<void>(), last_tiles_ * sizeof(uint2),
                                  cudaMemcpyDeviceToHost, stream_),
                  "tile range download");
     check_cuda(cudaStreamSynchronize(stream_), "tile range download");
-    counts.resize(last_tiles_);
     for (std::size_t t = 0; t < last_tiles_; ++t) counts[t] = ranges[t].y - ranges[t].x;
   }
 
@@ -331,7 +340,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &record_ids_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
+            &values_[1], &ranges_, &tile_order_, &tile_places_, &tile_counts_, &chunk_list_, &image_, &cub_temp_,
             &large_footprints_, &large_records_, &huge_footprints_, &huge_records_};
   }
 
@@ -399,6 +408,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   cuda::FrameBuffers frame_buffers() const {
     cuda::FrameBuffers b;
+    b.bins = bins_;
     b.key_format = key_format_;
     b.blend = blend_.as<cuda::BlendGaussian>();
     b.record_ids = compact_records_ ? record_ids_.as<std::uint32_t>() : nullptr;
@@ -457,9 +467,10 @@ class CudaRendererImpl final : public CudaRenderer {
   // Call after this frame's first wait, with the event sets already switched.
   bool dense_order_pays(std::uint64_t tiles, bool have_last_frame) const {
     if (dense_tiles_mode_ != kAuto) return dense_tiles_mode_ == kAlways;
-    if (!have_last_frame || tiles != last_tiles_ || last_pairs_ == 0) return false;
+    const std::uint64_t last_pairs = readback_->tile_pairs[event_set_ ^ 1];
+    if (!have_last_frame || tiles != last_tiles_ || last_pairs == 0) return false;
     const std::uint64_t fullest = readback_->tile_max[event_set_ ^ 1];
-    return fullest * blend_resident_blocks_ > last_pairs_;
+    return fullest * blend_resident_blocks_ > last_pairs;
   }
 
   // Stage times of the frame whose events are in `set` (its work must have finished).
@@ -506,11 +517,21 @@ class CudaRendererImpl final : public CudaRenderer {
     // A frame in the other SH precision re-packs the scene from its host copy first.
     if (options.fp16_sh != device_scene_.sh_half) upload_scene(scene_, options.fp16_sh);
     const gm::CameraParams cam = make_camera_params(camera);
+    // The emission kernels keep a box's tile range in 16 bits.
+    if (cam.tiles_x > 0xffff || cam.tiles_y > 0xffff)
+      throw Error("cuda renderer: an image side of more than " + std::to_string(0xffff * gm::kTileSize) +
+                  " pixels is not supported");
     const std::uint64_t tiles = static_cast<std::uint64_t>(cam.tiles_x) * cam.tiles_y;
     const std::uint64_t pixels = static_cast<std::uint64_t>(cam.width) * cam.height;
     const std::size_t n = device_scene_.count;
     const bool baseline = options.is_baseline();
     const bool fused = !baseline && options.fused_emit;
+    // Macro bins need the record in a pair value's low 28 bits (records are below the scene's size).
+    const bool binned = !baseline && options.macro_bins && n <= cuda::kRecordMask;
+    bins_.shift = binned ? cuda::kMacroBinShift : 0;
+    bins_.x = (cam.tiles_x + (1 << bins_.shift) - 1) >> bins_.shift;
+    bins_.y = (cam.tiles_y + (1 << bins_.shift) - 1) >> bins_.shift;
+    const std::uint64_t bins = static_cast<std::uint64_t>(bins_.x) * bins_.y;
     // 3DGS sorts 64-bit keys over 32 + bits(tiles); flash packs tile and depth bin in 32 bits;
     // with the switch off, all 64 bits are sorted, to show what the switch buys.
     const bool compact_keys = !baseline && options.minimal_sort_bits;
@@ -523,13 +544,15 @@ class CudaRendererImpl final : public CudaRenderer {
       const double tan_x = std::max(cam.cx, cam.width - cam.cx) / cam.fx;
       const double tan_y = std::max(cam.cy, cam.height - cam.cy) / cam.fy;
       const double cos_half_diagonal = 1.0 / std::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
-      key_format_ = compact_key_format(tiles, (distance - bounds_radius_) * cos_half_diagonal,
+      key_format_ = compact_key_format(bins, (distance - bounds_radius_) * cos_half_diagonal,
                                        distance + bounds_radius_, sort_key_bits_);
     } else {
       key_format_ = cuda::KeyFormat{};
     }
 
-    ranges_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile ranges");
+    ranges_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(uint2), "bin ranges");
+    const bool tile_counts_on_device = binned && options.collect_tile_counts;
+    if (tile_counts_on_device) tile_counts_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile counts");
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     // Fused emission keeps a blend record per projected Gaussian (FrameBuffers::blend), the
     // separate path one per Gaussian.
@@ -609,23 +632,23 @@ class CudaRendererImpl final : public CudaRenderer {
     // After the wait above: the last frame's fullest tile has come back by now.
     const bool dense_tiles_first = !baseline && options.dense_tiles_first && dense_order_pays(tiles, previous_complete);
     if (dense_tiles_first) {
-      tile_order_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile order");
-      tile_places_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile places");
+      tile_order_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "bin order");
+      tile_places_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "bin places");
     }
     const cuda::FrameBuffers b = frame_buffers();
     check_cuda(cudaEventRecord(events[kEmitBegin], stream_), "event record");
     if (!fused) cuda::launch_duplicate(n, b, cam, args.exact_tile_test, stream_);
     check_cuda(cudaEventRecord(events[kEmitted], stream_), "event record");
 
-    const int tile_bits = std::max(bits_for(tiles), 1);
+    const int tile_bits = std::max(bits_for(bins), 1);
     int end_bit = 64;
     if (key_format_.depth_bits > 0) end_bit = tile_bits + key_format_.depth_bits;
     else if (baseline || options.minimal_sort_bits) end_bit = std::min(64, 32 + tile_bits);
     check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
     const int which = cuda::launch_sort(pairs, end_bit, b, stream_);
     check_cuda(cudaEventRecord(events[kSorted], stream_), "event record");
-    cuda::launch_ranges(pairs, tiles, b, which, stream_);
-    if (dense_tiles_first) cuda::launch_tile_order(tiles, b, stream_);
+    cuda::launch_ranges(pairs, bins, b, which, stream_);
+    if (dense_tiles_first) cuda::launch_tile_order(bins, b, stream_);
     check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
 
     cuda::BlendArgs blend{};
@@ -639,6 +662,7 @@ class CudaRendererImpl final : public CudaRenderer {
                                                        : cuda::BlendKernel::warp_tile);
     blend.exp2_alpha = args.exp2_alpha;
     blend.region_width = region_width_;
+    blend.bins = bins_;
     blend.values = b.values[which];
     blend.tile_ranges = b.tile_ranges;
     blend.tile_order = dense_tiles_first ? b.tile_order : nullptr;
@@ -648,12 +672,17 @@ class CudaRendererImpl final : public CudaRenderer {
     cuda::launch_blend(blend, stream_);
     check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     last_tiles_ = tiles;
-    last_pairs_ = pairs;
-    // The fullest tile, for the statistics (after the last timed event: not a stage's cost).
-    cuda::launch_tile_max(tiles, b, stream_);
+    last_tile_counts_ = tile_counts_on_device;
+    // The fullest tile and the tile pairs, for the statistics (after the last timed event:
+    // not a stage's cost).
+    cuda::launch_tile_stats(cam.tiles_x, cam.tiles_y, b, which,
+                            tile_counts_on_device ? tile_counts_.as<std::uint32_t>() : nullptr, stream_);
     check_cuda(cudaMemcpyAsync(&readback_->tile_max[event_set_], &b.counters->max_tile_pairs, sizeof(std::uint32_t),
                                cudaMemcpyDeviceToHost, stream_),
                "tile maximum read back");
+    check_cuda(cudaMemcpyAsync(&readback_->tile_pairs[event_set_], &b.counters->tile_pairs,
+                               sizeof(unsigned long long), cudaMemcpyDeviceToHost, stream_),
+               "tile pair read back");
 
     if (out) {
       if (out->width != camera.width || out->height != camera.height) out->resize(camera.width, camera.height);
@@ -667,7 +696,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
     FrameStats stats;
     const cuda::FrameCounters& c = readback_->counters;
-    stats.kv_pairs = pairs;
+    stats.sorted_pairs = pairs;
     stats.tiles_x = cam.tiles_x;
     stats.tiles_y = cam.tiles_y;
     stats.gaussians = n;
@@ -684,10 +713,15 @@ class CudaRendererImpl final : public CudaRenderer {
       check_cuda(cudaStreamSynchronize(stream_), "frame");
       stats.times = stage_times(event_set_);
       stats.max_tile_pairs = readback_->tile_max[event_set_];
+      stats.kv_pairs = readback_->tile_pairs[event_set_];
     } else {
       stats.times = stage_times(previous_set);
       stats.max_tile_pairs = readback_->tile_max[previous_set];
+      stats.kv_pairs = readback_->tile_pairs[previous_set];
     }
+    // Tile keys count the tile pairs themselves; bins count them after the blend (above: this
+    // frame's, or for a surface frame the previous one's, as the times).
+    if (!binned) stats.kv_pairs = pairs;
     stats.device_memory_bytes = working_bytes_;
     stats.device_peak_bytes = peak_bytes_;
     stats.scene_device_bytes = scene_pos_.bytes() + scene_rot_.bytes() + scene_scale_.bytes() + scene_dc_.bytes() +
@@ -730,8 +764,9 @@ class CudaRendererImpl final : public CudaRenderer {
   Mode chunk_cull_ = kAuto;
   Mode dense_tiles_mode_ = kAuto;
   std::uint64_t blend_resident_blocks_ = 1;  // warp-blend blocks the device runs at once
-  std::uint64_t last_pairs_ = 0;             // pairs of the last frame (of last_tiles_ tiles)
   cuda::KeyFormat key_format_;           // this frame's
+  cuda::BinGrid bins_;                   // this frame's
+  bool last_tile_counts_ = false;        // the last frame left its tile counts in tile_counts_
   double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
   double bounds_radius_ = 0;
   float max_opacity_ = 1.0f;             // of the scene (sets the flash extent's largest threshold)
@@ -739,7 +774,7 @@ class CudaRendererImpl final : public CudaRenderer {
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
   DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_order_,
-      tile_places_, chunk_list_, image_,
+      tile_places_, tile_counts_, chunk_list_, image_,
       cub_temp_, large_footprints_, large_records_, huge_footprints_, huge_records_;
 };
 

@@ -36,14 +36,15 @@ __device__ __forceinline__ std::uint32_t sort_depth(const KeyFormat& k, float de
 
 // Stores one pair if it fits: an offset at or past the capacity writes nothing; the host
 // sees the wanted total in FrameCounters::pairs, grows the buffers and runs the frame again.
-__device__ __forceinline__ void store_pair(const FrameBuffers& b, unsigned long long offset, std::uint32_t tile,
-                                           std::uint32_t depth, std::uint32_t gaussian) {
+// `bin` indexes FrameBuffers::bins, `value` is the pair's (bins.cuh, pair_value).
+__device__ __forceinline__ void store_pair(const FrameBuffers& b, unsigned long long offset, std::uint32_t bin,
+                                           std::uint32_t depth, std::uint32_t value) {
   if (offset < b.pair_capacity) {
     if (b.key_format.depth_bits > 0)
-      reinterpret_cast<std::uint32_t*>(b.keys[0])[offset] = (tile << b.key_format.depth_bits) | depth;
+      reinterpret_cast<std::uint32_t*>(b.keys[0])[offset] = (bin << b.key_format.depth_bits) | depth;
     else
-      b.keys[0][offset] = (static_cast<std::uint64_t>(tile) << 32) | depth;
-    b.values[0][offset] = gaussian;
+      b.keys[0][offset] = (static_cast<std::uint64_t>(bin) << 32) | depth;
+    b.values[0][offset] = value;
   }
 }
 

@@ -1,5 +1,6 @@
 // Stage `emit`, separate pass (3DGS duplicateWithKeys): after the prefix sum over the pair
-// counts, each Gaussian writes its keys at its own offset.
+// counts, each Gaussian writes its keys (one per bin it touches) at its own offset.
+#include "bins.cuh"
 #include "device_common.cuh"
 #include "flashgs/gaussian_math.h"
 #include "pipeline.h"
@@ -20,11 +21,14 @@ __global__ void __launch_bounds__(kBlock) duplicate_kernel(std::size_t gaussians
   const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
   unsigned long long offset = buf.pair_offsets[i] - count;
   const unsigned long long end = offset + count;
-  for (int ty = f.tile_y0; ty < f.tile_y1 && offset < end; ++ty)
-    for (int tx = f.tile_x0; tx < f.tile_x1 && offset < end; ++tx)
-      if (!exact || gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height))
-        store_pair(buf, offset++, static_cast<unsigned>(ty) * cam.tiles_x + tx, depth_bits,
-                   static_cast<std::uint32_t>(i));
+  const BinBox bins(f, buf.bins.shift);
+  for (int by = bins.y0; by < bins.y1 && offset < end; ++by)
+    for (int bx = bins.x0; bx < bins.x1 && offset < end; ++bx) {
+      const unsigned tiles = footprint_bin_tiles(f, buf.bins.shift, bx, by, cam, exact);
+      if (tiles)
+        store_pair(buf, offset++, static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits,
+                   pair_value(buf.bins, static_cast<std::uint32_t>(i), tiles));
+    }
 }
 
 }  // namespace

@@ -105,6 +105,19 @@ struct KeyFormat {
   std::uint32_t exponent_base = 0;
 };
 
+// What the pairs are keyed by: bins of 2^shift x 2^shift tiles (RenderOptions::macro_bins:
+// shift 1, 32x32 pixels), or tiles (shift 0). A Gaussian has one pair per bin it touches,
+// whose value carries the bits of the bin's tiles it touches (kBinTileBitsShift and up), so
+// the sort has about half the pairs while the blend still visits only the Gaussians of its
+// tile, in the same order. Bins are row-major, x bins per row.
+struct BinGrid {
+  int shift = 0;
+  int x = 0, y = 0;
+};
+constexpr int kMacroBinShift = 1;
+constexpr int kBinTileBitsShift = 28;                                  // up to 4 tile bits
+constexpr std::uint32_t kRecordMask = (1u << kBinTileBitsShift) - 1u;  // a binned value's record
+
 // Tiles are ordered for the blend by the bit length of their pair count (launch_tile_order).
 constexpr int kTileClasses = 33;
 
@@ -114,7 +127,8 @@ struct FrameCounters {
   // Gaussians by gm::CullReason: kVisible counts those with at least one pair, and one whose
   // box met the image but whose ellipse missed every tile counts as kCulledOffscreen.
   unsigned int by_reason[gm::kCullReasonCount];
-  unsigned int max_tile_pairs;     // pairs of the fullest tile (set after the ranges pass)
+  unsigned int max_tile_pairs;     // pairs of the fullest tile (launch_tile_stats, after the blend)
+  unsigned long long tile_pairs;   // Gaussian-tile pairs (launch_tile_stats; `pairs` counts bins)
   unsigned int large;             // Gaussians deferred to the large-emission kernel
   unsigned int huge;              // Gaussians deferred to the huge-emission kernel
   unsigned long long chunk_culled; // Gaussians of chunks outside the view (classified, not projected)
@@ -149,13 +163,14 @@ struct FrameBuffers {
   // of more than kHugeBoxTiles tiles (a block per Gaussian).
   DeferredList large;
   DeferredList huge;
-  // Per pair: key (see KeyFormat; 32-bit keys use the front half), value = blend record; two
-  // of each for the sort.
+  // Per pair: key (see KeyFormat; 32-bit keys use the front half, the tile part is a bin of
+  // `bins`), value = blend record (and tile bits, see BinGrid); two of each for the sort.
+  BinGrid bins;
   KeyFormat key_format;
   std::uint64_t* keys[2] = {nullptr, nullptr};    // [pair_capacity]
   std::uint32_t* values[2] = {nullptr, nullptr};  // [pair_capacity]
   std::uint64_t pair_capacity = 0;
-  // Per tile: [start, end) of its pairs in the sorted list.
+  // Per bin: [start, end) of its pairs in the sorted list.
   uint2* tile_ranges = nullptr;  // [tile_capacity]
   std::uint64_t tile_capacity = 0;
   // The blend's tile order, fullest first: tile_order[block] = tile; tile_places holds each
@@ -205,16 +220,19 @@ void launch_scan(std::size_t gaussians, const FrameBuffers& buffers, cudaStream_
 // Radix sort of `pairs` keys (in buffers.key_format) over bits [0, end_bit); returns which
 // buffer (0/1) holds the result.
 int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, cudaStream_t stream);
-// Tile ranges from the sorted keys in buffer `which`, and runs of equal keys put in (depth,
-// Gaussian id) order.
-void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers& buffers, int which,
+// The ranges of the `bins` bins from the sorted keys in buffer `which`, and runs of equal keys
+// put in (depth, Gaussian id) order.
+void launch_ranges(std::uint64_t pairs, std::uint64_t bins, const FrameBuffers& buffers, int which,
                    cudaStream_t stream);
-// tile_order from the tile ranges: tiles by descending bit length of their pair count (the
-// order inside a class is immaterial: tiles blend independently), so the fullest tiles start
+// tile_order from the bin ranges: bins by descending bit length of their pair count (the
+// order inside a class is immaterial: bins blend independently), so the fullest bins start
 // first instead of wherever they lie in the image.
-void launch_tile_order(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
-// FrameCounters::max_tile_pairs from the tile ranges (a statistic: run outside the timed stages).
-void launch_tile_max(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
+void launch_tile_order(std::uint64_t bins, const FrameBuffers& buffers, cudaStream_t stream);
+// FrameCounters::max_tile_pairs and tile_pairs from the bin ranges and the sorted values in
+// buffer `which` (statistics: run outside the timed stages); binned frames also write each
+// tile's pair count to `counts` unless it is null.
+void launch_tile_stats(int tiles_x, int tiles_y, const FrameBuffers& buffers, int which, std::uint32_t* counts,
+                       cudaStream_t stream);
 
 enum class BlendKernel { per_pixel, warp_tile, warp_tile_pipelined };
 struct BlendArgs {
@@ -223,9 +241,10 @@ struct BlendArgs {
   BlendKernel kernel;
   bool exp2_alpha;
   int region_width;              // warp blend: a warp's region, 16 x 4 or 8 x 8 pixels
-  const std::uint32_t* values;   // sorted blend records
+  const std::uint32_t* values;   // sorted pair values (blend records, with tile bits when binned)
+  BinGrid bins;                  // warp blend: what tile_ranges and tile_order index (per pixel: tiles)
   const uint2* tile_ranges;
-  const std::uint32_t* tile_order;  // warp blend: block b blends tile tile_order[b] (null: tile b)
+  const std::uint32_t* tile_order;  // warp blend: blocks blend bin tile_order[b] (null: bin b), a tile each
   const BlendGaussian* gaussians;
   float* image_rgb;              // float output, or
   unsigned long long surface;    // RGBA8 surface (when image_rgb is null)

@@ -8,6 +8,7 @@
 
 #include <cub/block/block_scan.cuh>
 
+#include "bins.cuh"
 #include "chunk_cull.cuh"
 #include "device_common.cuh"
 #include "flashgs/gaussian_math.h"
@@ -72,24 +73,26 @@ __device__ __forceinline__ gm::Footprint shfl_footprint(const gm::Footprint& f, 
   return g;
 }
 
-__device__ __forceinline__ bool touches(const gm::Footprint& f, int tx, int ty, const gm::CameraParams& cam,
-                                        bool exact) {
-  return !exact || gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height);
-}
-
-// A segment of up to 32 chunks of 32 tiles of a box (tiles counted row-major from the box's
-// first), walked by a warp: lane j handles tile s0 + 32 c + j of chunk c. The tile's column
+// A segment of up to 32 chunks of 32 bins of a box (bins counted row-major from the box's
+// first), walked by a warp: lane j handles bin s0 + 32 c + j of chunk c. The bin's column
 // and row advance by a fixed step per chunk, so only the first costs integer divisions.
 struct BoxWalk {
-  unsigned box, box_w;   // tiles in the box, tiles per box row
-  unsigned step_x, step_y;  // 32 tiles further: columns and rows to add
-  __device__ BoxWalk(const gm::Footprint& g)
-      : box(static_cast<unsigned>(g.tile_x1 - g.tile_x0) * static_cast<unsigned>(g.tile_y1 - g.tile_y0)),
-        box_w(static_cast<unsigned>(g.tile_x1 - g.tile_x0)),
+  BinBox bins;
+  unsigned box, box_w;   // bins in the box, bins per box row
+  unsigned step_x, step_y;  // 32 bins further: columns and rows to add
+  __device__ BoxWalk(const gm::Footprint& g, int shift)
+      : bins(g, shift),
+        box(bins.count()),
+        box_w(static_cast<unsigned>(bins.width())),
         step_x(kWarp % box_w),
         step_y(kWarp / box_w) {}
+  // The key's bin of box column x, row y.
+  __device__ unsigned bin(unsigned x, unsigned y, const BinGrid& grid) const {
+    return static_cast<unsigned>(bins.y0 + static_cast<int>(y)) * static_cast<unsigned>(grid.x) +
+           static_cast<unsigned>(bins.x0 + static_cast<int>(x));
+  }
   __device__ unsigned chunks(unsigned s0) const { return min(static_cast<unsigned>(kWarp), (box - s0 + kWarp - 1) / kWarp); }
-  // Column and row (in the box) of tile s0 + lane.
+  // Column and row (in the box) of bin s0 + lane.
   __device__ void start(unsigned s0, unsigned lane, unsigned& x, unsigned& y) const {
     const unsigned t = s0 + lane;
     x = t % box_w;
@@ -105,18 +108,24 @@ struct BoxWalk {
   }
 };
 
+// The tiles of box bin (x, y) that footprint g touches (bin_tiles).
+__device__ __forceinline__ unsigned walk_bin_tiles(const gm::Footprint& g, const BoxWalk& walk, int shift, unsigned x,
+                                                   unsigned y, const gm::CameraParams& cam, bool exact) {
+  return footprint_bin_tiles(g, shift, walk.bins.x0 + static_cast<int>(x), walk.bins.y0 + static_cast<int>(y), cam,
+                             exact);
+}
+
 // Tests the segment at s0 (all lanes call with the same footprint); lane c returns chunk c's
-// ballot of passing tiles.
+// ballot of passing bins.
 __device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
-                                      const gm::CameraParams& cam, bool exact) {
+                                      const gm::CameraParams& cam, bool exact, int shift) {
   const unsigned lane = lane_id();
   const unsigned chunks = walk.chunks(s0);
   unsigned x, y;
   walk.start(s0, lane, x, y);
   unsigned my_ballot = 0;
   for (unsigned c = 0; c < chunks; ++c) {
-    const bool pass = s0 + c * kWarp + lane < walk.box &&
-                      touches(g, g.tile_x0 + static_cast<int>(x), g.tile_y0 + static_cast<int>(y), cam, exact);
+    const bool pass = s0 + c * kWarp + lane < walk.box && walk_bin_tiles(g, walk, shift, x, y, cam, exact) != 0;
     const unsigned ballot = __ballot_sync(kFullMask, pass);
     if (lane == c) my_ballot = ballot;
     walk.advance(x, y);
@@ -124,10 +133,12 @@ __device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& wal
   return my_ballot;
 }
 
-// Writes the segment's passing tiles; lane c holds chunk c's ballot and its first offset.
+// Writes the segment's passing bins; lane c holds chunk c's ballot and its first offset. With
+// bins larger than a tile, a passing bin's tiles are tested again for its value (the test
+// kept no more than a bit per bin).
 __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
                                    unsigned my_ballot, unsigned long long my_base, std::uint32_t depth_bits,
-                                   unsigned record, const gm::CameraParams& cam) {
+                                   unsigned record, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
   const unsigned lanes_below = (1u << lane) - 1u;
   const unsigned chunks = walk.chunks(s0);
@@ -136,9 +147,11 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
   for (unsigned c = 0; c < chunks; ++c) {
     const unsigned ballot = __shfl_sync(kFullMask, my_ballot, c);
     const unsigned long long chunk_base = __shfl_sync(kFullMask, my_base, c);
-    if (ballot & (1u << lane))
-      store_pair(buf, chunk_base + __popc(ballot & lanes_below),
-                 static_cast<unsigned>(g.tile_y0 + static_cast<int>(y)) * cam.tiles_x + g.tile_x0 + x, depth_bits, record);
+    if (ballot & (1u << lane)) {
+      const unsigned tiles = buf.bins.shift ? walk_bin_tiles(g, walk, buf.bins.shift, x, y, cam, exact) : 1u;
+      store_pair(buf, chunk_base + __popc(ballot & lanes_below), walk.bin(x, y, buf.bins), depth_bits,
+                 pair_value(buf.bins, record, tiles));
+    }
     walk.advance(x, y);
   }
 }
@@ -148,10 +161,10 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
 __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g, std::uint32_t depth_bits,
                                   unsigned record, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
-  const BoxWalk walk(g);
+  const BoxWalk walk(g, buf.bins.shift);
   unsigned total = 0;
   for (unsigned s0 = 0; s0 < walk.box; s0 += kWarp * kWarp) {
-    const unsigned my_ballot = warp_test_segment(g, walk, s0, cam, exact);
+    const unsigned my_ballot = warp_test_segment(g, walk, s0, cam, exact, buf.bins.shift);
     const unsigned my_count = __popc(my_ballot);
     const unsigned inclusive = warp_inclusive_sum(my_count);
     const unsigned segment_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -159,36 +172,40 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
     unsigned long long base = 0;
     if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
     base = __shfl_sync(kFullMask, base, 0) + (inclusive - my_count);  // lane c: chunk c's offset
-    warp_write_segment(buf, g, walk, s0, my_ballot, base, depth_bits, record, cam);
+    warp_write_segment(buf, g, walk, s0, my_ballot, base, depth_bits, record, cam, exact);
     total += segment_total;
   }
   return total;
 }
 
-// The small boxes of a warp's Gaussians (at most kWarp tiles each), tested and emitted by the
-// whole warp over their concatenation, 32 tiles per step: a thread looping over its own box
+// The small boxes of a warp's Gaussians (at most kWarp bins each), tested and emitted by the
+// whole warp over their concatenation, 32 bins per step: a thread looping over its own box
 // left most lanes idle while the warp's largest box finished (2-7 of 32 lanes active).
-// What a lane's tile test needs of its owner is staged in shared memory.
+// What a lane's bin test needs of its owner is staged in shared memory.
 struct alignas(16) SmallBox {
   float4 whiten;
   float edge_slope_x, edge_slope_y, threshold, mean_x;
   float mean_y;
-  int tile_x0, tile_y0, box_w;
+  unsigned tiles_x, tiles_y;  // the tile box: first tile | one past the last << 16
+  int box_w;                  // bins per box row
   unsigned start, row_magic, record, depth_bits;  // row_magic: ceil(2^16 / box_w), t / box_w = (t row_magic) >> 16
 };
 constexpr int kSmallTilesPerWarp = kWarp * kWarp;
 
 struct SmallBoxScratch {
   SmallBox boxes[kWarp];
-  unsigned char owner[kSmallTilesPerWarp];  // concatenated tile -> the lane whose box holds it
+  unsigned char owner[kSmallTilesPerWarp];  // concatenated bin -> the lane whose box holds it
+  unsigned char tiles[kSmallTilesPerWarp];  // concatenated bin -> the tiles it touches (bin_tiles)
 };
 
-// Tile t of the box (row-major from its first tile): t < kSmallTilesPerWarp and box_w <= kWarp
+// Bin t of the box (row-major from its first bin): t < kSmallTilesPerWarp and box_w <= kWarp
 // keep (t row_magic) >> 16 exact (the magic's excess times t stays below 1/box_w).
-__device__ __forceinline__ void small_box_tile(const SmallBox& b, unsigned t, int& tx, int& ty) {
+__device__ __forceinline__ void small_box_bin(const SmallBox& b, int shift, unsigned t, int& bx, int& by) {
   const unsigned row = (t * b.row_magic) >> 16;
-  tx = b.tile_x0 + static_cast<int>(t - row * static_cast<unsigned>(b.box_w));
-  ty = b.tile_y0 + static_cast<int>(row);
+  bx = static_cast<int>(b.tiles_x & 0xffffu) >> shift;
+  by = static_cast<int>(b.tiles_y & 0xffffu) >> shift;
+  bx += static_cast<int>(t - row * static_cast<unsigned>(b.box_w));
+  by += static_cast<int>(row);
 }
 
 // All lanes call; my_box: this lane's box size (0: nothing to emit here). Returns this lane's
@@ -200,10 +217,13 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
   const unsigned inclusive = warp_inclusive_sum(my_box);
   const unsigned start = inclusive - my_box, total_tiles = __shfl_sync(kFullMask, inclusive, kWarp - 1);
   if (total_tiles == 0) return 0;
+  const int shift = buf.bins.shift;
   if (my_box > 0) {
-    const int box_w = f.tile_x1 - f.tile_x0;
+    const int box_w = BinBox(f, shift).width();
     s.boxes[lane] = SmallBox{make_float4(f.whiten[0], f.whiten[1], f.whiten[2], f.whiten[3]),
-                             f.edge_slope_x, f.edge_slope_y, f.threshold, f.mean_x, f.mean_y, f.tile_x0, f.tile_y0,
+                             f.edge_slope_x, f.edge_slope_y, f.threshold, f.mean_x, f.mean_y,
+                             static_cast<unsigned>(f.tile_x0) | static_cast<unsigned>(f.tile_x1) << 16,
+                             static_cast<unsigned>(f.tile_y0) | static_cast<unsigned>(f.tile_y1) << 16,
                              box_w, start, (65536u + static_cast<unsigned>(box_w) - 1u) / static_cast<unsigned>(box_w),
                              record, depth_bits};
     for (unsigned t = 0; t < my_box; ++t) s.owner[start + t] = static_cast<unsigned char>(lane);
@@ -217,11 +237,18 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
     bool pass = false;
     if (g < total_tiles) {
       const SmallBox& b = s.boxes[s.owner[g]];
-      int tx, ty;
-      small_box_tile(b, g - b.start, tx, ty);
+      int bx, by;
+      small_box_bin(b, shift, g - b.start, bx, by);
       const float w[4] = {b.whiten.x, b.whiten.y, b.whiten.z, b.whiten.w};
-      pass = gm::ellipse_touches_tile(w, b.edge_slope_x, b.edge_slope_y, b.threshold, b.mean_x, b.mean_y, tx, ty,
-                                      cam.width, cam.height);
+      const unsigned tiles = bin_tiles(shift, bx, by, static_cast<int>(b.tiles_x & 0xffffu),
+                                       static_cast<int>(b.tiles_y & 0xffffu), static_cast<int>(b.tiles_x >> 16),
+                                       static_cast<int>(b.tiles_y >> 16), [&](int tx, int ty) {
+                                         return gm::ellipse_touches_tile(w, b.edge_slope_x, b.edge_slope_y,
+                                                                         b.threshold, b.mean_x, b.mean_y, tx, ty,
+                                                                         cam.width, cam.height);
+                                       });
+      s.tiles[g] = static_cast<unsigned char>(tiles);
+      pass = tiles != 0;
     }
     const unsigned ballot = __ballot_sync(kFullMask, pass);
     if (lane == c) my_ballot = ballot;
@@ -255,12 +282,13 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
     const unsigned ballot = __shfl_sync(kFullMask, my_ballot, c);
     const unsigned long long step_base = __shfl_sync(kFullMask, base, c);
     if (ballot & (1u << lane)) {
-      const SmallBox& b = s.boxes[s.owner[c * kWarp + lane]];
-      int tx, ty;
-      small_box_tile(b, c * kWarp + lane - b.start, tx, ty);
+      const unsigned g = c * kWarp + lane;
+      const SmallBox& b = s.boxes[s.owner[g]];
+      int bx, by;
+      small_box_bin(b, shift, g - b.start, bx, by);
       store_pair(buf, step_base + __popc(ballot & lanes_below),
-                 static_cast<unsigned>(ty) * static_cast<unsigned>(cam.tiles_x) + static_cast<unsigned>(tx),
-                 b.depth_bits, b.record);
+                 static_cast<unsigned>(by) * static_cast<unsigned>(buf.bins.x) + static_cast<unsigned>(bx),
+                 b.depth_bits, pair_value(buf.bins, b.record, s.tiles[g]));
     }
   }
   __syncwarp();  // the scratch is free again
@@ -314,11 +342,12 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   gm::Footprint f{};
   int reason = gm::kCulledDegenerate;
   unsigned count = 0;          // pairs of this Gaussian (small path / separate path)
-  unsigned passed_mask = 0;    // tiles of a box of <= 32 tiles that passed the exact test
+  unsigned passed_mask = 0;    // bins of a box of <= 32 bins that passed the exact test
   bool large = false;          // emitted by a whole warp (large_emit_kernel, or below)
   bool deferred = false;       // emitted and counted by large_emit_kernel or huge_emit_kernel
   // The flash path: boxes of at most large_box_tiles <= 32 tiles tested by the whole warp.
   const bool balanced = FUSED && args.warp_cooperative && args.exact_tile_test && args.large_box_tiles <= kWarp;
+  const int shift = buf.bins.shift;
   unsigned small_box = 0;
   float4 po{}, sd{};
   if (valid) {
@@ -370,8 +399,8 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   }
   // A frame whose records overflowed still counts (and writes) its pairs: it runs again.
   if (visible) {
-    const int box_w = f.tile_x1 - f.tile_x0;
-    const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
+    const BinBox bins(f, shift);
+    const unsigned box = bins.count();
     if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kHugeBoxTiles)) {
       const unsigned slot = atomicAdd(&buf.counters->huge, 1u);
       if (slot < buf.huge.capacity) {
@@ -389,9 +418,9 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
       small_box = box;
     } else {
       unsigned k = 0;
-      for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
-        for (int tx = f.tile_x0; tx < f.tile_x1; ++tx, ++k)
-          if (gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height)) {
+      for (int by = bins.y0; by < bins.y1; ++by)
+        for (int bx = bins.x0; bx < bins.x1; ++bx, ++k)
+          if (footprint_bin_tiles(f, shift, bx, by, cam, true) != 0) {
             ++count;
             if (k < 32) passed_mask |= 1u << k;
           }
@@ -411,19 +440,23 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     base = __shfl_sync(kFullMask, base, kWarp - 1);
     if (!balanced && count > 0) {
       unsigned long long offset = base + inclusive - count;
-      const int box_w = f.tile_x1 - f.tile_x0;
-      const unsigned box = static_cast<unsigned>(box_w) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
-      if (args.exact_tile_test && box <= 32) {
+      const BinBox bins(f, shift);
+      auto store = [&](int bx, int by, unsigned tiles) {
+        store_pair(buf, offset++, static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits,
+                   pair_value(buf.bins, record, tiles));
+      };
+      if (args.exact_tile_test && bins.count() <= 32) {
         for (unsigned m = passed_mask; m; m &= m - 1) {
           const unsigned k = __ffs(m) - 1;
-          const unsigned tile = (f.tile_y0 + k / box_w) * cam.tiles_x + f.tile_x0 + k % box_w;
-          store_pair(buf, offset++, tile, depth_bits, record);
+          const int bx = bins.x0 + static_cast<int>(k % bins.width()), by = bins.y0 + static_cast<int>(k / bins.width());
+          store(bx, by, shift ? footprint_bin_tiles(f, shift, bx, by, cam, true) : 1u);
         }
       } else {
-        for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
-          for (int tx = f.tile_x0; tx < f.tile_x1; ++tx)
-            if (touches(f, tx, ty, cam, args.exact_tile_test))
-              store_pair(buf, offset++, static_cast<unsigned>(ty) * cam.tiles_x + tx, depth_bits, record);
+        for (int by = bins.y0; by < bins.y1; ++by)
+          for (int bx = bins.x0; bx < bins.x1; ++bx) {
+            const unsigned tiles = footprint_bin_tiles(f, shift, bx, by, cam, args.exact_tile_test);
+            if (tiles) store(bx, by, tiles);
+          }
       }
     }
     // Large Gaussians: the warp tests 32 tiles at a time (FlashGS section 4.3). Lane c keeps
@@ -530,8 +563,8 @@ __global__ void __launch_bounds__(kBlock) large_emit_kernel(FrameBuffers buf, gm
       unsigned emitted = 0;  // by warp_emit_box, for a box of several segments
       if (k < count) {
         const gm::Footprint f = buf.large.footprints[k];
-        const BoxWalk walk(f);
-        if (walk.box <= kWarp * kWarp) my_ballot[j] = warp_test_segment(f, walk, 0, cam, exact);
+        const BoxWalk walk(f, buf.bins.shift);
+        if (walk.box <= kWarp * kWarp) my_ballot[j] = warp_test_segment(f, walk, 0, cam, exact, buf.bins.shift);
         else emitted = warp_emit_box(buf, f, sort_depth(buf.key_format, f.depth), buf.large.records[k], cam, exact);
       }
       const unsigned my_count = __popc(my_ballot[j]);
@@ -554,8 +587,8 @@ __global__ void __launch_bounds__(kBlock) large_emit_kernel(FrameBuffers buf, gm
       if (k >= count) break;
       if (!__any_sync(kFullMask, my_ballot[j] != 0)) continue;  // nothing passed (or emitted already)
       const gm::Footprint f = buf.large.footprints[k];
-      warp_write_segment(buf, f, BoxWalk(f), 0, my_ballot[j], base + my_offset[j],
-                         sort_depth(buf.key_format, f.depth), buf.large.records[k], cam);
+      warp_write_segment(buf, f, BoxWalk(f, buf.bins.shift), 0, my_ballot[j], base + my_offset[j],
+                         sort_depth(buf.key_format, f.depth), buf.large.records[k], cam, exact);
     }
   }
   if (lane == 0) {
@@ -583,14 +616,17 @@ __global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm:
     const gm::Footprint f = buf.huge.footprints[h];
     const unsigned record = buf.huge.records[h];
     const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
-    const unsigned box_w = static_cast<unsigned>(f.tile_x1 - f.tile_x0);
-    const unsigned box = box_w * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
+    const int shift = buf.bins.shift;
+    const BinBox bins(f, shift);
+    const unsigned box_w = static_cast<unsigned>(bins.width());
+    const unsigned box = bins.count();
     unsigned gaussian_total = 0;
     for (unsigned s0 = 0; s0 < box; s0 += kSegmentChunks * kWarp) {
       const unsigned chunks = min(static_cast<unsigned>(kSegmentChunks), (box - s0 + kWarp - 1) / kWarp);
       for (unsigned c = warp; c < chunks; c += kWarps) {
         const unsigned t = s0 + c * kWarp + lane;
-        const bool pass = t < box && touches(f, f.tile_x0 + t % box_w, f.tile_y0 + t / box_w, cam, exact);
+        const bool pass = t < box && footprint_bin_tiles(f, shift, bins.x0 + static_cast<int>(t % box_w),
+                                                         bins.y0 + static_cast<int>(t / box_w), cam, exact) != 0;
         const unsigned ballot = __ballot_sync(kFullMask, pass);
         if (lane == 0) ballots[c] = ballot;
       }
@@ -618,8 +654,10 @@ __global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm:
           const unsigned ballot = ballots[c];
           if (ballot & (1u << lane)) {
             const unsigned t = s0 + c * kWarp + lane;
+            const int bx = bins.x0 + static_cast<int>(t % box_w), by = bins.y0 + static_cast<int>(t / box_w);
+            const unsigned tiles = shift ? footprint_bin_tiles(f, shift, bx, by, cam, exact) : 1u;
             store_pair(buf, segment_base + chunk_offsets[c] + __popc(ballot & lanes_below),
-                       (f.tile_y0 + t / box_w) * cam.tiles_x + f.tile_x0 + t % box_w, depth_bits, record);
+                       static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits, pair_value(buf.bins, record, tiles));
           }
         }
       }

@@ -1,7 +1,8 @@
-// Stage `ranges`: each tile's [start, end) in the sorted pairs, the blend's tile order (fullest
+// Stage `ranges`: each bin's [start, end) in the sorted pairs, the blend's bin order (fullest
 // first), and runs of equal keys put in (depth, Gaussian id) order, so the blend order is
 // exactly the CPU's whatever the key format: equal 64-bit keys share their depth (the atomics
-// of emission shuffled their records), equal compact keys share a quantised depth bin.
+// of emission shuffled their records), equal compact keys share a quantised depth bin. (A
+// bin is a tile, or 2x2 tiles with macro bins: pipeline.h, BinGrid.)
 #include "device_common.cuh"
 #include "pipeline.h"
 
@@ -15,10 +16,12 @@ constexpr int kBlock = 256;
 struct Records {
   const BlendGaussian* gaussians;
   const std::uint32_t* ids;
+  std::uint32_t value_mask;  // a pair value's record bits
 };
 
 // The blend order of a pair: its Gaussian's exact depth bits, then its id.
-__device__ __forceinline__ std::uint64_t blend_order(const Records& r, std::uint32_t record) {
+__device__ __forceinline__ std::uint64_t blend_order(const Records& r, std::uint32_t value) {
+  const std::uint32_t record = value & r.value_mask;
   const std::uint32_t id = r.ids ? r.ids[record] : record;
   return (static_cast<std::uint64_t>(__float_as_uint(r.gaussians[record].depth)) << 32) | id;
 }
@@ -78,13 +81,41 @@ __global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, con
   }
 }
 
-// The largest end - start over the tiles: a warp reduction, one atomic per warp.
+// The largest end - start over the tiles and their sum: warp reductions, one atomic each per warp.
 __global__ void __launch_bounds__(kBlock) tile_max_kernel(std::uint64_t tiles, const uint2* __restrict__ tile_ranges,
                                                           FrameCounters* counters) {
   const std::uint64_t t = static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x;
   const uint2 range = t < tiles ? tile_ranges[t] : make_uint2(0, 0);
   const unsigned warp_max = __reduce_max_sync(kFullMask, range.y - range.x);
-  if (lane_id() == 0 && warp_max > 0) atomicMax(&counters->max_tile_pairs, warp_max);
+  const unsigned warp_sum = __reduce_add_sync(kFullMask, range.y - range.x);
+  if (lane_id() == 0 && warp_max > 0) {
+    atomicMax(&counters->max_tile_pairs, warp_max);
+    atomicAdd(&counters->tile_pairs, static_cast<unsigned long long>(warp_sum));
+  }
+}
+
+// Binned frames: each tile's pairs (the values of its bin that carry its bit), their sum and
+// the largest, and counts[tile] unless counts is null. A warp per tile.
+__global__ void __launch_bounds__(kBlock) binned_tile_stats_kernel(int tiles_x, int tiles_y, BinGrid bins,
+                                                                   const uint2* __restrict__ bin_ranges,
+                                                                   const std::uint32_t* __restrict__ values,
+                                                                   std::uint32_t* counts, FrameCounters* counters) {
+  const std::uint64_t t = (static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x) / kWarp;
+  if (t >= static_cast<std::uint64_t>(tiles_x) * static_cast<std::uint64_t>(tiles_y)) return;  // whole warp
+  const int tx = static_cast<int>(t % static_cast<unsigned>(tiles_x)), ty = static_cast<int>(t / static_cast<unsigned>(tiles_x));
+  const int side = 1 << bins.shift;
+  const uint2 range = bin_ranges[(ty >> bins.shift) * bins.x + (tx >> bins.shift)];
+  const std::uint32_t bit = 1u << (((ty & (side - 1)) << bins.shift) + (tx & (side - 1)) + kBinTileBitsShift);
+  unsigned n = 0;
+  for (unsigned i = range.x + lane_id(); i < range.y; i += kWarp) n += (values[i] & bit) ? 1u : 0u;
+  n = __reduce_add_sync(kFullMask, n);
+  if (lane_id() == 0) {
+    if (counts) counts[t] = n;
+    if (n > 0) {
+      atomicMax(&counters->max_tile_pairs, n);
+      atomicAdd(&counters->tile_pairs, static_cast<unsigned long long>(n));
+    }
+  }
 }
 
 // A tile's class: the leading zeros of its pair count, so fuller tiles come first.
@@ -134,19 +165,27 @@ void launch_tile_order(std::uint64_t tiles, const FrameBuffers& b, cudaStream_t 
   check_cuda(cudaGetLastError(), "tile order kernel launch");
 }
 
-void launch_tile_max(std::uint64_t tiles, const FrameBuffers& b, cudaStream_t stream) {
+void launch_tile_stats(int tiles_x, int tiles_y, const FrameBuffers& b, int which, std::uint32_t* counts,
+                       cudaStream_t stream) {
+  const std::uint64_t tiles = static_cast<std::uint64_t>(tiles_x) * static_cast<std::uint64_t>(tiles_y);
   if (tiles == 0) return;
-  const unsigned blocks = static_cast<unsigned>((tiles + kBlock - 1) / kBlock);
-  tile_max_kernel<<<blocks, kBlock, 0, stream>>>(tiles, b.tile_ranges, b.counters);
-  check_cuda(cudaGetLastError(), "tile max kernel launch");
+  if (b.bins.shift == 0) {
+    const unsigned blocks = static_cast<unsigned>((tiles + kBlock - 1) / kBlock);
+    tile_max_kernel<<<blocks, kBlock, 0, stream>>>(tiles, b.tile_ranges, b.counters);
+  } else {
+    const unsigned blocks = static_cast<unsigned>((tiles * kWarp + kBlock - 1) / kBlock);
+    binned_tile_stats_kernel<<<blocks, kBlock, 0, stream>>>(tiles_x, tiles_y, b.bins, b.tile_ranges, b.values[which],
+                                                            counts, b.counters);
+  }
+  check_cuda(cudaGetLastError(), "tile statistics kernel launch");
 }
 
-void launch_ranges(std::uint64_t pairs, std::uint64_t tiles, const FrameBuffers& b, int which,
+void launch_ranges(std::uint64_t pairs, std::uint64_t bins, const FrameBuffers& b, int which,
                    cudaStream_t stream) {
-  check_cuda(cudaMemsetAsync(b.tile_ranges, 0, tiles * sizeof(uint2), stream), "tile range reset");
+  check_cuda(cudaMemsetAsync(b.tile_ranges, 0, bins * sizeof(uint2), stream), "bin range reset");
   if (pairs == 0) return;
   const unsigned blocks = static_cast<unsigned>((pairs + kBlock - 1) / kBlock);
-  const Records records{b.blend, b.record_ids};
+  const Records records{b.blend, b.record_ids, b.bins.shift ? kRecordMask : ~0u};
   if (b.key_format.depth_bits > 0)
     ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, reinterpret_cast<const std::uint32_t*>(b.keys[which]),
                                                  b.key_format.depth_bits, b.values[which], records, b.tile_ranges);

@@ -87,6 +87,7 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
   std::uint64_t pairs = 0;
   for (int c = 0; c < chunks; ++c) pairs += frame.chunk_keys[c].size();
   stats.kv_pairs = pairs;
+  stats.sorted_pairs = pairs;
   stats.culled_offscreen += ellipse_missed;  // project counted the boxes that missed the image
 }
 

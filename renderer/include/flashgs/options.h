@@ -27,6 +27,7 @@ struct RenderOptions {
   bool warp_cooperative_emit = true;
   bool fused_emit = true;
   bool minimal_sort_bits = true;
+  bool macro_bins = true;
   bool dense_tiles_first = true;
   bool pipelined_blend = true;
   bool exp2_alpha = true;
@@ -99,6 +100,9 @@ inline constexpr RenderSwitch kRenderSwitches[] = {
     {"sort-bits", "sort_bits", "Sort bits", &RenderOptions::minimal_sort_bits, kCudaOnly, false,
      "radix sort over only the key bits the frame needs instead of all 64",
      "section 4, sort of the Gaussian-tile keys", "the CPU backend counting-sorts by tile, not by key bits"},
+    {"macro-bins", "macro_bins", "Macro bins", &RenderOptions::macro_bins, kCudaOnly, false,
+     "keys per 32x32-pixel bin carrying the bin's touched tiles: about half the pairs to sort",
+     "not in it: HiGS-style macro-tile binning, blended per tile", "the CPU backend sorts each tile's list on its own"},
     {"dense-tiles-first", "dense_tiles_first", "Dense tiles first", &RenderOptions::dense_tiles_first, kCudaOnly,
      false, "the blend takes tiles fullest first: no dense tile starting last and setting the frame's length",
      "not in it: our order of the blend's tiles", "the CPU backend schedules its tiles dynamically"},

@@ -18,6 +18,9 @@ struct StageTimes {
 
 struct FrameStats {
   std::uint64_t kv_pairs = 0;  // Gaussian-tile pairs emitted this frame
+  // Pairs the sort ordered: kv_pairs, or with CUDA macro bins (RenderOptions::macro_bins) one
+  // per Gaussian and 2x2-tile bin it touches.
+  std::uint64_t sorted_pairs = 0;
   int tiles_x = 0, tiles_y = 0;
   // Pairs per tile, row-major tiles_y x tiles_x; filled only when
   // RenderOptions::collect_tile_counts is set.
