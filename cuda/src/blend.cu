@@ -4,7 +4,6 @@
 #include <math.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <type_traits>
 
 #include "device_common.cuh"
@@ -127,40 +126,25 @@ struct TileList {
 };
 
 // The same for a tile of a larger bin: the bin's values that carry the tile's bit, gathered
-// into a per-warp ring in shared memory, so that every batch the blend stages is full of the
-// tile's own Gaussians (about 45% of a 2x2 bin's values are). fill() takes 64 values a step
-// (two per lane, loaded one step ahead, so that their latency passes while the blend works
-// on a batch) until 32 are queued or the bin is done: at most 31 + 64 in the ring.
+// 32 values per step into a per-warp ring in shared memory, so that every batch the blend
+// stages is full of the tile's own Gaussians (about 45% of a 2x2 bin's values are).
+// fill() keeps at least 32 queued while the bin has values left: at most 31 + 32 in the ring.
 struct BinTileList {
-  static constexpr unsigned kRing = 4 * kWarp;
+  static constexpr unsigned kRing = 2 * kWarp;
   const std::uint32_t* values;
   unsigned* ring;  // [kRing], this warp's
   unsigned cursor, end, bit;
   unsigned head, tail;  // queued: ring[head..tail) mod kRing
-  std::uint32_t ahead[2];  // the values at cursor + lane and cursor + 32 + lane
-  __device__ BinTileList(const std::uint32_t* v, unsigned* r, uint2 range, unsigned tile_bit)
-      : values(v), ring(r), cursor(range.x), end(range.y), bit(tile_bit), head(0), tail(0) {
-    load_ahead();
-  }
-  __device__ void load_ahead() {
-    const unsigned i = cursor + lane_id();
-    ahead[0] = i < end ? values[i] : 0u;  // 0: no tile's bit
-    ahead[1] = i + kWarp < end ? values[i + kWarp] : 0u;
-  }
-  __device__ void queue(std::uint32_t v, unsigned lanes_below) {
-    const bool mine = (v & bit) != 0;
-    const unsigned ballot = __ballot_sync(kFullMask, mine);
-    if (mine) ring[(tail + __popc(ballot & lanes_below)) % kRing] = v & kRecordMask;
-    tail += __popc(ballot);
-  }
   __device__ void fill() {
-    const unsigned lanes_below = (1u << lane_id()) - 1u;
+    const unsigned lane = lane_id();
     while (tail - head < kWarp && cursor < end) {  // warp-uniform
-      const std::uint32_t v0 = ahead[0], v1 = ahead[1];
-      cursor += 2 * kWarp;
-      load_ahead();
-      queue(v0, lanes_below);
-      queue(v1, lanes_below);
+      const unsigned i = cursor + lane;
+      const std::uint32_t v = i < end ? values[i] : 0u;
+      const bool mine = (v & bit) != 0;
+      const unsigned ballot = __ballot_sync(kFullMask, mine);
+      if (mine) ring[(tail + __popc(ballot & ((1u << lane) - 1u))) % kRing] = v & kRecordMask;
+      tail += __popc(ballot);
+      cursor += kWarp;
     }
     __syncwarp();
   }
@@ -196,15 +180,8 @@ constexpr float kFinishedX = 1e30f;
 // Gaussians add exactly nothing to it. Otherwise the arithmetic is the CPU's, term for term.
 // BINNED: the pairs are keyed by bins of 2x2 tiles (BinGrid); the 4 blocks of a bin blend its
 // tiles, each walking the bin's list for the values that carry its bit (BinTileList).
-// A window of a bin's list that a block gathers its tile's records from at once (BIN_MODE 2).
-constexpr unsigned kWindow = 2048;
-constexpr unsigned kWindowChunks = kWindow / kWarp;
-
-// The default kernel (EXP2, PIPELINED) fits 48 registers without spilling, so 10 blocks share
-// an SM; the compiler's own choice of 50-58 leaves room for 9.
-template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE, int BIN_MODE>
-__global__ void __launch_bounds__(kWarpsPerBlock * kWarp, EXP2 && PIPELINED ? 10 : 1)
-    blend_warp_tile_kernel(BlendArgs a) {
+template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE, bool BINNED>
+__global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
   constexpr int kRegionH = 64 / REGION_W;
   constexpr int kLanesX = REGION_W / kLanePixelsX;
   constexpr int kRegionsX = kTile / REGION_W;
@@ -213,7 +190,6 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp, EXP2 && PIPELINED ? 10
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   // A block is one tile, its warps the tile's regions.
   static_assert(kWarpsPerBlock == kRegionsPerTile, "a block must be one tile");
-  constexpr bool BINNED = BIN_MODE != 0;
   constexpr int kShift = BINNED ? kMacroBinShift : 0;
   const unsigned block_bin = blockIdx.x >> (2 * kShift);
   const unsigned bin = a.tile_order ? a.tile_order[block_bin] : block_bin;
@@ -244,8 +220,14 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp, EXP2 && PIPELINED ? 10
   }
   const unsigned inside = live;
   const uint2 range = a.tile_ranges[bin];
-  const unsigned tile_bit = 1u << (tile_in_bin + kBinTileBitsShift);
-  auto blend_list = [&](auto& list) {
+  __shared__ unsigned ring[BINNED ? kWarpsPerBlock : 1][BinTileList::kRing];
+  using List = std::conditional_t<BINNED, BinTileList, TileList>;
+  List list;
+  if constexpr (BINNED) {
+    list = BinTileList{a.values, ring[warp], range.x, range.y, 1u << (tile_in_bin + kBinTileBitsShift), 0u, 0u};
+  } else {
+    list = TileList{a.values, range.x, range.y};
+  }
   // This batch's records (n of them, lane j the j-th) and, PIPELINED, their Gaussians.
   unsigned record = 0;
   list.fill();
@@ -344,54 +326,6 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp, EXP2 && PIPELINED ? 10
     n = next_n;
     record = next_record;
   }
-  };
-  if constexpr (BIN_MODE == 2) {
-    __shared__ unsigned window_records[kWindow];
-    __shared__ unsigned chunk_starts[kWindowChunks + 1];
-    const unsigned lanes_below = (1u << lane) - 1u;
-    for (unsigned w0 = range.x; w0 < range.y; w0 += kWindow) {
-      const unsigned w_end = min(range.y, w0 + kWindow), chunks = (w_end - w0 + kWarp - 1) / kWarp;
-      for (unsigned c = warp; c < chunks; c += kWarpsPerBlock) {
-        const unsigned i = w0 + c * kWarp + lane;
-        const unsigned ballot = __ballot_sync(kFullMask, i < w_end && (a.values[i] & tile_bit) != 0);
-        if (lane == 0) chunk_starts[c] = __popc(ballot);
-      }
-      __syncthreads();
-      if (warp == 0) {
-        static_assert(kWindowChunks == 2 * kWarp, "two chunks per lane");
-        const unsigned c0 = 2 * lane < chunks ? chunk_starts[2 * lane] : 0u;
-        const unsigned c1 = 2 * lane + 1 < chunks ? chunk_starts[2 * lane + 1] : 0u;
-        const unsigned inclusive = warp_inclusive_sum(c0 + c1);
-        chunk_starts[2 * lane] = inclusive - c0 - c1;
-        chunk_starts[2 * lane + 1] = inclusive - c1;
-        if (lane == kWarp - 1) chunk_starts[kWindowChunks] = inclusive;
-      }
-      __syncthreads();
-      for (unsigned c = warp; c < chunks; c += kWarpsPerBlock) {
-        const unsigned i = w0 + c * kWarp + lane;
-        const std::uint32_t v = i < w_end ? a.values[i] : 0u;
-        const bool mine = (v & tile_bit) != 0;
-        const unsigned ballot = __ballot_sync(kFullMask, mine);
-        if (mine) window_records[chunk_starts[c] + __popc(ballot & lanes_below)] = v & kRecordMask;
-      }
-      __syncthreads();
-      TileList list{window_records, 0, chunk_starts[kWindowChunks]};
-      blend_list(list);
-      if constexpr (EXP2) {
-        live = 0;
-#pragma unroll
-        for (int p = 0; p < kLanePixelsX; ++p) live |= lane_x[p] != kFinishedX ? 1u << p : 0u;
-      }
-      if (!__syncthreads_or(live != 0)) break;  // also: every warp is done with this window
-    }
-  } else if constexpr (BIN_MODE == 1) {
-    __shared__ unsigned ring[kWarpsPerBlock][BinTileList::kRing];
-    BinTileList list(a.values, ring[warp], range, tile_bit);
-    blend_list(list);
-  } else {
-    TileList list{a.values, range.x, range.y};
-    blend_list(list);
-  }
 #pragma unroll
   for (int p = 0; p < kLanePixelsX; ++p)
     if (inside & (1u << p))
@@ -399,7 +333,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp, EXP2 && PIPELINED ? 10
                            cb[p] + t[p] * a.background[2]);
 }
 
-template <int REGION_W, bool SURFACE, int BINNED>
+template <int REGION_W, bool SURFACE, bool BINNED>
 void launch_warp_tile(const BlendArgs& a, cudaStream_t stream) {
   // A block per tile of each bin (tiles of bins over the image's edge return at once).
   const unsigned blocks = static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y) << (2 * a.bins.shift);
@@ -415,7 +349,7 @@ void launch_warp_tile(const BlendArgs& a, cudaStream_t stream) {
     blend_warp_tile_kernel<REGION_W, false, false, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
 }
 
-template <bool SURFACE, int BINNED>
+template <bool SURFACE, bool BINNED>
 void launch_warp_tile_for_region(const BlendArgs& a, cudaStream_t stream) {
   if (a.region_width == 16) launch_warp_tile<16, SURFACE, BINNED>(a, stream);
   else launch_warp_tile<8, SURFACE, BINNED>(a, stream);
@@ -428,10 +362,8 @@ void launch_for_output(const BlendArgs& a, cudaStream_t stream) {
     blend_per_pixel_kernel<SURFACE><<<tiles, kTile * kTile, 0, stream>>>(a);
     return;
   }
-  static const bool tmp_block = std::getenv("FLASHGS_TMP_BLOCKFILTER") != nullptr;
-  if (a.bins.shift == kMacroBinShift && tmp_block) launch_warp_tile_for_region<SURFACE, 2>(a, stream);
-  else if (a.bins.shift == kMacroBinShift) launch_warp_tile_for_region<SURFACE, 1>(a, stream);
-  else launch_warp_tile_for_region<SURFACE, 0>(a, stream);
+  if (a.bins.shift == kMacroBinShift) launch_warp_tile_for_region<SURFACE, true>(a, stream);
+  else launch_warp_tile_for_region<SURFACE, false>(a, stream);
 }
 
 }  // namespace
@@ -440,7 +372,7 @@ std::uint64_t blend_resident_blocks() {
   int device = 0, sms = 0, per_sm = 0;
   check_cuda(cudaGetDevice(&device), "device query");
   check_cuda(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "device query");
-  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false, 1>,
+  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false, true>,
                                                            kWarpsPerBlock * kWarp, 0),
              "occupancy query");
   return static_cast<std::uint64_t>(std::max(1, sms * per_sm));

@@ -178,77 +178,58 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
   return total;
 }
 
-// The small boxes of a warp's Gaussians (at most kWarp tiles each), tested and emitted by the
-// whole warp over their concatenation, 32 tiles per step: a thread looping over its own box
+// The small boxes of a warp's Gaussians (at most kWarp bins each), tested and emitted by the
+// whole warp over their concatenation, 32 bins per step: a thread looping over its own box
 // left most lanes idle while the warp's largest box finished (2-7 of 32 lanes active).
-// What a lane's tile test needs of its owner is staged in shared memory. With bins larger
-// than a tile, the tiles' results are then gathered bin by bin over the concatenation of the
-// boxes' bins, so that each tile is still tested once, by one lane.
+// What a lane's bin test needs of its owner is staged in shared memory.
 struct alignas(16) SmallBox {
   float4 whiten;
   float edge_slope_x, edge_slope_y, threshold, mean_x;
   float mean_y;
-  int tile_x0, tile_y0, box_w;
+  unsigned tiles_x, tiles_y;  // the tile box: first tile | one past the last << 16
+  int box_w;                  // bins per box row
   unsigned start, row_magic, record, depth_bits;  // row_magic: ceil(2^16 / box_w), t / box_w = (t row_magic) >> 16
-  unsigned bin_start, bin_row_magic, bin_box_w, box_h;  // the same for the box's bins; box_h: tile rows
 };
 constexpr int kSmallTilesPerWarp = kWarp * kWarp;
 
 struct SmallBoxScratch {
   SmallBox boxes[kWarp];
-  unsigned char owner[kSmallTilesPerWarp];      // concatenated tile -> the lane whose box holds it
-  unsigned char bin_owner[kSmallTilesPerWarp];  // concatenated bin -> the lane whose box holds it
-  unsigned char bin_tiles[kSmallTilesPerWarp];  // concatenated bin -> the tiles it touches (bin_tiles)
-  unsigned passed[kWarp];                       // step c's ballot of passing tiles
+  unsigned char owner[kSmallTilesPerWarp];  // concatenated bin -> the lane whose box holds it
+  unsigned char tiles[kSmallTilesPerWarp];  // concatenated bin -> the tiles it touches (bin_tiles)
 };
 
-// Element t of a row-major box of `width` columns (t < kSmallTilesPerWarp, width <= kWarp keep
-// (t magic) >> 16 exact: the magic's excess times t stays below 1 / width).
-__device__ __forceinline__ void small_box_cell(unsigned t, unsigned magic, unsigned width, int& col, int& row) {
-  const unsigned r = (t * magic) >> 16;
-  col = static_cast<int>(t - r * width);
-  row = static_cast<int>(r);
-}
-__device__ __forceinline__ unsigned row_magic(unsigned width) { return (65536u + width - 1u) / width; }
-
-// Lane c's count of the passing units (tiles or bins) of [start, start + count) given each
-// step's ballot in lane c (all lanes call): the bits of that range, in at most two steps.
-__device__ __forceinline__ unsigned small_box_count(unsigned my_ballot, unsigned start, unsigned count) {
-  const unsigned first_step = start / kWarp, last_step = (start + (count > 0 ? count : 1) - 1) / kWarp;
-  const unsigned b0 = __shfl_sync(kFullMask, my_ballot, first_step & (kWarp - 1));
-  const unsigned b1 = __shfl_sync(kFullMask, my_ballot, last_step & (kWarp - 1));
-  if (count == 0) return 0;
-  const unsigned lo = start % kWarp;
-  if (first_step == last_step) return __popc(b0 & ((count == kWarp ? 0xffffffffu : ((1u << count) - 1u)) << lo));
-  return __popc(b0 & (0xffffffffu << lo)) + __popc(b1 & ((1u << ((start + count) % kWarp)) - 1u));
+// Bin t of the box (row-major from its first bin): t < kSmallTilesPerWarp and box_w <= kWarp
+// keep (t row_magic) >> 16 exact (the magic's excess times t stays below 1/box_w).
+__device__ __forceinline__ void small_box_bin(const SmallBox& b, int shift, unsigned t, int& bx, int& by) {
+  const unsigned row = (t * b.row_magic) >> 16;
+  bx = static_cast<int>(b.tiles_x & 0xffffu) >> shift;
+  by = static_cast<int>(b.tiles_y & 0xffffu) >> shift;
+  bx += static_cast<int>(t - row * static_cast<unsigned>(b.box_w));
+  by += static_cast<int>(row);
 }
 
-// All lanes call; my_box: this lane's box size in tiles (0: nothing to emit here). Returns
-// this lane's pair count.
+// All lanes call; my_box: this lane's box size (0: nothing to emit here). Returns this lane's
+// pair count.
 __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers& buf, const gm::Footprint& f,
                                           unsigned my_box, std::uint32_t depth_bits, unsigned record,
                                           const gm::CameraParams& cam) {
   const unsigned lane = lane_id();
-  const int shift = buf.bins.shift;
   const unsigned inclusive = warp_inclusive_sum(my_box);
   const unsigned start = inclusive - my_box, total_tiles = __shfl_sync(kFullMask, inclusive, kWarp - 1);
   if (total_tiles == 0) return 0;
-  const unsigned my_bins = my_box > 0 && shift ? BinBox(f, shift).count() : my_box;
-  const unsigned bin_inclusive = shift ? warp_inclusive_sum(my_bins) : inclusive;
-  const unsigned bin_start = bin_inclusive - my_bins, total_bins = __shfl_sync(kFullMask, bin_inclusive, kWarp - 1);
+  const int shift = buf.bins.shift;
   if (my_box > 0) {
-    const unsigned box_w = static_cast<unsigned>(f.tile_x1 - f.tile_x0);
-    const unsigned bin_box_w = static_cast<unsigned>(BinBox(f, shift).width());
+    const int box_w = BinBox(f, shift).width();
     s.boxes[lane] = SmallBox{make_float4(f.whiten[0], f.whiten[1], f.whiten[2], f.whiten[3]),
-                             f.edge_slope_x, f.edge_slope_y, f.threshold, f.mean_x, f.mean_y, f.tile_x0, f.tile_y0,
-                             static_cast<int>(box_w), start, row_magic(box_w), record, depth_bits,
-                             bin_start, row_magic(bin_box_w), bin_box_w, static_cast<unsigned>(f.tile_y1 - f.tile_y0)};
+                             f.edge_slope_x, f.edge_slope_y, f.threshold, f.mean_x, f.mean_y,
+                             static_cast<unsigned>(f.tile_x0) | static_cast<unsigned>(f.tile_x1) << 16,
+                             static_cast<unsigned>(f.tile_y0) | static_cast<unsigned>(f.tile_y1) << 16,
+                             box_w, start, (65536u + static_cast<unsigned>(box_w) - 1u) / static_cast<unsigned>(box_w),
+                             record, depth_bits};
     for (unsigned t = 0; t < my_box; ++t) s.owner[start + t] = static_cast<unsigned char>(lane);
-    if (shift)
-      for (unsigned t = 0; t < my_bins; ++t) s.bin_owner[bin_start + t] = static_cast<unsigned char>(lane);
   }
   __syncwarp();
-  // Test: lane c keeps step c's ballot (and s.passed[c] holds it for the bins).
+  // Test: lane c keeps step c's ballot.
   const unsigned steps = (total_tiles + kWarp - 1) / kWarp;
   unsigned my_ballot = 0;
   for (unsigned c = 0; c < steps; ++c) {
@@ -256,41 +237,38 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
     bool pass = false;
     if (g < total_tiles) {
       const SmallBox& b = s.boxes[s.owner[g]];
-      int col, row;
-      small_box_cell(g - b.start, b.row_magic, static_cast<unsigned>(b.box_w), col, row);
+      int bx, by;
+      small_box_bin(b, shift, g - b.start, bx, by);
       const float w[4] = {b.whiten.x, b.whiten.y, b.whiten.z, b.whiten.w};
-      pass = gm::ellipse_touches_tile(w, b.edge_slope_x, b.edge_slope_y, b.threshold, b.mean_x, b.mean_y,
-                                      b.tile_x0 + col, b.tile_y0 + row, cam.width, cam.height);
+      const unsigned tiles = bin_tiles(shift, bx, by, static_cast<int>(b.tiles_x & 0xffffu),
+                                       static_cast<int>(b.tiles_y & 0xffffu), static_cast<int>(b.tiles_x >> 16),
+                                       static_cast<int>(b.tiles_y >> 16), [&](int tx, int ty) {
+                                         return gm::ellipse_touches_tile(w, b.edge_slope_x, b.edge_slope_y,
+                                                                         b.threshold, b.mean_x, b.mean_y, tx, ty,
+                                                                         cam.width, cam.height);
+                                       });
+      s.tiles[g] = static_cast<unsigned char>(tiles);
+      pass = tiles != 0;
     }
     const unsigned ballot = __ballot_sync(kFullMask, pass);
     if (lane == c) my_ballot = ballot;
-    if (shift && lane == 0) s.passed[c] = ballot;
   }
-  if (shift) {
-    // Each bin's tiles from the tiles' ballots: lane c keeps bin step c's ballot.
-    __syncwarp();
-    const unsigned bin_steps = (total_bins + kWarp - 1) / kWarp;
-    my_ballot = 0;
-    for (unsigned c = 0; c < bin_steps; ++c) {
-      const unsigned g = c * kWarp + lane;
-      unsigned bits = 0;
-      if (g < total_bins) {
-        const SmallBox& b = s.boxes[s.bin_owner[g]];
-        int col, row;
-        small_box_cell(g - b.bin_start, b.bin_row_magic, b.bin_box_w, col, row);
-        const int bx = (b.tile_x0 >> shift) + col, by = (b.tile_y0 >> shift) + row;
-        bits = bin_tiles(shift, bx, by, b.tile_x0, b.tile_y0, b.tile_x0 + b.box_w,
-                         b.tile_y0 + static_cast<int>(b.box_h), [&](int tx, int ty) {
-                           const unsigned t = b.start + static_cast<unsigned>((ty - b.tile_y0) * b.box_w + tx - b.tile_x0);
-                           return ((s.passed[t / kWarp] >> (t % kWarp)) & 1u) != 0;
-                         });
-        s.bin_tiles[g] = static_cast<unsigned char>(bits);
+  // This lane's count: the bits of its range [start, start + my_box), in at most two steps.
+  unsigned my_count = 0;
+  {
+    const unsigned first_step = start / kWarp, last_step = (start + (my_box > 0 ? my_box : 1) - 1) / kWarp;
+    const unsigned b0 = __shfl_sync(kFullMask, my_ballot, first_step & (kWarp - 1));
+    const unsigned b1 = __shfl_sync(kFullMask, my_ballot, last_step & (kWarp - 1));
+    if (my_box > 0) {
+      const unsigned lo = start % kWarp;
+      if (first_step == last_step) {
+        const unsigned mask = (my_box == kWarp ? 0xffffffffu : ((1u << my_box) - 1u)) << lo;
+        my_count = __popc(b0 & mask);
+      } else {
+        my_count = __popc(b0 & (0xffffffffu << lo)) + __popc(b1 & ((1u << ((start + my_box) % kWarp)) - 1u));
       }
-      const unsigned ballot = __ballot_sync(kFullMask, bits != 0);
-      if (lane == c) my_ballot = ballot;
     }
   }
-  const unsigned my_count = small_box_count(my_ballot, bin_start, my_bins);
   // One atomic for the warp, then each step's pairs at its offset.
   const unsigned step_count = __popc(my_ballot);
   const unsigned step_inclusive = warp_inclusive_sum(step_count);
@@ -300,20 +278,17 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
   if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(total));
   base = __shfl_sync(kFullMask, base, 0) + (step_inclusive - step_count);  // lane c: step c's offset
   const unsigned lanes_below = (1u << lane) - 1u;
-  const unsigned out_steps = (total_bins + kWarp - 1) / kWarp;
-  for (unsigned c = 0; c < out_steps; ++c) {
+  for (unsigned c = 0; c < steps; ++c) {
     const unsigned ballot = __shfl_sync(kFullMask, my_ballot, c);
     const unsigned long long step_base = __shfl_sync(kFullMask, base, c);
     if (ballot & (1u << lane)) {
       const unsigned g = c * kWarp + lane;
-      const SmallBox& b = s.boxes[shift ? s.bin_owner[g] : s.owner[g]];
-      int col, row;
-      if (shift) small_box_cell(g - b.bin_start, b.bin_row_magic, b.bin_box_w, col, row);
-      else small_box_cell(g - b.start, b.row_magic, static_cast<unsigned>(b.box_w), col, row);
-      const unsigned bx = static_cast<unsigned>((b.tile_x0 >> shift) + col);
-      const unsigned by = static_cast<unsigned>((b.tile_y0 >> shift) + row);
-      store_pair(buf, step_base + __popc(ballot & lanes_below), by * static_cast<unsigned>(buf.bins.x) + bx,
-                 b.depth_bits, pair_value(buf.bins, b.record, shift ? s.bin_tiles[g] : 1u));
+      const SmallBox& b = s.boxes[s.owner[g]];
+      int bx, by;
+      small_box_bin(b, shift, g - b.start, bx, by);
+      store_pair(buf, step_base + __popc(ballot & lanes_below),
+                 static_cast<unsigned>(by) * static_cast<unsigned>(buf.bins.x) + static_cast<unsigned>(bx),
+                 b.depth_bits, pair_value(buf.bins, b.record, s.tiles[g]));
     }
   }
   __syncwarp();  // the scratch is free again
@@ -424,9 +399,8 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   }
   // A frame whose records overflowed still counts (and writes) its pairs: it runs again.
   if (visible) {
-    // Emission paths are chosen by the tile box (each tile is tested once whatever the bins).
-    const unsigned box = static_cast<unsigned>(f.tile_x1 - f.tile_x0) * static_cast<unsigned>(f.tile_y1 - f.tile_y0);
     const BinBox bins(f, shift);
+    const unsigned box = bins.count();
     if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kHugeBoxTiles)) {
       const unsigned slot = atomicAdd(&buf.counters->huge, 1u);
       if (slot < buf.huge.capacity) {
@@ -439,7 +413,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     } else if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(args.large_box_tiles)) {
       large = true;
     } else if (!args.exact_tile_test) {
-      count = bins.count();
+      count = box;
     } else if (balanced) {
       small_box = box;
     } else {
