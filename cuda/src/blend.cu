@@ -111,48 +111,14 @@ struct alignas(16) RegionGaussian {
   float red, green, blue, pad1;
 };
 
-// A tile's blend records in list order, up to 32 at a time (lane j gets the j-th): its bin's
-// pair values, read whole when a bin is the tile.
+// A tile's blend records in list order, up to 32 at a time (lane j gets the j-th).
 struct TileList {
   const std::uint32_t* values;
   unsigned cursor, end;
-  __device__ void fill() {}
   __device__ unsigned take(unsigned lane, unsigned& record) {
     const unsigned n = min(static_cast<unsigned>(kWarp), end - cursor);
     if (lane < n) record = values[cursor + lane];
     cursor += n;
-    return n;
-  }
-};
-
-// The same for a tile of a larger bin: the bin's values that carry the tile's bit, gathered
-// 32 values per step into a per-warp ring in shared memory, so that every batch the blend
-// stages is full of the tile's own Gaussians (about 45% of a 2x2 bin's values are).
-// fill() keeps at least 32 queued while the bin has values left: at most 31 + 32 in the ring.
-struct BinTileList {
-  static constexpr unsigned kRing = 2 * kWarp;
-  const std::uint32_t* values;
-  unsigned* ring;  // [kRing], this warp's
-  unsigned cursor, end, bit;
-  unsigned head, tail;  // queued: ring[head..tail) mod kRing
-  __device__ void fill() {
-    const unsigned lane = lane_id();
-    while (tail - head < kWarp && cursor < end) {  // warp-uniform
-      const unsigned i = cursor + lane;
-      const std::uint32_t v = i < end ? values[i] : 0u;
-      const bool mine = (v & bit) != 0;
-      const unsigned ballot = __ballot_sync(kFullMask, mine);
-      if (mine) ring[(tail + __popc(ballot & ((1u << lane) - 1u))) % kRing] = v & kRecordMask;
-      tail += __popc(ballot);
-      cursor += kWarp;
-    }
-    __syncwarp();
-  }
-  __device__ unsigned take(unsigned lane, unsigned& record) {
-    const unsigned n = min(static_cast<unsigned>(kWarp), tail - head);
-    if (lane < n) record = ring[(head + lane) % kRing];
-    head += n;
-    __syncwarp();  // read before the next fill overwrites
     return n;
   }
 };
@@ -178,9 +144,10 @@ constexpr float kFinishedX = 1e30f;
 // (at least one lane of the warp passes the cut on almost every visit, so a branch skipped
 // nothing and cost its own instructions); a finished pixel moves to kFinishedX, so later
 // Gaussians add exactly nothing to it. Otherwise the arithmetic is the CPU's, term for term.
-// BINNED: the pairs are keyed by bins of 2x2 tiles (BinGrid); the 4 blocks of a bin blend its
-// tiles, each walking the bin's list for the values that carry its bit (BinTileList).
-template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE, bool BINNED>
+// Only the Gaussians that meet the region are staged, packed in list order, so the loop over
+// them is a counted one. Binned frames (BinGrid): the 4 blocks of a bin blend its tiles, each
+// from its own tile list (FrameBuffers::tile_lists).
+template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
   constexpr int kRegionH = 64 / REGION_W;
   constexpr int kLanesX = REGION_W / kLanePixelsX;
@@ -190,13 +157,13 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   // A block is one tile, its warps the tile's regions.
   static_assert(kWarpsPerBlock == kRegionsPerTile, "a block must be one tile");
-  constexpr int kShift = BINNED ? kMacroBinShift : 0;
-  const unsigned block_bin = blockIdx.x >> (2 * kShift);
+  const int shift = a.bins.shift;
+  const unsigned block_bin = blockIdx.x >> (2 * shift);
   const unsigned bin = a.tile_order ? a.tile_order[block_bin] : block_bin;
   if (bin >= static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y)) return;  // whole block
-  const unsigned tile_in_bin = blockIdx.x & ((1u << (2 * kShift)) - 1u);
-  const int tx = static_cast<int>(bin % a.bins.x) * (1 << kShift) + static_cast<int>(tile_in_bin & ((1u << kShift) - 1u));
-  const int ty = static_cast<int>(bin / a.bins.x) * (1 << kShift) + static_cast<int>(tile_in_bin >> kShift);
+  const unsigned tile_in_bin = blockIdx.x & ((1u << (2 * shift)) - 1u);
+  const int tx = static_cast<int>(bin % a.bins.x) * (1 << shift) + static_cast<int>(tile_in_bin & ((1u << shift) - 1u));
+  const int ty = static_cast<int>(bin / a.bins.x) * (1 << shift) + static_cast<int>(tile_in_bin >> shift);
   if (tx >= a.tiles_x || ty >= a.tiles_y) return;  // a bin over the image's edge: whole block
   const int region_in_tile = static_cast<int>(warp);
   // The region's pixel-centre rectangle, clipped to the image, and this lane's pixels.
@@ -219,18 +186,16 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     lane_x[p] = !EXP2 || (live & (1u << p)) ? static_cast<float>(x0 + p) - region_x0 : kFinishedX;
   }
   const unsigned inside = live;
-  const uint2 range = a.tile_ranges[bin];
-  __shared__ unsigned ring[BINNED ? kWarpsPerBlock : 1][BinTileList::kRing];
-  using List = std::conditional_t<BINNED, BinTileList, TileList>;
-  List list;
-  if constexpr (BINNED) {
-    list = BinTileList{a.values, ring[warp], range.x, range.y, 1u << (tile_in_bin + kBinTileBitsShift), 0u, 0u};
+  TileList list;
+  if (shift > 0) {
+    const uint2 range = a.tile_lists[static_cast<unsigned>(ty) * static_cast<unsigned>(a.tiles_x) + static_cast<unsigned>(tx)];
+    list = TileList{(tile_in_bin >> shift) ? a.tile_values[1] : a.tile_values[0], range.x, range.y};
   } else {
+    const uint2 range = a.tile_ranges[bin];
     list = TileList{a.values, range.x, range.y};
   }
   // This batch's records (n of them, lane j the j-th) and, PIPELINED, their Gaussians.
   unsigned record = 0;
-  list.fill();
   unsigned n = list.take(lane, record);
   BlendGaussian next{};
   if (PIPELINED && lane < n) next = load_gaussian(a.gaussians + record);
@@ -243,12 +208,8 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     if (!__any_sync(kFullMask, live)) break;
     if (!PIPELINED && lane < n) next = load_gaussian(a.gaussians + record);
     __syncwarp();
-    unsigned relevant = 0xffffffffu;
+    unsigned staged = n;  // Gaussians in batch[warp], in list order
     if constexpr (EXP2) {
-      const float ox = next.mean_x - region_x0, oy = next.mean_y - region_y0;
-      batch[warp][lane] = RegionGaussian{-__fmaf_rn(next.w0, ox, next.w1 * oy), -__fmaf_rn(next.w2, ox, next.w3 * oy),
-                                         next.w1, next.w3, next.w0, next.w2, next.opacity, 0.0f, next.red, next.green,
-                                         next.blue, 0.0f};
       bool meets = false;
       const float cut = (next.opacity - kLog2AlphaMin) * 1.00001f + 1e-4f;  // q' of alpha = 1/255
       if (lane < n && cut > 0.0f) {
@@ -263,18 +224,24 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
                                                 region_x1 - next.mean_x,
                                                 region_y0 - next.mean_y, region_y1 - next.mean_y);
       }
-      relevant = __ballot_sync(kFullMask, meets);
+      const unsigned relevant = __ballot_sync(kFullMask, meets);
+      if (meets) {
+        const float ox = next.mean_x - region_x0, oy = next.mean_y - region_y0;
+        batch[warp][__popc(relevant & ((1u << lane) - 1u))] =
+            RegionGaussian{-__fmaf_rn(next.w0, ox, next.w1 * oy), -__fmaf_rn(next.w2, ox, next.w3 * oy),
+                           next.w1, next.w3, next.w0, next.w2, next.opacity, 0.0f, next.red, next.green,
+                           next.blue, 0.0f};
+      }
+      staged = __popc(relevant);
     } else {
       batch[warp][lane] = next;
     }
     __syncwarp();
-    list.fill();
     unsigned next_record = 0;
     const unsigned next_n = list.take(lane, next_record);
     if (PIPELINED && lane < next_n) next = load_gaussian(a.gaussians + next_record);
-    if (n < kWarp) relevant &= (1u << n) - 1u;
-    for (unsigned m = relevant; m && (EXP2 || live); m &= m - 1) {
-      const Staged& g = batch[warp][__ffs(m) - 1];
+    for (unsigned j = 0; j < staged && (EXP2 || live); ++j) {
+      const Staged& g = batch[warp][j];
       if constexpr (EXP2) {
         const float uy = __fmaf_rn(g.w1, lane_y, g.u0), vy = __fmaf_rn(g.w3, lane_y, g.v0);
         const float red = g.red, green = g.green, blue = g.blue;
@@ -333,27 +300,22 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
                            cb[p] + t[p] * a.background[2]);
 }
 
-template <int REGION_W, bool SURFACE, bool BINNED>
+template <int REGION_W, bool SURFACE>
 void launch_warp_tile(const BlendArgs& a, cudaStream_t stream) {
   // A block per tile of each bin (tiles of bins over the image's edge return at once).
   const unsigned blocks = static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y) << (2 * a.bins.shift);
   const unsigned threads = kWarpsPerBlock * kWarp;
   const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
   if (pipelined && a.exp2_alpha)
-    blend_warp_tile_kernel<REGION_W, true, true, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
+    blend_warp_tile_kernel<REGION_W, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
   else if (pipelined)
-    blend_warp_tile_kernel<REGION_W, true, false, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
+    blend_warp_tile_kernel<REGION_W, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
   else if (a.exp2_alpha)
-    blend_warp_tile_kernel<REGION_W, false, true, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
+    blend_warp_tile_kernel<REGION_W, false, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
   else
-    blend_warp_tile_kernel<REGION_W, false, false, SURFACE, BINNED><<<blocks, threads, 0, stream>>>(a);
+    blend_warp_tile_kernel<REGION_W, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
 }
 
-template <bool SURFACE, bool BINNED>
-void launch_warp_tile_for_region(const BlendArgs& a, cudaStream_t stream) {
-  if (a.region_width == 16) launch_warp_tile<16, SURFACE, BINNED>(a, stream);
-  else launch_warp_tile<8, SURFACE, BINNED>(a, stream);
-}
 
 template <bool SURFACE>
 void launch_for_output(const BlendArgs& a, cudaStream_t stream) {
@@ -362,8 +324,8 @@ void launch_for_output(const BlendArgs& a, cudaStream_t stream) {
     blend_per_pixel_kernel<SURFACE><<<tiles, kTile * kTile, 0, stream>>>(a);
     return;
   }
-  if (a.bins.shift == kMacroBinShift) launch_warp_tile_for_region<SURFACE, true>(a, stream);
-  else launch_warp_tile_for_region<SURFACE, false>(a, stream);
+  if (a.region_width == 16) launch_warp_tile<16, SURFACE>(a, stream);
+  else launch_warp_tile<8, SURFACE>(a, stream);
 }
 
 }  // namespace
@@ -372,7 +334,7 @@ std::uint64_t blend_resident_blocks() {
   int device = 0, sms = 0, per_sm = 0;
   check_cuda(cudaGetDevice(&device), "device query");
   check_cuda(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "device query");
-  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false, true>,
+  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false>,
                                                            kWarpsPerBlock * kWarp, 0),
              "occupancy query");
   return static_cast<std::uint64_t>(std::max(1, sms * per_sm));

@@ -317,17 +317,10 @@ class CudaRendererImpl final : public CudaRenderer {
 
   void download_tile_counts(std::vector<std::uint32_t>& counts) override {
     counts.resize(last_tiles_);
-    if (last_tile_counts_) {  // a binned frame's, from launch_tile_stats
-      if (last_tiles_)
-        check_cuda(cudaMemcpyAsync(counts.data(), tile_counts_.as<void>(), last_tiles_ * sizeof(std::uint32_t),
-                                   cudaMemcpyDeviceToHost, stream_),
-                   "tile count download");
-      check_cuda(cudaStreamSynchronize(stream_), "tile count download");
-      return;
-    }
     std::vector<uint2> ranges(last_tiles_);
+    const DeviceBuffer& lists = last_frame_binned_ ? tile_lists_ : ranges_;
     if (last_tiles_)
-      check_cuda(cudaMemcpyAsync(ranges.data(), ranges_.as<void>(), last_tiles_ * sizeof(uint2),
+      check_cuda(cudaMemcpyAsync(ranges.data(), lists.as<void>(), last_tiles_ * sizeof(uint2),
                                  cudaMemcpyDeviceToHost, stream_),
                  "tile range download");
     check_cuda(cudaStreamSynchronize(stream_), "tile range download");
@@ -340,7 +333,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &record_ids_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &tile_order_, &tile_places_, &tile_counts_, &chunk_list_, &image_, &cub_temp_,
+            &values_[1], &ranges_, &tile_lists_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
             &large_footprints_, &large_records_, &huge_footprints_, &huge_records_};
   }
 
@@ -425,6 +418,9 @@ class CudaRendererImpl final : public CudaRenderer {
     b.huge = deferred_list(huge_footprints_, huge_records_);
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
+    for (int k = 0; k < 2; ++k) b.tile_values[k] = keys_[k].as<std::uint32_t>();
+    b.tile_lists = tile_lists_.as<uint2>();
+    b.dense_bins = dense_bins_.as<std::uint32_t>();
     b.tile_order = tile_order_.as<std::uint32_t>();
     b.tile_places = tile_places_.as<std::uint32_t>();
     b.image_rgb = image_.as<float>();
@@ -551,8 +547,10 @@ class CudaRendererImpl final : public CudaRenderer {
     }
 
     ranges_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(uint2), "bin ranges");
-    const bool tile_counts_on_device = binned && options.collect_tile_counts;
-    if (tile_counts_on_device) tile_counts_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(std::uint32_t), "tile counts");
+    if (binned) {
+      tile_lists_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile lists");
+      dense_bins_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "dense bin list");
+    }
     if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     // Fused emission keeps a blend record per projected Gaussian (FrameBuffers::blend), the
     // separate path one per Gaussian.
@@ -648,6 +646,7 @@ class CudaRendererImpl final : public CudaRenderer {
     const int which = cuda::launch_sort(pairs, end_bit, b, stream_);
     check_cuda(cudaEventRecord(events[kSorted], stream_), "event record");
     cuda::launch_ranges(pairs, bins, b, which, stream_);
+    if (binned) cuda::launch_tile_lists(pairs, cam.tiles_x, cam.tiles_y, b, which, stream_);
     if (dense_tiles_first) cuda::launch_tile_order(bins, b, stream_);
     check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
 
@@ -665,6 +664,8 @@ class CudaRendererImpl final : public CudaRenderer {
     blend.bins = bins_;
     blend.values = b.values[which];
     blend.tile_ranges = b.tile_ranges;
+    blend.tile_lists = b.tile_lists;
+    for (int k = 0; k < 2; ++k) blend.tile_values[k] = b.tile_values[k];
     blend.tile_order = dense_tiles_first ? b.tile_order : nullptr;
     blend.gaussians = b.blend;
     blend.image_rgb = out ? b.image_rgb : nullptr;
@@ -672,11 +673,10 @@ class CudaRendererImpl final : public CudaRenderer {
     cuda::launch_blend(blend, stream_);
     check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     last_tiles_ = tiles;
-    last_tile_counts_ = tile_counts_on_device;
+    last_frame_binned_ = binned;
     // The fullest tile and the tile pairs, for the statistics (after the last timed event:
     // not a stage's cost).
-    cuda::launch_tile_stats(cam.tiles_x, cam.tiles_y, b, which,
-                            tile_counts_on_device ? tile_counts_.as<std::uint32_t>() : nullptr, stream_);
+    cuda::launch_tile_stats(tiles, b, stream_);
     check_cuda(cudaMemcpyAsync(&readback_->tile_max[event_set_], &b.counters->max_tile_pairs, sizeof(std::uint32_t),
                                cudaMemcpyDeviceToHost, stream_),
                "tile maximum read back");
@@ -766,15 +766,15 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t blend_resident_blocks_ = 1;  // warp-blend blocks the device runs at once
   cuda::KeyFormat key_format_;           // this frame's
   cuda::BinGrid bins_;                   // this frame's
-  bool last_tile_counts_ = false;        // the last frame left its tile counts in tile_counts_
+  bool last_frame_binned_ = false;       // the last frame's tile counts are in tile_lists_
   double bounds_centre_[3] = {0, 0, 0};  // sphere around the scene's Gaussian centres
   double bounds_radius_ = 0;
   float max_opacity_ = 1.0f;             // of the scene (sets the flash extent's largest threshold)
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
-  DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_order_,
-      tile_places_, tile_counts_, chunk_list_, image_,
+  DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_,
+      dense_bins_, tile_order_, tile_places_, chunk_list_, image_,
       cub_temp_, large_footprints_, large_records_, huge_footprints_, huge_records_;
 };
 

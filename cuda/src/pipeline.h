@@ -135,6 +135,7 @@ struct FrameCounters {
   unsigned int listed_chunks;      // chunks the chunk cull left to preprocess (launch_chunk_list)
   unsigned int tiles_by_class[kTileClasses];  // tiles per pair-count class (launch_tile_order)
   unsigned int records;            // blend records wanted (compact records: may exceed capacity)
+  unsigned int dense_bins;         // bins listed in FrameBuffers::dense_bins (launch_tile_lists)
 };
 
 // Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
@@ -173,6 +174,14 @@ struct FrameBuffers {
   // Per bin: [start, end) of its pairs in the sorted list.
   uint2* tile_ranges = nullptr;  // [tile_capacity]
   std::uint64_t tile_capacity = 0;
+  // Binned frames: each tile's blend records, gathered once from its bin's values
+  // (launch_tile_lists), so that the blend walks its own tile's list. They live in the key
+  // buffers, which nothing reads after the ranges pass: bin [s, e)'s top tiles in
+  // tile_values[0] from 2s and from 2s + (e - s), its bottom tiles likewise in tile_values[1].
+  // tile_lists[tile] is [start, end) in the buffer of the tile's row parity.
+  std::uint32_t* tile_values[2] = {nullptr, nullptr};  // keys[0], keys[1] as 2 x pair_capacity
+  uint2* tile_lists = nullptr;                         // [tiles]
+  std::uint32_t* dense_bins = nullptr;                 // [bins] bins too full for one warp to list
   // The blend's tile order, fullest first: tile_order[block] = tile; tile_places holds each
   // tile's class and place within it on the way (launch_tile_order).
   std::uint32_t* tile_order = nullptr;   // [tile_capacity]
@@ -228,11 +237,13 @@ void launch_ranges(std::uint64_t pairs, std::uint64_t bins, const FrameBuffers& 
 // order inside a class is immaterial: bins blend independently), so the fullest bins start
 // first instead of wherever they lie in the image.
 void launch_tile_order(std::uint64_t bins, const FrameBuffers& buffers, cudaStream_t stream);
-// FrameCounters::max_tile_pairs and tile_pairs from the bin ranges and the sorted values in
-// buffer `which` (statistics: run outside the timed stages); binned frames also write each
-// tile's pair count to `counts` unless it is null.
-void launch_tile_stats(int tiles_x, int tiles_y, const FrameBuffers& buffers, int which, std::uint32_t* counts,
+// Binned frames: FrameBuffers::tile_lists and tile_values from the bin ranges and the sorted
+// values in buffer `which` (after launch_ranges).
+void launch_tile_lists(std::uint64_t pairs, int tiles_x, int tiles_y, const FrameBuffers& buffers, int which,
                        cudaStream_t stream);
+// FrameCounters::max_tile_pairs and tile_pairs from the tile ranges, or the tile lists of a
+// binned frame (statistics: run outside the timed stages).
+void launch_tile_stats(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
 
 enum class BlendKernel { per_pixel, warp_tile, warp_tile_pipelined };
 struct BlendArgs {
@@ -241,9 +252,11 @@ struct BlendArgs {
   BlendKernel kernel;
   bool exp2_alpha;
   int region_width;              // warp blend: a warp's region, 16 x 4 or 8 x 8 pixels
-  const std::uint32_t* values;   // sorted pair values (blend records, with tile bits when binned)
+  const std::uint32_t* values;   // sorted pair values (blend records; tile bits when binned)
   BinGrid bins;                  // warp blend: what tile_ranges and tile_order index (per pixel: tiles)
   const uint2* tile_ranges;
+  const uint2* tile_lists;                 // binned: each tile's list (FrameBuffers::tile_lists)
+  const std::uint32_t* tile_values[2];     // binned: the lists' records
   const std::uint32_t* tile_order;  // warp blend: blocks blend bin tile_order[b] (null: bin b), a tile each
   const BlendGaussian* gaussians;
   float* image_rgb;              // float output, or

@@ -3,6 +3,8 @@
 // exactly the CPU's whatever the key format: equal 64-bit keys share their depth (the atomics
 // of emission shuffled their records), equal compact keys share a quantised depth bin. (A
 // bin is a tile, or 2x2 tiles with macro bins: pipeline.h, BinGrid.)
+#include <algorithm>
+
 #include "device_common.cuh"
 #include "pipeline.h"
 
@@ -94,28 +96,139 @@ __global__ void __launch_bounds__(kBlock) tile_max_kernel(std::uint64_t tiles, c
   }
 }
 
-// Binned frames: each tile's pairs (the values of its bin that carry its bit), their sum and
-// the largest, and counts[tile] unless counts is null. A warp per tile.
-__global__ void __launch_bounds__(kBlock) binned_tile_stats_kernel(int tiles_x, int tiles_y, BinGrid bins,
-                                                                   const uint2* __restrict__ bin_ranges,
-                                                                   const std::uint32_t* __restrict__ values,
-                                                                   std::uint32_t* counts, FrameCounters* counters) {
-  const std::uint64_t t = (static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x) / kWarp;
-  if (t >= static_cast<std::uint64_t>(tiles_x) * static_cast<std::uint64_t>(tiles_y)) return;  // whole warp
-  const int tx = static_cast<int>(t % static_cast<unsigned>(tiles_x)), ty = static_cast<int>(t / static_cast<unsigned>(tiles_x));
-  const int side = 1 << bins.shift;
-  const uint2 range = bin_ranges[(ty >> bins.shift) * bins.x + (tx >> bins.shift)];
-  const std::uint32_t bit = 1u << (((ty & (side - 1)) << bins.shift) + (tx & (side - 1)) + kBinTileBitsShift);
-  unsigned n = 0;
-  for (unsigned i = range.x + lane_id(); i < range.y; i += kWarp) n += (values[i] & bit) ? 1u : 0u;
-  n = __reduce_add_sync(kFullMask, n);
-  if (lane_id() == 0) {
-    if (counts) counts[t] = n;
-    if (n > 0) {
-      atomicMax(&counters->max_tile_pairs, n);
-      atomicAdd(&counters->tile_pairs, static_cast<unsigned long long>(n));
-    }
+// The tile-list pass. A warp walks values in runs of 32 x kListLoads, every load of a run in
+// flight at once. A warp lists a small bin alone; a dense bin gets a block whose warps take
+// a run each per round, so that a bin of 10^4 values costs a few rounds rather than one
+// warp's serial walk.
+constexpr int kListWarps = 8;
+constexpr int kListLoads = 8;
+constexpr unsigned kListRun = kWarp * kListLoads;
+constexpr unsigned kSmallBin = 2 * kListRun;  // values of a bin one warp lists alone
+
+// Where one bin's four tile lists go (FrameBuffers::tile_lists; tile q row-major in the bin).
+struct BinLists {
+  std::uint32_t* top;
+  std::uint32_t* bottom;
+  unsigned start, length;  // the bin's range in the sorted values
+  __device__ unsigned list_start(int q) const { return 2 * start + (q & 1) * length; }
+  __device__ std::uint32_t* list(int q) const { return (q < 2 ? top : bottom) + list_start(q); }
+};
+
+__device__ __forceinline__ bool carries(std::uint32_t value, int q) { return (value >> (kBinTileBitsShift + q)) & 1u; }
+
+// The run of values from `first` (up to `end`), lane l holding first + k * 32 + l in v[k].
+__device__ __forceinline__ void load_run(const std::uint32_t* values, unsigned first, unsigned end, unsigned lane,
+                                         std::uint32_t (&v)[kListLoads]) {
+#pragma unroll
+  for (int k = 0; k < kListLoads; ++k) {
+    const unsigned i = first + k * kWarp + lane;
+    v[k] = i < end ? values[i] : 0u;
   }
+}
+
+// Appends a loaded run's records to the bin's tile lists in order: tile q's next from place next[q].
+__device__ __forceinline__ void place_run(const BinLists& lists, const std::uint32_t (&v)[kListLoads], unsigned lane,
+                                          unsigned (&next)[4]) {
+#pragma unroll
+  for (int k = 0; k < kListLoads; ++k)
+#pragma unroll
+    for (int q = 0; q < 4; ++q) {
+      const bool mine = carries(v[k], q);
+      const unsigned ballot = __ballot_sync(kFullMask, mine);
+      if (mine) lists.list(q)[next[q] + __popc(ballot & ((1u << lane) - 1u))] = v[k] & kRecordMask;
+      next[q] += __popc(ballot);
+    }
+}
+
+// Lane q < 4 records tile q's list (tiles beyond the image's edge have none).
+__device__ __forceinline__ void record_tile_list(const BinGrid& bins, int tiles_x, int tiles_y, unsigned bin,
+                                                 const BinLists& lists, const unsigned (&placed)[4], unsigned q,
+                                                 uint2* tile_lists) {
+  if (q >= 4) return;
+  const int tx = static_cast<int>(bin % static_cast<unsigned>(bins.x)) * 2 + static_cast<int>(q & 1u);
+  const int ty = static_cast<int>(bin / static_cast<unsigned>(bins.x)) * 2 + static_cast<int>(q >> 1);
+  if (tx >= tiles_x || ty >= tiles_y) return;
+  const unsigned count = q == 0 ? placed[0] : q == 1 ? placed[1] : q == 2 ? placed[2] : placed[3];
+  const unsigned start = lists.list_start(static_cast<int>(q));
+  tile_lists[static_cast<std::uint64_t>(ty) * static_cast<unsigned>(tiles_x) + static_cast<unsigned>(tx)] =
+      make_uint2(start, start + count);
+}
+
+// Binned frames: each tile's list, the records of its bin's values that carry its bit, in
+// bin order. A warp per bin lists the small bins and leaves the dense ones to
+// dense_bin_lists_kernel (FrameBuffers::dense_bins).
+__global__ void __launch_bounds__(kListWarps * kWarp) small_bin_lists_kernel(BinGrid bins, int tiles_x, int tiles_y,
+                                                                             const uint2* __restrict__ bin_ranges,
+                                                                             const std::uint32_t* __restrict__ values,
+                                                                             std::uint32_t* __restrict__ top_lists,
+                                                                             std::uint32_t* __restrict__ bottom_lists,
+                                                                             uint2* __restrict__ tile_lists,
+                                                                             std::uint32_t* __restrict__ dense_bins,
+                                                                             FrameCounters* counters) {
+  static_assert(kMacroBinShift == 1, "a bin is 2x2 tiles");
+  const unsigned bin = blockIdx.x * kListWarps + threadIdx.x / kWarp, lane = lane_id();
+  if (bin >= static_cast<unsigned>(bins.x) * static_cast<unsigned>(bins.y)) return;  // whole warp
+  const uint2 range = bin_ranges[bin];
+  const BinLists lists{top_lists, bottom_lists, range.x, range.y - range.x};
+  if (lists.length > kSmallBin) {
+    if (lane == 0) dense_bins[atomicAdd(&counters->dense_bins, 1u)] = bin;
+    return;
+  }
+  unsigned placed[4] = {0, 0, 0, 0};
+  for (unsigned run = range.x; run < range.y; run += kListRun) {  // warp-uniform
+    std::uint32_t v[kListLoads];
+    load_run(values, run, range.y, lane, v);
+    place_run(lists, v, lane, placed);
+  }
+  record_tile_list(bins, tiles_x, tiles_y, bin, lists, placed, lane, tile_lists);
+}
+
+// The dense bins' lists, a block per bin: warp w takes the w-th run of each round; a first
+// pass of ballots counts each warp's values per tile, so that the second knows where in each
+// tile's list the warp's values go. Blocks beyond the listed bins return at once.
+__global__ void __launch_bounds__(kListWarps * kWarp) dense_bin_lists_kernel(BinGrid bins, int tiles_x, int tiles_y,
+                                                                             const uint2* __restrict__ bin_ranges,
+                                                                             const std::uint32_t* __restrict__ values,
+                                                                             std::uint32_t* __restrict__ top_lists,
+                                                                             std::uint32_t* __restrict__ bottom_lists,
+                                                                             uint2* __restrict__ tile_lists,
+                                                                             const std::uint32_t* __restrict__ dense_bins,
+                                                                             const FrameCounters* counters) {
+  if (blockIdx.x >= counters->dense_bins) return;  // whole block
+  __shared__ unsigned warp_counts[kListWarps][4];
+  const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
+  const unsigned bin = dense_bins[blockIdx.x];
+  const uint2 range = bin_ranges[bin];
+  const BinLists lists{top_lists, bottom_lists, range.x, range.y - range.x};
+  unsigned placed[4] = {0, 0, 0, 0};
+  for (unsigned round = range.x; round < range.y; round += kListWarps * kListRun) {  // block-uniform
+    std::uint32_t v[kListLoads];
+    load_run(values, round + warp * kListRun, range.y, lane, v);
+    unsigned count[4] = {0, 0, 0, 0};
+#pragma unroll
+    for (int k = 0; k < kListLoads; ++k)
+#pragma unroll
+      for (int q = 0; q < 4; ++q) count[q] += __popc(__ballot_sync(kFullMask, carries(v[k], q)));
+    if (lane == 0)
+#pragma unroll
+      for (int q = 0; q < 4; ++q) warp_counts[warp][q] = count[q];
+    __syncthreads();
+    unsigned next[4], total[4];  // this warp's first place per tile; the round's values per tile
+#pragma unroll
+    for (int q = 0; q < 4; ++q) {
+      next[q] = placed[q];
+      total[q] = 0;
+      for (unsigned w = 0; w < kListWarps; ++w) {
+        if (w == warp) next[q] += total[q];
+        total[q] += warp_counts[w][q];
+      }
+    }
+    __syncthreads();  // read before the next round writes
+    place_run(lists, v, lane, next);
+#pragma unroll
+    for (int q = 0; q < 4; ++q) placed[q] += total[q];
+  }
+  record_tile_list(bins, tiles_x, tiles_y, bin, lists, placed, threadIdx.x, tile_lists);
 }
 
 // A tile's class: the leading zeros of its pair count, so fuller tiles come first.
@@ -165,19 +278,28 @@ void launch_tile_order(std::uint64_t tiles, const FrameBuffers& b, cudaStream_t 
   check_cuda(cudaGetLastError(), "tile order kernel launch");
 }
 
-void launch_tile_stats(int tiles_x, int tiles_y, const FrameBuffers& b, int which, std::uint32_t* counts,
-                       cudaStream_t stream) {
-  const std::uint64_t tiles = static_cast<std::uint64_t>(tiles_x) * static_cast<std::uint64_t>(tiles_y);
+void launch_tile_stats(std::uint64_t tiles, const FrameBuffers& b, cudaStream_t stream) {
   if (tiles == 0) return;
-  if (b.bins.shift == 0) {
-    const unsigned blocks = static_cast<unsigned>((tiles + kBlock - 1) / kBlock);
-    tile_max_kernel<<<blocks, kBlock, 0, stream>>>(tiles, b.tile_ranges, b.counters);
-  } else {
-    const unsigned blocks = static_cast<unsigned>((tiles * kWarp + kBlock - 1) / kBlock);
-    binned_tile_stats_kernel<<<blocks, kBlock, 0, stream>>>(tiles_x, tiles_y, b.bins, b.tile_ranges, b.values[which],
-                                                            counts, b.counters);
-  }
+  const unsigned blocks = static_cast<unsigned>((tiles + kBlock - 1) / kBlock);
+  tile_max_kernel<<<blocks, kBlock, 0, stream>>>(tiles, b.bins.shift ? b.tile_lists : b.tile_ranges, b.counters);
   check_cuda(cudaGetLastError(), "tile statistics kernel launch");
+}
+
+void launch_tile_lists(std::uint64_t pairs, int tiles_x, int tiles_y, const FrameBuffers& b, int which,
+                       cudaStream_t stream) {
+  const std::uint64_t bins = static_cast<std::uint64_t>(b.bins.x) * static_cast<std::uint64_t>(b.bins.y);
+  if (bins == 0) return;
+  small_bin_lists_kernel<<<static_cast<unsigned>((bins + kListWarps - 1) / kListWarps), kListWarps * kWarp, 0,
+                           stream>>>(b.bins, tiles_x, tiles_y, b.tile_ranges, b.values[which], b.tile_values[0],
+                                     b.tile_values[1], b.tile_lists, b.dense_bins, b.counters);
+  check_cuda(cudaGetLastError(), "tile lists kernel launch");
+  // At most this many bins hold more than kSmallBin values; the device knows how many do.
+  const std::uint64_t most_dense = std::min<std::uint64_t>(bins, pairs / (kSmallBin + 1));
+  if (most_dense == 0) return;
+  dense_bin_lists_kernel<<<static_cast<unsigned>(most_dense), kListWarps * kWarp, 0, stream>>>(
+      b.bins, tiles_x, tiles_y, b.tile_ranges, b.values[which], b.tile_values[0], b.tile_values[1], b.tile_lists,
+      b.dense_bins, b.counters);
+  check_cuda(cudaGetLastError(), "dense tile lists kernel launch");
 }
 
 void launch_ranges(std::uint64_t pairs, std::uint64_t bins, const FrameBuffers& b, int which,

@@ -5,7 +5,7 @@
 #                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
 #                                       cpu-simd-tests build-prev bench-cpu-prev
 #                                       profile-blend profile-sass
-#                                       build-bg wait-build
+#                                       build-bg wait-build build-prev-bg bench-prev-cuda
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
 # cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
 # there; `build` builds everything on the machine instead, into build-dev) and sysroot/usr with
@@ -152,10 +152,11 @@ bench_cpu() {  # the CPU backend on 1, 2 and every host thread (CPU_THREADS); TA
   done
 }
 
-build_prev() {  # an earlier tree's flashgs (CPU backend only) into /tmp/prev/b, for an A/B in the same run:
-  # .deps/prev.tar.gz (made with `git archive <commit> -- . ':!docs' ':!assets' | gzip`)
+build_prev() {  # an earlier tree's flashgs into /tmp/prev/b, for an A/B in the same run: .deps/prev.tar.gz
+  # (made with `git archive <commit> -- . ':!docs' ':!assets' | gzip`); CPU backend only unless PREV_CUDA=1
   rm -rf /tmp/prev && mkdir -p /tmp/prev && tar xzf "$ROOT/.deps/prev.tar.gz" -C /tmp/prev &&
-    cmake -S /tmp/prev -B /tmp/prev/b -G Ninja -DCMAKE_BUILD_TYPE=Release -DFLASHGS_WITH_CUDA=OFF \
+    cmake -S /tmp/prev -B /tmp/prev/b -G Ninja -DCMAKE_BUILD_TYPE=Release \
+      -DFLASHGS_WITH_CUDA=$([ "${PREV_CUDA:-0}" = 1 ] && echo ON || echo OFF) -DCMAKE_CUDA_ARCHITECTURES=90 \
       -DFLASHGS_HEADER_DEPS_DIR="$ROOT/.deps/include" -DCMAKE_PREFIX_PATH="$ROOT/.deps/sysroot/usr" \
       -DFLASHGS_BUILD_APP=OFF -DFLASHGS_BUILD_TESTS=OFF > "$OUT/build_prev.log" 2>&1 &&
     ninja -C /tmp/prev/b flashgs >> "$OUT/build_prev.log" 2>&1
@@ -168,6 +169,17 @@ cpu_simd_tests() {  # the SIMD kernels against the scalar ones on every target t
     "$ROOT/build-dev/tests/$t" > "$OUT/$t.log" 2>&1
     log "$t rc=$? $(grep -E '^\[  (PASSED|FAILED)' "$OUT/$t.log" | tr '\n' ' ')"
   done
+}
+
+bench_prev_cuda() {  # the earlier tree's CUDA flash (build-prev with PREV_CUDA=1) on the bench-ab rows
+  for scene in pc_biker pc_playbot; do
+    log "bench earlier tree $scene"
+    bench_scene "$SCENES/$scene" prev_bench_$scene --backend cuda -r 1920x1080,3840x2160 --configs flash \
+      --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
+  done
+  log "bench earlier tree 7 x pc_playbot"
+  bench_scene "$SCENES/pc_playbot" prev_bench_tile7 --backend cuda --tile 7 -r 1920x1080,3840x2160 --configs flash \
+    --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
 }
 
 bench_scale() {  # pc_playbot copied SCALE_COPIES times in memory (default 20 60 200: 10M, 30M, 100M)
@@ -252,6 +264,8 @@ for step in "$@"; do
     bench-cpu) bench_cpu ;;
     build-prev) build_prev ;;
     bench-cpu-prev) (FLASHGS=/tmp/prev/b/app/flashgs TAG=prev_ bench_cpu) ;;
+    build-prev-bg) (PREV_CUDA=1 build_prev > /dev/null 2>&1) & PREV_PID=$! ;;
+    bench-prev-cuda) [ -n "${PREV_PID:-}" ] && wait "$PREV_PID"; (FLASHGS=/tmp/prev/b/app/flashgs bench_prev_cuda) ;;
     cpu-simd-tests) cpu_simd_tests ;;
     bench-scale) bench_scale ;;
     report) report ;;
