@@ -56,9 +56,9 @@ build() {
   tail -5 "$OUT/build.log"
 }
 
-tests() {
+tests() {  # GPU_TEST_FILTER: a gtest filter (default: every test but the sanitizer frames)
   log "gpu tests"
-  "$TESTS" --gtest_filter=-CudaSanitizer.* 2>&1 | tee "$OUT/gpu_tests.log" | grep -E "^\[  (FAILED|PASSED|SKIPPED) |Failure|expected error" | head -40
+  "$TESTS" --gtest_filter="${GPU_TEST_FILTER:--CudaSanitizer.*}" 2>&1 | tee "$OUT/gpu_tests.log" | grep -E "^\[  (FAILED|PASSED|SKIPPED) |Failure|expected error" | head -40
   log "gpu tests rc=${PIPESTATUS[0]}"
   if [ -x "$STRESS_TESTS" ]; then
     log "stress gpu tests"
@@ -89,12 +89,14 @@ bench_quick() {
   bench_scene "$SCENES/pc_biker" bench_biker_quick --backend cuda -r 1920x1080 --configs baseline,flash --warmup 2 --repeat 5
 }
 
-bench_ab() {  # flash against flash with one switch off (AB_CONFIG, default flash-no_dense_tiles_first), same run
+bench_ab() {  # flash against flash with one switch off (AB_CONFIG, default flash-no_dense_tiles_first), same run;
+  # AB_TILED=0 leaves out the 7 x pc_playbot rows
   for scene in pc_biker pc_playbot; do
     log "bench A/B $scene"
     bench_scene "$SCENES/$scene" bench_ab_$scene --backend cuda -r 1920x1080,3840x2160 \
       --configs flash,${AB_CONFIG:-flash-no_dense_tiles_first} --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
   done
+  [ "${AB_TILED:-1}" = 1 ] || return 0
   log "bench A/B 7 x pc_playbot"
   bench_scene "$SCENES/pc_playbot" bench_ab_tile7 --backend cuda --tile 7 -r 1920x1080,3840x2160 \
     --configs flash,${AB_CONFIG:-flash-no_dense_tiles_first} --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
