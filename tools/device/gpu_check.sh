@@ -210,11 +210,15 @@ profile() {  # PROFILE_SCENE (pc_playbot), PROFILE_RES (3840x2160)
   grep -E "^  [a-z_].*\(|Duration|Memory Throughput|Compute \(SM\) Throughput|Registers Per|Achieved Occupancy" "$OUT/ncu.txt" | head -60
 }
 
-profile_kernels() {  # each kernel's GPU time in one frame: KERNEL_SCENES, KERNEL_RES, KERNEL_FLAGS (e.g. --no-tile-sort)
+profile_kernels() {  # each kernel's GPU time in one frame: KERNEL_SCENES, KERNEL_RES, KERNEL_FLAGS (e.g.
+  # --no-macro-bins); KERNEL_FILTER (an ncu regex, e.g. 'bin_lists|ranges') times only those kernels
+  local skip=30  # launches of the first frames (a filter counts only its kernels' launches)
+  [ -n "${KERNEL_FILTER:-}" ] && skip=6
   for scene in ${KERNEL_SCENES:-pc_playbot}; do
     for res in ${KERNEL_RES:-1920x1080 3840x2160}; do
-      log "ncu kernel times $scene $res ${KERNEL_FLAGS:-}"
-      timeout 120 ncu --metrics gpu__time_duration.sum --cache-control none --clock-control none --launch-skip 30 \
+      log "ncu kernel times $scene $res ${KERNEL_FLAGS:-} ${KERNEL_FILTER:-}"
+      timeout 120 ncu --metrics gpu__time_duration.sum --cache-control none --clock-control none \
+        ${KERNEL_FILTER:+-k regex:$KERNEL_FILTER} --launch-skip $skip \
         --launch-count 12 "$FLASHGS" render "$SCENES/$scene/point_cloud.ply" --backend cuda -c 10 -r "$res" \
         ${KERNEL_FLAGS:-} --repeat 8 -o /tmp/p.ppm > "$OUT/ncu_kernels_${scene}_$res.txt" 2>&1
       grep -E "^  [a-zA-Z_]|gpu__time_duration" "$OUT/ncu_kernels_${scene}_$res.txt" | cut -c1-90
