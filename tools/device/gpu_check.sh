@@ -7,9 +7,10 @@
 #                                       profile-blend profile-sass
 #                                       build-bg wait-build build-prev-bg bench-prev-cuda
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
-# cameras.json} and bin/{flashgs,test_cuda_render} built here for sm_90 (used when they run
-# there; `build` builds everything on the machine instead, into build-dev) and sysroot/usr with
-# Debian's Highway (include/hwy, lib/x86_64-linux-gnu/{libhwy*.so*,cmake/hwy}).
+# cameras.json}, sysroot/usr with Debian's Highway (include/hwy, lib/x86_64-linux-gnu/{libhwy*.so*,
+# cmake/hwy}) and optionally bin/ + lib/ from tools/device/prebuild.sh: binaries built on the
+# development machine, which setup runs instead of building when their stamp matches this tree
+# and they start here (otherwise it builds everything into build-dev, as `build` does).
 set -u
 ROOT=$(pwd)
 OUT=${OUT:-$ROOT/out}
@@ -27,16 +28,37 @@ setup() {
   if [ ! -e /work/shared/scenes ]; then mkdir -p /work/shared && ln -sfn "$SCENES" /work/shared/scenes; fi
   if [ ! -e /work/main/assets ]; then mkdir -p /work/main && ln -sfn "$ROOT/assets" /work/main/assets; fi
   ls /work/shared/scenes/ | tr '\n' ' '; echo
-  ldconfig -p | grep -q libgomp.so.1 || export LD_LIBRARY_PATH=$ROOT/.deps/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
   export LD_LIBRARY_PATH=$ROOT/.deps/sysroot/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-  if "$BIN/flashgs" --help > /dev/null 2>&1; then
-    FLASHGS=$BIN/flashgs
-    TESTS=$BIN/test_cuda_render
+  if use_carried_binaries; then
     log "using carried binaries"
   else
-    log "carried binaries do not run here; building"
     build
   fi
+}
+
+# The binaries of tools/device/prebuild.sh, when they were built from this very tree and start
+# here (with the libraries carried beside them: only then, so that binaries built here keep the
+# machine's own C++ runtime).
+use_carried_binaries() {
+  if [ ! -f "$BIN/STAMP" ]; then log "no carried binaries; building"; return 1; fi
+  if [ "$(cat "$BIN/STAMP")" != "$(bash "$ROOT/tools/device/source_stamp.sh")" ]; then
+    log "the carried binaries are of another tree; building"
+    return 1
+  fi
+  # Unpacked outside .deps (build-carried is git-ignored and not carried back and forth).
+  local dir=$ROOT/build-carried f
+  mkdir -p "$dir"
+  for f in "$BIN"/*.xz; do xz -d -c "$f" > "$dir/$(basename "${f%.xz}")" && chmod +x "$dir/$(basename "${f%.xz}")"; done
+  local libs=$ROOT/.deps/lib:$LD_LIBRARY_PATH
+  if ! LD_LIBRARY_PATH=$libs "$dir/flashgs" --help > /dev/null 2>&1; then
+    log "the carried binaries do not start here ($(LD_LIBRARY_PATH=$libs "$dir/flashgs" --help 2>&1 | head -1)); building"
+    return 1
+  fi
+  export LD_LIBRARY_PATH=$libs
+  FLASHGS=$dir/flashgs
+  TESTS=$dir/test_cuda_render
+  STRESS_TESTS=$dir/test_stress_gpu
+  TEST_DIR=$dir
 }
 
 build() {
@@ -52,6 +74,7 @@ build() {
     FLASHGS=$ROOT/build-dev/app/flashgs
     TESTS=$ROOT/build-dev/tests/test_cuda_render
     STRESS_TESTS=$ROOT/build-dev/tests/test_stress_gpu
+    TEST_DIR=$ROOT/build-dev/tests
   fi
   tail -5 "$OUT/build.log"
 }
@@ -168,7 +191,7 @@ build_prev() {  # an earlier tree's flashgs into /tmp/prev/b, for an A/B in the 
 cpu_simd_tests() {  # the SIMD kernels against the scalar ones on every target this host runs (AVX-512 here)
   for t in test_cpu_simd test_cpu_project_simd; do
     log "$t"
-    "$ROOT/build-dev/tests/$t" > "$OUT/$t.log" 2>&1
+    "$TEST_DIR/$t" > "$OUT/$t.log" 2>&1
     log "$t rc=$? $(grep -E '^\[  (PASSED|FAILED)' "$OUT/$t.log" | tr '\n' ' ')"
   done
 }
@@ -252,6 +275,7 @@ profile_sass() {  # executed instructions per SASS line of PROFILE_KERNELS (bina
 FLASHGS=$BIN/flashgs
 TESTS=$BIN/test_cuda_render
 STRESS_TESTS=$BIN/test_stress_gpu
+TEST_DIR=$ROOT/build-dev/tests
 for step in "$@"; do
   case $step in
     setup) setup ;;
