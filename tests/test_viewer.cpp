@@ -86,6 +86,10 @@ const char* const kInputHelper = FLASHGS_X11_INPUT;
 const char* const kInputHelper = "";
 #endif
 
+// The --render-gate file of run `name` (run_live_viewer opens and closes it).
+std::string gate_file(const std::string& name) { return out_dir() + "/" + name + ".gate"; }
+std::string gate_args(const std::string& name) { return " --render-gate \"" + gate_file(name) + "\""; }
+
 // Starts the viewer (`viewer_args`, run in the test output folder, output to NAME.log there)
 // in the background and runs `steps`, shell lines that drive it. They have `$drop` (x11_drop),
 // `$input` (x11_input) and `$log`, and these functions, each waiting for the viewer's log (up
@@ -97,6 +101,9 @@ const char* const kInputHelper = "";
 //   hold WHAT TOKEN      press, then `$input up WHAT`
 //   close_window         a window manager's close request; waits for the viewer to exit and
 //                        sets `closed` (its exit status in `exit_status`)
+//   close_gate, open_gate  with gate_args(name) among `viewer_args` (--render-gate): CPU
+//                        renders started while the gate is closed wait until it opens (it
+//                        starts open), so a step can act while a frame is surely in flight
 // A failing step sets `status`. The script then exits with `crash_status` if the viewer is gone
 // without being closed, else with `status`. Returns its result with the viewer's log appended.
 // `env` (e.g. "PATH=/x:$PATH") is set for the viewer alone. The viewer keeps its settings in
@@ -111,7 +118,11 @@ RunResult run_live_viewer(const std::string& prefix, const std::string& name, co
   }
   if (FILE* f = std::fopen(script.c_str(), "w")) {
     std::fputs(("viewer=$1 drop=$2 input=$3 log=$4\n"
+                "gate=\"" + gate_file(name) + "\"\n"
                 "export XDG_CONFIG_HOME=\"" + config_home + "\"\n"
+                "open_gate() { : > \"$gate\"; }\n"
+                "close_gate() { rm -f \"$gate\"; }\n"
+                "open_gate\n"
                 "cd \"$(dirname \"$log\")\"\n"
                 + (env.empty() ? std::string() : "env " + env + " ") + "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
                 "pid=$!\n"
@@ -968,43 +979,43 @@ std::string playbot_dir() {
   return found.empty() ? found : std::filesystem::canonical(found).string();
 }
 
-// The viewer on pc_playbot in a `window`-sized window, its frames rendered at `render` size
-// on one thread: a render (or comparison, or export frame) then takes most of a second or
-// more here, long enough for a test's input to arrive while it runs, and a core stays free
-// for the test's script.
-std::string slow_playbot_viewer_args(const std::string& dir, const std::string& window,
-                                     const std::string& render = "2048x1200") {
-  return "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size " + window + " --render-size " + render +
-         " --log-input";
+// The viewer on pc_playbot in a `window`-sized window, its frames rendered at 2048x1200 on one
+// thread (a core stays free for the test's script) behind the render gate of run `name`.
+std::string gated_playbot_viewer_args(const std::string& dir, const std::string& window, const std::string& name) {
+  return "\"" + dir + "/point_cloud.ply\" --backend cpu --threads 1 --size " + window +
+         " --render-size 2048x1200 --log-input" + gate_args(name);
 }
 #endif
 
-// While the CPU renders a frame of pc_playbot (seconds on a small machine) on the worker
-// thread, a real click (XTEST) on a checkbox is answered: the frames that see the button held
-// are logged while the frame renders, the option changes, and no UI frame in the whole run
-// took 100 ms or more (the viewer measures each from input to swap; before the worker, each
-// took as long as a render).
+// While the CPU renders a frame of pc_playbot on the worker thread, a real click (XTEST) on a
+// checkbox is answered: the frames that see the button held are logged while the frame is in
+// flight (held there by the render gate, however fast the machine), the option changes, and
+// no UI frame in the whole run took 100 ms or more (the viewer measures each from input to
+// swap; before the worker, each took as long as a render).
 TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
 #else
   REQUIRE_LIVE_PLAYBOT(prefix, dir);
-  // H turns the heat map on (a new full frame starts rendering), then the "Tight box" checkbox
-  // is clicked while that frame renders. 1024x600: the sections are open from 600 points up,
-  // and the swap (llvmpipe drawing the window, Xvfb copying it) is most of a UI frame's time
-  // here. The frame renders at 4096x2400 (about 2.5 s on one thread here): at 2048x1200 it
-  // took 0.65 s, about as long as the script takes to find and click the checkbox.
+  // H turns the heat map on (a new full frame starts and waits at the closed gate), then the
+  // "Tight box" checkbox is clicked; the gate opens and the frame of the new options is shown.
+  // 1024x600: the sections are open from 600 points up, and the swap (llvmpipe drawing the
+  // window, Xvfb copying it) is most of a UI frame's time here.
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
+      "close_gate\n"
       "[ $status -eq 0 ] && { hold H \" key72 \" || status=11; }\n"
       "[ $status -eq 0 ] && { click \"Tight box\" || status=12; }\n"
       "[ $status -eq 0 ] && { wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
+      "open_gate\n"
+      "[ $status -eq 0 ] && { wait_count \"(full) rendered in\" 2 || status=16; }\n"
       "[ $status -eq 0 ] && { close_window || status=15; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_rendering",
-                                      slow_playbot_viewer_args(dir, "1024x600", "4096x2400"),
+                                      gated_playbot_viewer_args(dir, "1024x600", "ui_while_rendering"),
                                       steps, 14);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
-                            << " failed (10 first frame, 11 H, 12 click, 13 option not changed, 14 crash, 15 close)\n"
+                            << " failed (10 first frame, 11 H, 12 click, 13 option not changed, 14 crash, 15 close, "
+                               "16 no frame after the gate opened)\n"
                             << r.output;
   bool seen_while_rendering = false;  // a held-button line of a frame that began with a render in flight
   for (std::size_t at = r.output.find("held: mouse0 at "); at != std::string::npos;
@@ -1031,11 +1042,12 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
 #endif
 }
 
-// "Compare this view" on the CPU path renders two frames of pc_playbot at 2048x1200 on one
-// thread (seconds): they run beside the frame loop. While they do, a second C is refused with
-// a notice and a click changes an option (frames logged as "(comparing)"); then the comparison
-// arrives, stale (the options changed meanwhile), and no UI frame while it ran took 100 ms or
-// more. Before, the window froze for the whole comparison and the second C started another.
+// "Compare this view" on the CPU path renders two frames of pc_playbot beside the frame loop.
+// While they are in flight (held by the render gate), a second C is refused with a notice and
+// a click changes an option (frames logged as "(comparing)"); then the gate opens and the
+// comparison arrives, stale (the options changed meanwhile), and no UI frame while it ran took
+// 100 ms or more. Before, the window froze for the whole comparison and the second C started
+// another.
 TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
@@ -1044,14 +1056,16 @@ TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
   // GLFW key code of C: 67.
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
+      "close_gate\n"
       "[ $status -eq 0 ] && { hold c \" key67 \" || status=11; }\n"
       "[ $status -eq 0 ] && { wait_for \"comparing flash vs baseline at 2048x1200 in the background\" || status=12; }\n"
       "[ $status -eq 0 ] && { hold c \" key67 \" && wait_for \"this request is ignored\" || status=13; }\n"
       "[ $status -eq 0 ] && { click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=14; }\n"
+      "open_gate\n"
       "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=15; }\n"
       "[ $status -eq 0 ] && { close_window || status=17; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_comparing",
-                                      slow_playbot_viewer_args(dir, "1024x600"),
+                                      gated_playbot_viewer_args(dir, "1024x600", "ui_while_comparing"),
                                       steps, 16);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 C, 12 not started in the background, 13 second C not "
@@ -1076,8 +1090,9 @@ TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
 #endif
 }
 
-// Closing the window while a comparison renders on the CPU cancels it: the viewer exits
-// cleanly (status 0, the cancel logged) instead of finishing the comparison first.
+// Closing the window while a comparison renders on the CPU (held in flight by the render
+// gate) cancels it: the viewer exits cleanly (status 0, the cancel logged) instead of
+// finishing the comparison first.
 TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
@@ -1085,6 +1100,7 @@ TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
   REQUIRE_LIVE_PLAYBOT(prefix, dir);
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
+      "close_gate\n"
       "[ $status -eq 0 ] && { hold c \" key67 \" || status=11; }\n"
       "[ $status -eq 0 ] && { wait_for \"comparing flash vs baseline\" || status=12; }\n"
       "t0=$(date +%s%N)\n"
@@ -1092,7 +1108,7 @@ TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
       "echo \"closed after $(( ($(date +%s%N) - t0) / 1000000 )) ms\"\n"
       "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=15\n";
   const RunResult r = run_live_viewer(prefix, "close_while_comparing",
-                                      slow_playbot_viewer_args(dir, "800x450"),
+                                      gated_playbot_viewer_args(dir, "800x450", "close_while_comparing"),
                                       steps, 13);
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 C, 12 not started, 13 crash, 14 close, 15 exit status)\n"
@@ -1105,9 +1121,10 @@ TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
 #endif
 }
 
-// A path export on the CPU renders its frames beside the frame loop: while they render, a
-// click on a checkbox is answered (in a frame that says so), no UI frame takes 100 ms, and the
-// frames are all written. The folder is typed into the panel's box, as a user would.
+// A path export on the CPU renders its frames beside the frame loop: while one is in flight
+// (held by the render gate), a click on a checkbox is answered (in a frame that says so), no
+// UI frame takes 100 ms, and the frames are all written once the gate opens. The folder is
+// typed into the panel's box, as a user would.
 TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
@@ -1121,12 +1138,15 @@ TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
   const std::string steps =
       "wait_for \"first frame shown\" || status=10\n"
       "[ $status -eq 0 ] && { click \"export folder\" && \"$input\" type exportwhilelive || status=11; }\n"
+      "close_gate\n"
       "[ $status -eq 0 ] && { click \"Export path\" && wait_for \"path export: 3 frames into\" || status=12; }\n"
       "[ $status -eq 0 ] && { click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
+      "open_gate\n"
       "[ $status -eq 0 ] && { wait_for \"path export: 3 frames in \" || status=14; }\n"
       "[ $status -eq 0 ] && { close_window || status=16; }\n";
   const RunResult r = run_live_viewer(prefix, "ui_while_exporting",
-                                      slow_playbot_viewer_args(dir, "1024x1000") + " --export-frames 3",
+                                      gated_playbot_viewer_args(dir, "1024x1000", "ui_while_exporting") +
+                                          " --export-frames 3",
                                       steps, 15, "PATH=/usr/bin:/bin");
   ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 typing the folder, 12 export not started, 13 click, "

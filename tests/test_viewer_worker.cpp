@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
 #include <condition_variable>
 #include <atomic>
 #include <future>
@@ -16,6 +18,7 @@
 #include "flashgs/generators.h"
 #include "path_note.h"
 #include "rate_meter.h"
+#include "render_gate.h"
 #include "render_worker.h"
 #include "viewer_settings.h"
 
@@ -443,4 +446,93 @@ TEST(ViewerBackgroundJob, CancelRaisesTheJobsFlag) {
   std::string error;
   ASSERT_TRUE(job.take(&error));
   EXPECT_EQ(error, "cancelled");
+}
+
+// What the --render-gate renderer passes on: each render reaches the inner renderer only once
+// the gate file exists, or at once when its cancel flag is raised (which the inner renderer
+// then sees, and stops the frame as cancelled).
+namespace {
+
+class RecordingRenderer final : public flashgs::Renderer {
+ public:
+  explicit RecordingRenderer(std::string gate_file) : m_gate_file(std::move(gate_file)) {}
+  std::string name() const override { return "recording"; }
+  void set_scene(std::shared_ptr<const flashgs::Scene>) override {}
+  void render(const flashgs::Camera& camera, const flashgs::RenderOptions&, flashgs::Image& out,
+              flashgs::FrameStats* stats) override {
+    ++renders;
+    gate_was_open = std::filesystem::exists(m_gate_file);
+    if (cancel_requested()) {
+      stats->cancelled = true;
+      return;
+    }
+    out.resize(camera.width, 1);
+  }
+  std::atomic<int> renders{0};
+  std::atomic<bool> gate_was_open{false};
+
+ private:
+  std::string m_gate_file;
+};
+
+std::string fresh_gate_file(const char* name) {
+  const auto dir = std::filesystem::temp_directory_path() / "flashgs_render_gate";
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / name).string();
+  std::filesystem::remove(file);
+  return file;
+}
+
+void open_gate(const std::string& file) {
+  if (FILE* f = std::fopen(file.c_str(), "w")) std::fclose(f);
+}
+
+}  // namespace
+
+TEST(ViewerRenderGate, AnOpenGateRendersAtOnce) {
+  const std::string gate = fresh_gate_file("open");
+  open_gate(gate);
+  auto owned = std::make_unique<RecordingRenderer>(gate);
+  RecordingRenderer* inner = owned.get();
+  fv::FileGatedRenderer gated(std::move(owned), gate);
+  EXPECT_EQ(gated.name(), "recording");
+  flashgs::Image image;
+  flashgs::FrameStats stats;
+  gated.render(request_of_width(7).camera, {}, image, &stats);
+  EXPECT_EQ(inner->renders, 1);
+  EXPECT_EQ(image.width, 7);
+  EXPECT_FALSE(stats.cancelled);
+}
+
+TEST(ViewerRenderGate, AClosedGateHoldsTheRenderUntilTheFileAppears) {
+  const std::string gate = fresh_gate_file("closed");
+  auto owned = std::make_unique<RecordingRenderer>(gate);
+  RecordingRenderer* inner = owned.get();
+  fv::FileGatedRenderer gated(std::move(owned), gate);
+  flashgs::Image image;
+  flashgs::FrameStats stats;
+  std::thread render([&] { gated.render(request_of_width(5).camera, {}, image, &stats); });
+  EXPECT_EQ(inner->renders, 0) << "it rendered before the gate opened";
+  open_gate(gate);
+  render.join();
+  EXPECT_EQ(inner->renders, 1);
+  EXPECT_TRUE(inner->gate_was_open) << "the inner render ran with the gate closed";
+  EXPECT_EQ(image.width, 5);
+}
+
+TEST(ViewerRenderGate, ACancelledRenderLeavesTheClosedGateAsACancelledFrame) {
+  const std::string gate = fresh_gate_file("cancelled");
+  auto owned = std::make_unique<RecordingRenderer>(gate);
+  RecordingRenderer* inner = owned.get();
+  fv::FileGatedRenderer gated(std::move(owned), gate);
+  std::atomic<bool> cancel{false};
+  gated.set_cancel_flag(&cancel);
+  flashgs::Image image;
+  flashgs::FrameStats stats;
+  std::thread render([&] { gated.render(request_of_width(5).camera, {}, image, &stats); });
+  cancel = true;
+  render.join();  // returns with the gate still closed
+  EXPECT_EQ(inner->renders, 1);
+  EXPECT_FALSE(inner->gate_was_open);
+  EXPECT_TRUE(stats.cancelled) << "the inner renderer did not get the cancel flag";
 }

@@ -26,6 +26,7 @@
 #include "scene_lines.h"
 #include "split_view_gl.h"
 #include "path_note.h"
+#include "render_gate.h"
 #include "settings_store.h"
 #include "viewer_panels_ui.h"
 #include "widget_places_ui.h"
@@ -178,7 +179,12 @@ void ViewerApp::use_cpu_path(const std::string& why) {
     m_export_job.take(&dropped);
   }
   // The worker wakes the event loop when a frame is done: the window shows it at once.
-  m_path = make_background_upload_path(make_cpu_renderer(m_args.cpu_threads), m_presenter.get(), "CPU renderer + texture upload",
+  std::unique_ptr<Renderer> renderer = make_cpu_renderer(m_args.cpu_threads);
+  if (!m_args.render_gate.empty()) {
+    renderer = std::make_unique<FileGatedRenderer>(std::move(renderer), m_args.render_gate);
+    std::fprintf(stderr, "flashgs-viewer: each render waits for %s (--render-gate)\n", m_args.render_gate.c_str());
+  }
+  m_path = make_background_upload_path(std::move(renderer), m_presenter.get(), "CPU renderer + texture upload",
                                        [] { glfwPostEmptyEvent(); });
   m_path_is_cpu = true;
   m_path_note = plain_path_note(why);

@@ -112,6 +112,8 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_flag("--compare", a->compare, "scripted: compare the last frame with the baseline and print PSNR");
   app.add_flag("--log-input", a->log_input,
                "log every frame in which a mouse button is held, and where the clickable widgets are (for tests that click through X)");
+  app.add_option("--render-gate", a->render_gate,
+                 "CPU path: each render waits until this file exists (for tests that act while a frame renders)");
   try {
     app.parse(argc, argv);
     if (!size.empty()) parse_size("--size", size, &a->window_width, &a->window_height);

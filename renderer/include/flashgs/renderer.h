@@ -35,6 +35,8 @@ class Renderer {
   bool cancel_requested() const {
     return m_cancel_flag != nullptr && m_cancel_flag->load(std::memory_order_relaxed);
   }
+  // The flag set_cancel_flag gave (a renderer that wraps another passes it on).
+  const std::atomic<bool>* cancel_flag() const { return m_cancel_flag; }
 
  private:
   const std::atomic<bool>* m_cancel_flag = nullptr;

@@ -1,0 +1,22 @@
+#include "render_gate.h"
+
+#include <chrono>
+#include <filesystem>
+#include <system_error>
+#include <thread>
+
+namespace flashgs::viewer {
+
+FileGatedRenderer::FileGatedRenderer(std::unique_ptr<Renderer> inner, std::string gate_file)
+    : m_inner(std::move(inner)), m_gate_file(std::move(gate_file)) {}
+
+void FileGatedRenderer::render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) {
+  // Polled: the file comes from another process (the test's script), which cannot signal us.
+  std::error_code ignored;
+  while (!cancel_requested() && !std::filesystem::exists(m_gate_file, ignored))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  m_inner->set_cancel_flag(cancel_flag());
+  m_inner->render(camera, options, out, stats);
+}
+
+}  // namespace flashgs::viewer

@@ -1,0 +1,26 @@
+// FileGatedRenderer: a Renderer that holds each render until a file exists (--render-gate), so that a scripted test keeps a CPU frame, comparison or export frame in flight for exactly as long as it needs, on a fast machine as on a slow one.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "flashgs/renderer.h"
+
+namespace flashgs::viewer {
+
+class FileGatedRenderer final : public Renderer {
+ public:
+  // Renders with `inner` once `gate_file` exists; a render whose cancel flag is raised while
+  // it waits goes on at once (and `inner` stops it as a cancelled frame).
+  FileGatedRenderer(std::unique_ptr<Renderer> inner, std::string gate_file);
+
+  std::string name() const override { return m_inner->name(); }
+  void set_scene(std::shared_ptr<const Scene> scene) override { m_inner->set_scene(std::move(scene)); }
+  void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override;
+
+ private:
+  std::unique_ptr<Renderer> m_inner;
+  std::string m_gate_file;
+};
+
+}  // namespace flashgs::viewer
