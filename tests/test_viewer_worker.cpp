@@ -487,6 +487,14 @@ void open_gate(const std::string& file) {
   if (FILE* f = std::fopen(file.c_str(), "w")) std::fclose(f);
 }
 
+// Waits (up to 30 s) until a render waits at `gated`'s closed gate.
+bool wait_until_held(const fv::FileGatedRenderer& gated) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!gated.waiting() && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  return gated.waiting();
+}
+
 }  // namespace
 
 TEST(ViewerRenderGate, AnOpenGateRendersAtOnce) {
@@ -512,9 +520,12 @@ TEST(ViewerRenderGate, AClosedGateHoldsTheRenderUntilTheFileAppears) {
   flashgs::Image image;
   flashgs::FrameStats stats;
   std::thread render([&] { gated.render(request_of_width(5).camera, {}, image, &stats); });
+  const bool held = wait_until_held(gated);
+  EXPECT_TRUE(held) << "the render never waited at the closed gate";
   EXPECT_EQ(inner->renders, 0) << "it rendered before the gate opened";
   open_gate(gate);
   render.join();
+  EXPECT_FALSE(gated.waiting());
   EXPECT_EQ(inner->renders, 1);
   EXPECT_TRUE(inner->gate_was_open) << "the inner render ran with the gate closed";
   EXPECT_EQ(image.width, 5);
@@ -530,6 +541,7 @@ TEST(ViewerRenderGate, ACancelledRenderLeavesTheClosedGateAsACancelledFrame) {
   flashgs::Image image;
   flashgs::FrameStats stats;
   std::thread render([&] { gated.render(request_of_width(5).camera, {}, image, &stats); });
+  EXPECT_TRUE(wait_until_held(gated)) << "the render never waited at the closed gate";
   cancel = true;
   render.join();  // returns with the gate still closed
   EXPECT_EQ(inner->renders, 1);

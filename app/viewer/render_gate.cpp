@@ -13,8 +13,11 @@ FileGatedRenderer::FileGatedRenderer(std::unique_ptr<Renderer> inner, std::strin
 void FileGatedRenderer::render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) {
   // Polled: the file comes from another process (the test's script), which cannot signal us.
   std::error_code ignored;
-  while (!cancel_requested() && !std::filesystem::exists(m_gate_file, ignored))
+  while (!cancel_requested() && !std::filesystem::exists(m_gate_file, ignored)) {
+    m_waiting = true;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  m_waiting = false;
   m_inner->set_cancel_flag(cancel_flag());
   m_inner->render(camera, options, out, stats);
 }

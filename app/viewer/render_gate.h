@@ -1,6 +1,7 @@
 // FileGatedRenderer: a Renderer that holds each render until a file exists (--render-gate), so that a scripted test keeps a CPU frame, comparison or export frame in flight for exactly as long as it needs, on a fast machine as on a slow one.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <string>
 
@@ -17,10 +18,13 @@ class FileGatedRenderer final : public Renderer {
   std::string name() const override { return m_inner->name(); }
   void set_scene(std::shared_ptr<const Scene> scene) override { m_inner->set_scene(std::move(scene)); }
   void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override;
+  // A render waits at the closed gate now (tests wait for it before they open it).
+  bool waiting() const { return m_waiting; }
 
  private:
   std::unique_ptr<Renderer> m_inner;
   std::string m_gate_file;
+  std::atomic<bool> m_waiting{false};
 };
 
 }  // namespace flashgs::viewer
