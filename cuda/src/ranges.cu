@@ -105,6 +105,19 @@ constexpr int kListLoads = 8;
 constexpr unsigned kListRun = kWarp * kListLoads;
 constexpr unsigned kSmallBin = 2 * kListRun;  // values of a bin one warp lists alone
 
+// What both tile-list kernels read and write (FrameBuffers' fields of the same names).
+struct BinListArgs {
+  BinGrid bins;
+  int tiles_x, tiles_y;
+  const uint2* bin_ranges;       // tile_ranges: per bin
+  const std::uint32_t* values;   // the sorted pair values
+  std::uint32_t* top_lists;      // tile_values[0]
+  std::uint32_t* bottom_lists;   // tile_values[1]
+  uint2* tile_lists;
+  std::uint32_t* dense_bins;
+  FrameCounters* counters;
+};
+
 // Where one bin's four tile lists go (FrameBuffers::tile_lists; tile q row-major in the bin).
 struct BinLists {
   std::uint32_t* top;
@@ -141,69 +154,54 @@ __device__ __forceinline__ void place_run(const BinLists& lists, const std::uint
 }
 
 // Lane q < 4 records tile q's list (tiles beyond the image's edge have none).
-__device__ __forceinline__ void record_tile_list(const BinGrid& bins, int tiles_x, int tiles_y, unsigned bin,
-                                                 const BinLists& lists, const unsigned (&placed)[4], unsigned q,
-                                                 uint2* tile_lists) {
+__device__ __forceinline__ void record_tile_list(const BinListArgs& a, unsigned bin, const BinLists& lists,
+                                                 const unsigned (&placed)[4], unsigned q) {
   if (q >= 4) return;
-  const int tx = static_cast<int>(bin % static_cast<unsigned>(bins.x)) * 2 + static_cast<int>(q & 1u);
-  const int ty = static_cast<int>(bin / static_cast<unsigned>(bins.x)) * 2 + static_cast<int>(q >> 1);
-  if (tx >= tiles_x || ty >= tiles_y) return;
+  const int tx = static_cast<int>(bin % static_cast<unsigned>(a.bins.x)) * 2 + static_cast<int>(q & 1u);
+  const int ty = static_cast<int>(bin / static_cast<unsigned>(a.bins.x)) * 2 + static_cast<int>(q >> 1);
+  if (tx >= a.tiles_x || ty >= a.tiles_y) return;
   const unsigned count = q == 0 ? placed[0] : q == 1 ? placed[1] : q == 2 ? placed[2] : placed[3];
   const unsigned start = lists.list_start(static_cast<int>(q));
-  tile_lists[static_cast<std::uint64_t>(ty) * static_cast<unsigned>(tiles_x) + static_cast<unsigned>(tx)] =
+  a.tile_lists[static_cast<std::uint64_t>(ty) * static_cast<unsigned>(a.tiles_x) + static_cast<unsigned>(tx)] =
       make_uint2(start, start + count);
 }
 
 // Binned frames: each tile's list, the records of its bin's values that carry its bit, in
 // bin order. A warp per bin lists the small bins and leaves the dense ones to
 // dense_bin_lists_kernel (FrameBuffers::dense_bins).
-__global__ void __launch_bounds__(kListWarps * kWarp) small_bin_lists_kernel(BinGrid bins, int tiles_x, int tiles_y,
-                                                                             const uint2* __restrict__ bin_ranges,
-                                                                             const std::uint32_t* __restrict__ values,
-                                                                             std::uint32_t* __restrict__ top_lists,
-                                                                             std::uint32_t* __restrict__ bottom_lists,
-                                                                             uint2* __restrict__ tile_lists,
-                                                                             std::uint32_t* __restrict__ dense_bins,
-                                                                             FrameCounters* counters) {
+__global__ void __launch_bounds__(kListWarps * kWarp) small_bin_lists_kernel(BinListArgs a) {
   static_assert(kMacroBinShift == 1, "a bin is 2x2 tiles");
   const unsigned bin = blockIdx.x * kListWarps + threadIdx.x / kWarp, lane = lane_id();
-  if (bin >= static_cast<unsigned>(bins.x) * static_cast<unsigned>(bins.y)) return;  // whole warp
-  const uint2 range = bin_ranges[bin];
-  const BinLists lists{top_lists, bottom_lists, range.x, range.y - range.x};
+  if (bin >= static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y)) return;  // whole warp
+  const uint2 range = a.bin_ranges[bin];
+  const BinLists lists{a.top_lists, a.bottom_lists, range.x, range.y - range.x};
   if (lists.length > kSmallBin) {
-    if (lane == 0) dense_bins[atomicAdd(&counters->dense_bins, 1u)] = bin;
+    if (lane == 0) a.dense_bins[atomicAdd(&a.counters->dense_bins, 1u)] = bin;
     return;
   }
   unsigned placed[4] = {0, 0, 0, 0};
   for (unsigned run = range.x; run < range.y; run += kListRun) {  // warp-uniform
     std::uint32_t v[kListLoads];
-    load_run(values, run, range.y, lane, v);
+    load_run(a.values, run, range.y, lane, v);
     place_run(lists, v, lane, placed);
   }
-  record_tile_list(bins, tiles_x, tiles_y, bin, lists, placed, lane, tile_lists);
+  record_tile_list(a, bin, lists, placed, lane);
 }
 
 // The dense bins' lists, a block per bin: warp w takes the w-th run of each round; a first
 // pass of ballots counts each warp's values per tile, so that the second knows where in each
 // tile's list the warp's values go. Blocks beyond the listed bins return at once.
-__global__ void __launch_bounds__(kListWarps * kWarp) dense_bin_lists_kernel(BinGrid bins, int tiles_x, int tiles_y,
-                                                                             const uint2* __restrict__ bin_ranges,
-                                                                             const std::uint32_t* __restrict__ values,
-                                                                             std::uint32_t* __restrict__ top_lists,
-                                                                             std::uint32_t* __restrict__ bottom_lists,
-                                                                             uint2* __restrict__ tile_lists,
-                                                                             const std::uint32_t* __restrict__ dense_bins,
-                                                                             const FrameCounters* counters) {
-  if (blockIdx.x >= counters->dense_bins) return;  // whole block
+__global__ void __launch_bounds__(kListWarps * kWarp) dense_bin_lists_kernel(BinListArgs a) {
+  if (blockIdx.x >= a.counters->dense_bins) return;  // whole block
   __shared__ unsigned warp_counts[kListWarps][4];
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
-  const unsigned bin = dense_bins[blockIdx.x];
-  const uint2 range = bin_ranges[bin];
-  const BinLists lists{top_lists, bottom_lists, range.x, range.y - range.x};
+  const unsigned bin = a.dense_bins[blockIdx.x];
+  const uint2 range = a.bin_ranges[bin];
+  const BinLists lists{a.top_lists, a.bottom_lists, range.x, range.y - range.x};
   unsigned placed[4] = {0, 0, 0, 0};
   for (unsigned round = range.x; round < range.y; round += kListWarps * kListRun) {  // block-uniform
     std::uint32_t v[kListLoads];
-    load_run(values, round + warp * kListRun, range.y, lane, v);
+    load_run(a.values, round + warp * kListRun, range.y, lane, v);
     unsigned count[4] = {0, 0, 0, 0};
 #pragma unroll
     for (int k = 0; k < kListLoads; ++k)
@@ -228,7 +226,7 @@ __global__ void __launch_bounds__(kListWarps * kWarp) dense_bin_lists_kernel(Bin
 #pragma unroll
     for (int q = 0; q < 4; ++q) placed[q] += total[q];
   }
-  record_tile_list(bins, tiles_x, tiles_y, bin, lists, placed, threadIdx.x, tile_lists);
+  record_tile_list(a, bin, lists, placed, threadIdx.x);
 }
 
 // A tile's class: the leading zeros of its pair count, so fuller tiles come first.
@@ -289,16 +287,15 @@ void launch_tile_lists(std::uint64_t pairs, int tiles_x, int tiles_y, const Fram
                        cudaStream_t stream) {
   const std::uint64_t bins = static_cast<std::uint64_t>(b.bins.x) * static_cast<std::uint64_t>(b.bins.y);
   if (bins == 0) return;
+  const BinListArgs args{b.bins,          tiles_x,          tiles_y,      b.tile_ranges, b.values[which],
+                         b.tile_values[0], b.tile_values[1], b.tile_lists, b.dense_bins,  b.counters};
   small_bin_lists_kernel<<<static_cast<unsigned>((bins + kListWarps - 1) / kListWarps), kListWarps * kWarp, 0,
-                           stream>>>(b.bins, tiles_x, tiles_y, b.tile_ranges, b.values[which], b.tile_values[0],
-                                     b.tile_values[1], b.tile_lists, b.dense_bins, b.counters);
+                           stream>>>(args);
   check_cuda(cudaGetLastError(), "tile lists kernel launch");
   // At most this many bins hold more than kSmallBin values; the device knows how many do.
   const std::uint64_t most_dense = std::min<std::uint64_t>(bins, pairs / (kSmallBin + 1));
   if (most_dense == 0) return;
-  dense_bin_lists_kernel<<<static_cast<unsigned>(most_dense), kListWarps * kWarp, 0, stream>>>(
-      b.bins, tiles_x, tiles_y, b.tile_ranges, b.values[which], b.tile_values[0], b.tile_values[1], b.tile_lists,
-      b.dense_bins, b.counters);
+  dense_bin_lists_kernel<<<static_cast<unsigned>(most_dense), kListWarps * kWarp, 0, stream>>>(args);
   check_cuda(cudaGetLastError(), "dense tile lists kernel launch");
 }
 

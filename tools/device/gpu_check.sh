@@ -196,10 +196,10 @@ cpu_simd_tests() {  # the SIMD kernels against the scalar ones on every target t
   done
 }
 
-bench_prev_cuda() {  # the earlier tree's CUDA flash (build-prev with PREV_CUDA=1) on the bench-ab rows
+bench_prev_cuda() {  # the earlier tree's CUDA flash (build-prev with PREV_CUDA=1) on the bench-ab rows; PREV_CONFIGS (flash)
   for scene in pc_biker pc_playbot; do
     log "bench earlier tree $scene"
-    bench_scene "$SCENES/$scene" prev_bench_$scene --backend cuda -r 1920x1080,3840x2160 --configs flash \
+    bench_scene "$SCENES/$scene" prev_bench_$scene --backend cuda -r 1920x1080,3840x2160 --configs ${PREV_CONFIGS:-flash} \
       --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
   done
   log "bench earlier tree 7 x pc_playbot"
