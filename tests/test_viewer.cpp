@@ -965,6 +965,20 @@ double worst_ui_frame_ms(const std::string& log, double* frames) {
   return at == std::string::npos ? -1 : std::atof(log.c_str() + at + 8);
 }
 
+// The shortest full-size render the viewer logged (--log-input), or -1 if none. A UI frame
+// that waited for a render would take at least this long, on a loaded machine as on an idle
+// one, so it bounds the worst UI frame without a fixed figure (a fixed 100 ms failed on CI,
+// where llvmpipe's swap alone took 87 ms beside the other tests).
+double shortest_full_render_ms(const std::string& log) {
+  const std::string key = "(full) rendered in ";
+  double shortest = -1;
+  for (auto at = log.find(key); at != std::string::npos; at = log.find(key, at + 1)) {
+    const double ms = std::atof(log.c_str() + at + key.size());
+    if (shortest < 0 || ms < shortest) shortest = ms;
+  }
+  return shortest;
+}
+
 #ifdef FLASHGS_X11_INPUT
 // The live tests on pc_playbot: a private display (their XTEST input must not reach another
 // session's) and the scene, its folder made canonical.
@@ -990,8 +1004,9 @@ std::string gated_playbot_viewer_args(const std::string& dir, const std::string&
 // While the CPU renders a frame of pc_playbot on the worker thread, a real click (XTEST) on a
 // checkbox is answered: the frames that see the button held are logged while the frame is in
 // flight (held there by the render gate, however fast the machine), the option changes, and
-// no UI frame in the whole run took 100 ms or more (the viewer measures each from input to
-// swap; before the worker, each took as long as a render).
+// no UI frame while a frame rendered took as long as a render (the viewer measures each from
+// input to swap; before the worker, each took as long as a render). The frame times are
+// printed; the 100 ms goal is a figure, not an assertion, since a loaded machine's swap varies.
 TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
@@ -1036,9 +1051,11 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
   double frames = 0;
   const double worst_ms = worst_ui_frame_ms(r.output, &frames);
   ASSERT_GE(worst_ms, 0.0) << r.output;
-  std::printf("UI frames while rendering: %.0f, worst %.1f ms\n", frames, worst_ms);
+  const double render_ms = shortest_full_render_ms(r.output);
+  std::printf("UI frames while rendering: %.0f, worst %.1f ms; shortest full render %.0f ms\n", frames, worst_ms,
+              render_ms);
   EXPECT_GE(frames, 2.0);
-  EXPECT_LT(worst_ms, 100.0) << r.output;
+  EXPECT_LT(worst_ms, render_ms) << r.output;
 #endif
 }
 
@@ -1046,8 +1063,8 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
 // While they are in flight (held by the render gate), a second C is refused with a notice and
 // a click changes an option (frames logged as "(comparing)"); then the gate opens and the
 // comparison arrives, stale (the options changed meanwhile), and no UI frame while it ran took
-// 100 ms or more. Before, the window froze for the whole comparison and the second C started
-// another.
+// as long as a render. Before, the window froze for the whole comparison and the second C
+// started another.
 TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
@@ -1083,10 +1100,12 @@ TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
   EXPECT_NE(log.find("the comparison is stale", result), std::string::npos) << "an option changed meanwhile\n" << log;
   double frames = 0;
   const double worst_ms = worst_ui_frame_ms(log, &frames);
-  std::printf("UI frames while comparing: %.0f, worst %.1f ms\n", frames, worst_ms);
+  const double render_ms = shortest_full_render_ms(log);
+  std::printf("UI frames while comparing: %.0f, worst %.1f ms; shortest full render %.0f ms\n", frames, worst_ms,
+              render_ms);
   EXPECT_GE(frames, 5.0) << log;
   ASSERT_GE(worst_ms, 0.0) << log;
-  EXPECT_LT(worst_ms, 100.0) << log;
+  EXPECT_LT(worst_ms, render_ms) << log;
 #endif
 }
 
@@ -1123,7 +1142,7 @@ TEST(Viewer, ClosingTheWindowCancelsAComparisonInFlight) {
 
 // A path export on the CPU renders its frames beside the frame loop: while one is in flight
 // (held by the render gate), a click on a checkbox is answered (in a frame that says so), no
-// UI frame takes 100 ms, and the frames are all written once the gate opens. The folder is
+// UI frame takes a second, and the frames are all written once the gate opens. The folder is
 // typed into the panel's box, as a user would.
 TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
 #ifndef FLASHGS_X11_INPUT
@@ -1165,9 +1184,9 @@ TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
     EXPECT_TRUE(std::filesystem::exists(folder + name + kExt)) << name;
   }
   // Every UI frame of the run (--log-input logs each that takes 50 ms or more): the 1-megapixel
-  // window's swap alone takes up to ~160 ms on a loaded 2-core machine under llvmpipe (the
-  // 100 ms bound is asserted with smaller windows above), while an export frame rendered on
-  // the UI thread, as before, held its UI frame for the whole render (seconds here).
+  // window's swap alone takes up to ~160 ms on a loaded 2-core machine under llvmpipe, while
+  // an export frame rendered on the UI thread, as before, held its UI frame for the whole
+  // render (seconds here).
   double slowest_ms = 0;
   const std::string slow = "slow UI frame ";
   for (auto at = log.find(slow); at != std::string::npos; at = log.find(slow, at + 1))
