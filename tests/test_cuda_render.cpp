@@ -315,10 +315,12 @@ TEST(CudaDeterminism, SameFrameTwiceGivesTheSameBytes) {
   }
 }
 
-// The 32-bit keys (tile + a depth bin, ties put in order by the ranges pass) must give the
+// The compact keys (tile + a depth bin, ties put in order by the ranges pass) must give the
 // blend exactly the order of the 64-bit keys (tile + the depth's float bits): same kernels on
-// the same order, so the images are equal to the byte. Both resolutions: 4K leaves fewer bits
-// for the depth bin, hence more ties.
+// the same order, so the images are equal to the byte. Each key length FLASHGS_SORT_KEY_BITS
+// offers: 32 bits (the default), 24 (one radix pass fewer, 11-13 bits of depth) and 16 (8 bits
+// of depth: long runs of ties, which the ranges pass heap-sorts). Both resolutions: 4K leaves
+// fewer bits for the depth bin, hence more ties.
 TEST(CudaSortKeys, CompactKeysBlendInTheSameOrderAsFullKeys) {
   FLASHGS_REQUIRE_CUDA();
   FLASHGS_REQUIRE_SHARED_SCENES();
@@ -327,17 +329,21 @@ TEST(CudaSortKeys, CompactKeysBlendInTheSameOrderAsFullKeys) {
   for (const std::string& name : test::shared_scene_names()) {
     const auto scene = test::load_shared_scene(name);
     const std::vector<Camera> cameras = test::load_shared_cameras(name);
-    auto gpu = make_cuda_renderer();
-    gpu->set_scene(scene);
-    for (int index : {0, 10, 20})
-      for (const Camera& camera : {cameras[index].resized(1920, 1080), cameras[index].resized(3840, 2160)}) {
-        const Result compact = render(*gpu, camera, RenderOptions{});
-        const Result full = render(*gpu, camera, full_keys);
-        EXPECT_EQ(compact.stats.kv_pairs, full.stats.kv_pairs) << name << " " << camera.name;
-        EXPECT_TRUE(compact.image.rgb == full.image.rgb)
-            << name << " camera " << index << " " << camera.width << "x" << camera.height
-            << ": the compact keys changed the blend order";
-      }
+    for (const char* key_bits : {"", "24", "16"}) {
+      if (*key_bits) setenv("FLASHGS_SORT_KEY_BITS", key_bits, 1);
+      auto gpu = make_cuda_renderer();  // reads the variable once
+      unsetenv("FLASHGS_SORT_KEY_BITS");
+      gpu->set_scene(scene);
+      for (int index : {0, 10, 20})
+        for (const Camera& camera : {cameras[index].resized(1920, 1080), cameras[index].resized(3840, 2160)}) {
+          const Result compact = render(*gpu, camera, RenderOptions{});
+          const Result full = render(*gpu, camera, full_keys);
+          EXPECT_EQ(compact.stats.kv_pairs, full.stats.kv_pairs) << name << " " << camera.name;
+          EXPECT_TRUE(compact.image.rgb == full.image.rgb)
+              << name << " camera " << index << " " << camera.width << "x" << camera.height << ", key bits "
+              << (*key_bits ? key_bits : "32") << ": the compact keys changed the blend order";
+        }
+    }
   }
 }
 

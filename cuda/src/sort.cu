@@ -44,10 +44,9 @@ template <typename KEY>
 int sort_pairs(std::uint64_t pairs, int end_bit, const FrameBuffers& b, cudaStream_t stream) {
   cub::DoubleBuffer<KEY> keys(reinterpret_cast<KEY*>(b.keys[0]), reinterpret_cast<KEY*>(b.keys[1]));
   cub::DoubleBuffer<std::uint32_t> values(b.values[0], b.values[1]);
-  std::size_t needed = 0;
-  check_cuda(cub::DeviceRadixSort::SortPairs(nullptr, needed, keys, values, static_cast<int>(pairs), 0, end_bit),
-             "cub sort size query");
-  if (needed > b.cub_temp_bytes) throw Error("cuda renderer: internal error, sort scratch too small");
+  // No size query per frame: it is host work while the GPU waits for the sort's first launch.
+  // The scratch was sized for the pair capacity (cub_temp_bytes_needed), and CUB refuses a
+  // scratch too small with an error, which check_cuda reports.
   std::size_t bytes = b.cub_temp_bytes;
   check_cuda(cub::DeviceRadixSort::SortPairs(b.cub_temp, bytes, keys, values, static_cast<int>(pairs), 0, end_bit,
                                              stream),

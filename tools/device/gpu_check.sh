@@ -125,13 +125,17 @@ bench_ab() {  # flash against flash with one switch off (AB_CONFIG, default flas
     --configs flash,${AB_CONFIG:-flash-no_dense_tiles_first} --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
 }
 
-bench_env() {  # flash without and with the environment of ENV_AB (e.g. FLASHGS_SORT_KEY_BITS=24), same run
-  for scene in pc_biker pc_playbot; do
+bench_env() {  # flash without and with the environment of ENV_AB (e.g. FLASHGS_SORT_KEY_BITS=24), same run;
+  # ENV_TILED=1 adds pc_playbot tiled 7 times in memory
+  local scene tile
+  for scene in pc_biker pc_playbot ${ENV_TILED:+pc_playbot_x7}; do
+    tile=""
+    [ $scene = pc_playbot_x7 ] && tile="--tile 7"
     log "bench env: $scene, default"
-    bench_scene "$SCENES/$scene" bench_env_a_$scene --backend cuda -r 1920x1080,3840x2160 --configs flash \
+    bench_scene "$SCENES/${scene%_x7}" bench_env_a_$scene --backend cuda $tile -r 1920x1080,3840x2160 --configs flash \
       --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
     log "bench env: $scene, $ENV_AB"
-    (export $ENV_AB; bench_scene "$SCENES/$scene" bench_env_b_$scene --backend cuda -r 1920x1080,3840x2160 \
+    (export $ENV_AB; bench_scene "$SCENES/${scene%_x7}" bench_env_b_$scene --backend cuda $tile -r 1920x1080,3840x2160 \
       --configs flash --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res")
   done
 }
