@@ -315,6 +315,41 @@ TEST(CudaDeterminism, SameFrameTwiceGivesTheSameBytes) {
   }
 }
 
+// Which kernel emits a Gaussian's pairs only moves work: a box above FLASHGS_LARGE_BOX_TILES
+// goes to a warp, above FLASHGS_HUGE_BOX_TILES to a block (both in bins with macro bins). With
+// every box a block's (1), none a block's (2^20) and the earlier split (1024), every byte and
+// count equals the default split's, with bins and with tiles, at 1080p and 4K (pc_biker has
+// thousands of boxes of 33 to 1,000 bins, and some of the whole frame).
+TEST(CudaDeferredEmission, TheSplitBetweenWarpsAndBlocksChangesNoByte) {
+  FLASHGS_REQUIRE_CUDA();
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  RenderOptions tile_keys;
+  tile_keys.macro_bins = false;
+  for (const std::string& name : {std::string("pc_biker"), std::string("pc_playbot")}) {
+    const auto scene = test::load_shared_scene(name);
+    const std::vector<Camera> cameras = test::load_shared_cameras(name);
+    auto standard = make_cuda_renderer();
+    standard->set_scene(scene);
+    for (const char* huge : {"1", "1048576", "1024"}) {
+      setenv("FLASHGS_HUGE_BOX_TILES", huge, 1);
+      auto split = make_cuda_renderer();  // reads the variable once
+      unsetenv("FLASHGS_HUGE_BOX_TILES");
+      split->set_scene(scene);
+      for (int index : {0, 10})
+        for (const Camera& camera : {cameras[index].resized(1920, 1080), cameras[index].resized(3840, 2160)})
+          for (const RenderOptions& o : {RenderOptions{}, tile_keys}) {
+            const std::string what = name + " camera " + std::to_string(index) + " " + std::to_string(camera.width) +
+                                     "x" + std::to_string(camera.height) + " " + o.label() + ", blocks above " + huge;
+            const Result a = render(*standard, camera, o);
+            const Result b = render(*split, camera, o);
+            expect_same_counts(what, a.stats, b.stats);
+            EXPECT_EQ(a.stats.sorted_pairs, b.stats.sorted_pairs) << what;
+            EXPECT_TRUE(a.image.rgb == b.image.rgb) << what;
+          }
+    }
+  }
+}
+
 // The compact keys (tile + a depth bin, ties put in order by the ranges pass) must give the
 // blend exactly the order of the 64-bit keys (tile + the depth's float bits): same kernels on
 // the same order, so the images are equal to the byte. Each key length FLASHGS_SORT_KEY_BITS

@@ -183,9 +183,12 @@ class CudaRendererImpl final : public CudaRenderer {
     stream_ = stream_handle_.get();
     // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
     if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
-    // And the box size (in tiles) above which a warp emits a Gaussian's pairs.
+    // And the box sizes (in tiles, bins with macro bins) above which a warp, or a block, emits
+    // a Gaussian's pairs.
     if (const char* tiles = std::getenv("FLASHGS_LARGE_BOX_TILES"))
-      large_box_tiles_ = std::max(1, std::min(cuda::kHugeBoxTiles, std::atoi(tiles)));
+      large_box_tiles_ = std::max(1, std::min(kMaxBoxThreshold, std::atoi(tiles)));
+    if (const char* tiles = std::getenv("FLASHGS_HUGE_BOX_TILES"))
+      huge_box_tiles_ = std::max(1, std::min(kMaxBoxThreshold, std::atoi(tiles)));
     // FLASHGS_CHUNK_CULL=0 projects every Gaussian, =1 culls chunks in any scene (unset: scenes
     // of kChunkCullMinGaussians and more).
     if (const char* cull = std::getenv("FLASHGS_CHUNK_CULL")) chunk_cull_ = std::atoi(cull) != 0 ? kAlways : kNever;
@@ -564,7 +567,7 @@ class CudaRendererImpl final : public CudaRenderer {
       const std::size_t large_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 8192 + projected / 8);
       large_footprints_.reserve(large_cap * sizeof(gm::Footprint), "large-Gaussian footprints");
       large_records_.reserve(large_cap * sizeof(std::uint32_t), "large-Gaussian records");
-      const std::size_t huge_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 4096 + projected / 64);
+      const std::size_t huge_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 4096 + projected / 16);
       huge_footprints_.reserve(huge_cap * sizeof(gm::Footprint), "huge-Gaussian footprints");
       huge_records_.reserve(huge_cap * sizeof(std::uint32_t), "huge-Gaussian records");
     }
@@ -583,6 +586,7 @@ class CudaRendererImpl final : public CudaRenderer {
     args.exp2_alpha = !baseline && options.exp2_alpha;
     args.sh_degree = std::max(0, std::min(device_scene_.sh_degree, options.sh_degree_cap));
     args.large_box_tiles = large_box_tiles_;
+    args.huge_box_tiles = huge_box_tiles_;
     args.chunk_cull = !baseline && (chunk_cull_ == kAlways || (chunk_cull_ == kAuto && n >= kChunkCullMinGaussians));
     if (args.chunk_cull) args.chunk_frame = cuda::chunk_cull_frame(cam, args.geometry, max_opacity_);
     // Fused emission runs the chunk test as a pass of its own and preprocess over the chunks
@@ -751,7 +755,9 @@ class CudaRendererImpl final : public CudaRenderer {
   int region_width_ = 8;
   std::size_t cub_sized_for_gaussians_ = ~std::size_t{0};  // sizes cub_temp_ was last checked for
   std::uint64_t cub_sized_for_pairs_ = 0;
+  static constexpr int kMaxBoxThreshold = 1 << 20;  // of the two below (a box beyond it: a 16K frame)
   int large_box_tiles_ = cuda::kLargeBoxTiles;
+  int huge_box_tiles_ = cuda::kHugeBoxTiles;
   // Chunk culling pays off in large scenes (the 3.5M tiled scene's project stage fell 9%, the
   // 100M one's 2.8x on an H200) and costs a test per 256 Gaussians that cannot pay off when
   // the whole of a small scene is in view (pc_biker's and pc_playbot's orbit views).

@@ -18,9 +18,11 @@ constexpr int kWarp = 32;
 // warp (FlashGS section 4.3): below it one thread's loop is shorter than the warp's
 // bookkeeping (PreprocessArgs::large_box_tiles; FLASHGS_LARGE_BOX_TILES overrides it).
 constexpr int kLargeBoxTiles = 32;
-// Boxes of more than this many tiles go to a list that a second kernel emits with a whole
-// block per Gaussian: one warp looping over 10^4 tiles would set the preprocess kernel's length.
-constexpr int kHugeBoxTiles = 1024;
+// By default, boxes of more than this many tiles (bins with macro bins) go to a list that a
+// second kernel emits with a whole block per Gaussian, its warps taking 32-bin chunks side by
+// side: a warp walking a box of several chunks alone sets the large-emission kernel's length
+// (PreprocessArgs::huge_box_tiles; FLASHGS_HUGE_BOX_TILES overrides it).
+constexpr int kHugeBoxTiles = 64;
 
 // Preprocess takes the Gaussians in chunks of this many (one block each) and skips the
 // projection of a chunk whose bounds lie outside the view (chunk_cull.cuh).
@@ -161,7 +163,7 @@ struct FrameBuffers {
   std::uint32_t* pair_counts = nullptr;   // [gaussians] pairs per Gaussian (separate path)
   std::uint32_t* pair_offsets = nullptr;  // [gaussians] inclusive prefix sum of pair_counts
   // Deferred by the fused kernel: boxes of more than large_box_tiles (a warp per Gaussian) and
-  // of more than kHugeBoxTiles tiles (a block per Gaussian).
+  // of more than huge_box_tiles (a block per Gaussian).
   DeferredList large;
   DeferredList huge;
   // Per pair: key (see KeyFormat; 32-bit keys use the front half, the tile part is a bin of
@@ -205,6 +207,7 @@ struct PreprocessArgs {
   bool exp2_alpha;
   int sh_degree;        // bands evaluated (the scene's, capped)
   int large_box_tiles;  // boxes of more tiles go to the warp-cooperative path
+  int huge_box_tiles;   // boxes of more tiles go to the block-per-Gaussian path
   bool chunk_cull;      // skip chunks outside the view (flash geometry only)
   ChunkCullFrame chunk_frame;
 };

@@ -401,7 +401,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   if (visible) {
     const BinBox bins(f, shift);
     const unsigned box = bins.count();
-    if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(kHugeBoxTiles)) {
+    if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(args.huge_box_tiles)) {
       const unsigned slot = atomicAdd(&buf.counters->huge, 1u);
       if (slot < buf.huge.capacity) {
         buf.huge.footprints[slot] = f;
