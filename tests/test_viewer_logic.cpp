@@ -496,6 +496,53 @@ TEST(ViewerSceneLoader, ABlockedLoadIsAbandonedWithoutWaiting) {
   EXPECT_EQ(fv::SceneLoader::running(), running_before) << "the abandoned threads did not end";
 }
 
+// Waits (up to 30 s) for `done()`, which may have effects: it is not called again once true.
+template <typename DONE>
+bool within_30s(DONE done) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (;;) {
+    if (done()) return true;
+    if (std::chrono::steady_clock::now() >= give_up) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+// --load-gate: a load waits, before its load function runs, until the gate file appears.
+TEST(ViewerSceneLoader, AClosedLoadGateHoldsTheLoadUntilTheFileAppears) {
+  const std::string gate = scratch_dir("load_gate") + "/gate";
+  auto ran = std::make_shared<std::atomic<bool>>(false);
+  fv::SceneLoader loader([ran](const std::string&, flashgs::LoadProgress&) {
+    *ran = true;
+    return fv::LoadedScene{};
+  });
+  loader.set_gate(gate);
+  ASSERT_TRUE(loader.start("gated.ply"));
+  EXPECT_TRUE(within_30s([&] { return loader.waiting_at_gate(); })) << "the load never waited at the closed gate";
+  fv::LoadedScene scene;
+  std::string error;
+  EXPECT_FALSE(loader.take(&scene, &error)) << "the load finished with the gate closed";
+  EXPECT_FALSE(*ran);
+  std::ofstream(gate).put('\n');
+  EXPECT_TRUE(within_30s([&] { return loader.take(&scene, &error); })) << "the load did not finish after the gate opened";
+  EXPECT_TRUE(*ran);
+  EXPECT_EQ(error, "");
+}
+
+// Cancelling a load that waits at the closed gate ends its thread (the gate never opens).
+TEST(ViewerSceneLoader, AnAbandonedLoadDoesNotWaitAtTheGate) {
+  const std::string gate = scratch_dir("load_gate_abandoned") + "/gate";
+  const int running_before = fv::SceneLoader::running();
+  {
+    fv::SceneLoader loader([](const std::string&, flashgs::LoadProgress&) { return fv::LoadedScene{}; });
+    loader.set_gate(gate);
+    ASSERT_TRUE(loader.start("gated.ply"));
+    EXPECT_TRUE(within_30s([&] { return loader.waiting_at_gate(); }));
+    loader.abandon();
+  }
+  EXPECT_TRUE(within_30s([&] { return fv::SceneLoader::running() == running_before; }))
+      << "the abandoned load still waits at the gate";
+}
+
 // Navigation as SIBR, SuperSplat and viser users expect it (issue 11).
 TEST(ViewerNavigation, FlyPanMovesAcrossTheViewAndKeepsTheDirection) {
   fv::ViewerSettings s;

@@ -1,13 +1,17 @@
-// FileGatedRenderer: a Renderer that holds each render until a file exists (--render-gate), so that a scripted test keeps a CPU frame, comparison or export frame in flight for exactly as long as it needs, on a fast machine as on a slow one.
+// File gates for scripted tests, so that a test keeps work in flight for exactly as long as it needs, on a fast machine as on a slow one: a Renderer that holds each render until a file exists (--render-gate), and the wait the scene loader uses to hold each load (--load-gate).
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <string>
 
 #include "flashgs/renderer.h"
 
 namespace flashgs::viewer {
+
+// Returns once `gate_file` exists or `stop()` is true; `waiting` is true while it waits.
+void wait_at_gate(const std::string& gate_file, const std::function<bool()>& stop, std::atomic<bool>& waiting);
 
 class FileGatedRenderer final : public Renderer {
  public:

@@ -7,6 +7,8 @@
 #include <new>
 #include <thread>
 
+#include "render_gate.h"
+
 namespace flashgs::viewer {
 namespace {
 
@@ -20,6 +22,7 @@ struct SceneLoader::Job {
   LoadedScene scene;
   std::string error;
   LoadProgress progress;  // written by the thread (atomics), read by the viewer
+  std::atomic<bool> waiting_at_gate{false};
 };
 
 SceneLoader::SceneLoader(LoadFunction load) : m_load(std::move(load)) {}
@@ -36,10 +39,12 @@ bool SceneLoader::start(const std::string& path, LoadFunction load) {
   try {
     // Detached: a thread blocked in open() cannot be interrupted, and the viewer must be able
     // to close anyway; the job outlives whichever side lets go of it first.
-    std::thread([job, load = std::move(load), path] {
+    std::thread([job, load = std::move(load), path, gate = m_gate_file] {
       LoadedScene scene;
       std::string error;
       try {
+        if (!gate.empty())
+          wait_at_gate(gate, [&job] { return job->progress.cancel_requested.load(); }, job->waiting_at_gate);
         scene = load(path, job->progress);
       } catch (const std::bad_alloc&) {
         error = path + ": out of memory while loading";
@@ -66,6 +71,8 @@ bool SceneLoader::start(const std::string& path, LoadFunction load) {
 }
 
 const LoadProgress* SceneLoader::progress() const { return m_job ? &m_job->progress : nullptr; }
+
+bool SceneLoader::waiting_at_gate() const { return m_job && m_job->waiting_at_gate; }
 
 double SceneLoader::elapsed_seconds() const {
   return m_job ? std::chrono::duration<double>(std::chrono::steady_clock::now() - m_started).count() : 0.0;

@@ -41,12 +41,18 @@ class SceneLoader {
   void abandon();
   // Loads of this process still running, abandoned ones included (exit must not wait for them).
   static int running();
+  // Each load started from now on waits, before it reads anything, until `gate_file` exists
+  // or it is abandoned (--load-gate: tests act while a load is surely in flight).
+  void set_gate(std::string gate_file) { m_gate_file = std::move(gate_file); }
+  // The running load waits at the closed gate now.
+  bool waiting_at_gate() const;
 
  private:
   struct Job;
   LoadFunction m_load;
   std::shared_ptr<Job> m_job;
   std::string m_path;
+  std::string m_gate_file;
   std::chrono::steady_clock::time_point m_started;
 };
 

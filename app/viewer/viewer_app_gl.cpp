@@ -1138,6 +1138,11 @@ LoadedScene load_start_scene(const ViewerArgs& args, LoadProgress* progress) {
 }  // namespace
 
 bool ViewerApp::start_first_scene() {
+  if (!m_args.load_gate.empty()) {
+    m_loader.set_gate(m_args.load_gate);
+    std::fprintf(stderr, "flashgs-viewer: each scene load beside the window waits for %s (--load-gate)\n",
+                 m_args.load_gate.c_str());
+  }
   if (!m_scripted) {
     // The window and panels come up at once; the scene loads beside them with its progress shown.
     m_first_load_pending = true;

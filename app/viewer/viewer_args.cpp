@@ -114,6 +114,9 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
                "log every frame in which a mouse button is held, and where the clickable widgets are (for tests that click through X)");
   app.add_option("--render-gate", a->render_gate,
                  "CPU path: each render waits until this file exists (for tests that act while a frame renders)");
+  app.add_option("--load-gate", a->load_gate,
+                 "each scene load beside the window waits until this file exists before it reads anything "
+                 "(for tests that act while a scene loads)");
   try {
     app.parse(argc, argv);
     if (!size.empty()) parse_size("--size", size, &a->window_width, &a->window_height);

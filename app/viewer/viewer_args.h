@@ -55,6 +55,7 @@ struct ViewerArgs {
   bool compare = false;          // run compare mode once on the last frame and print it
   bool log_input = false;        // log each frame a mouse button is held (tests driving it through X)
   std::string render_gate;       // CPU path: each render waits until this file exists (tests hold a frame in flight)
+  std::string load_gate;         // each background scene load waits until this file exists (tests hold a load in flight)
 
   bool scripted() const { return frames > 0 || !keys.empty() || path || !screenshot.empty() ||
                                   !window_screenshot.empty() || exit_after; }
