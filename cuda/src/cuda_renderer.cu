@@ -755,7 +755,7 @@ class CudaRendererImpl final : public CudaRenderer {
   int region_width_ = 8;
   std::size_t cub_sized_for_gaussians_ = ~std::size_t{0};  // sizes cub_temp_ was last checked for
   std::uint64_t cub_sized_for_pairs_ = 0;
-  static constexpr int kMaxBoxThreshold = 1 << 20;  // of the two below (a box beyond it: a 16K frame)
+  static constexpr int kMaxBoxThreshold = 1 << 20;  // the two below at most: a 16384x16384 frame's tiles
   int large_box_tiles_ = cuda::kLargeBoxTiles;
   int huge_box_tiles_ = cuda::kHugeBoxTiles;
   // Chunk culling pays off in large scenes (the 3.5M tiled scene's project stage fell 9%, the
