@@ -6,6 +6,7 @@
 #                                       cpu-simd-tests build-prev bench-cpu-prev
 #                                       profile-blend profile-sass
 #                                       build-bg wait-build build-prev-bg bench-prev-cuda
+# tools/device/make_deps.sh fills .deps (52 MB; with the tree, just under a call's 64 MiB):
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
 # cameras.json}, sysroot/usr with Debian's Highway (include/hwy, lib/x86_64-linux-gnu/{libhwy*.so*,
 # cmake/hwy}) and optionally bin/ + lib/ from tools/device/prebuild.sh: binaries built on the
