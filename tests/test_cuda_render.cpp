@@ -319,7 +319,7 @@ TEST(CudaDeterminism, SameFrameTwiceGivesTheSameBytes) {
 // goes to a warp, above FLASHGS_HUGE_BOX_TILES to a block (both in bins with macro bins). With
 // every box a block's (1), none a block's (2^20) and the earlier split (1024), every byte and
 // count equals the default split's, with bins and with tiles, at 1080p and 4K (pc_biker has
-// thousands of boxes of 33 to 1,000 bins, and some of the whole frame).
+// about a thousand boxes of 33 to 600 bins at 1080p, and at 4K some of the whole frame).
 TEST(CudaDeferredEmission, TheSplitBetweenWarpsAndBlocksChangesNoByte) {
   FLASHGS_REQUIRE_CUDA();
   FLASHGS_REQUIRE_SHARED_SCENES();
