@@ -315,31 +315,40 @@ TEST(CudaDeterminism, SameFrameTwiceGivesTheSameBytes) {
   }
 }
 
-// Which kernel emits a Gaussian's pairs only moves work: a box above FLASHGS_LARGE_BOX_TILES
-// goes to a warp, above FLASHGS_HUGE_BOX_TILES to a block (both in bins with macro bins). With
-// every box a block's (1), none a block's (2^20) and the earlier split (1024), every byte and
-// count equals the default split's, with bins and with tiles, at 1080p and 4K (pc_biker has
-// about a thousand boxes of 33 to 600 bins at 1080p, and at 4K some of the whole frame).
-TEST(CudaDeferredEmission, TheSplitBetweenWarpsAndBlocksChangesNoByte) {
+// Which kernel emits a Gaussian's pairs, and in how large pieces, only moves work: a box
+// above FLASHGS_LARGE_BOX_TILES (bins with macro bins) goes to warps after preprocess, in work
+// items of FLASHGS_DEFERRED_ITEM_CHUNKS 32-bin chunks. With every box deferred (1: more than
+// the list holds, so the preprocess kernel emits the rest itself), none (2^20), items of one
+// chunk and of 32, every byte and count equals the defaults', with bins and with tiles, at
+// 1080p and 4K (pc_biker has about a thousand boxes of 33 to 600 bins at 1080p, and at 4K
+// some of the whole frame).
+TEST(CudaDeferredEmission, WhereAndInWhatPiecesABoxIsEmittedChangesNoByte) {
   FLASHGS_REQUIRE_CUDA();
   FLASHGS_REQUIRE_SHARED_SCENES();
   RenderOptions tile_keys;
   tile_keys.macro_bins = false;
+  struct Split {
+    const char* large_box_tiles;
+    const char* item_chunks;
+  };
   for (const std::string& name : {std::string("pc_biker"), std::string("pc_playbot")}) {
     const auto scene = test::load_shared_scene(name);
     const std::vector<Camera> cameras = test::load_shared_cameras(name);
     auto standard = make_cuda_renderer();
     standard->set_scene(scene);
-    for (const char* huge : {"1", "1048576", "1024"}) {
-      setenv("FLASHGS_HUGE_BOX_TILES", huge, 1);
-      auto split = make_cuda_renderer();  // reads the variable once
-      unsetenv("FLASHGS_HUGE_BOX_TILES");
+    for (const Split& s : {Split{"1", "1"}, Split{"1048576", "4"}, Split{"32", "1"}, Split{"32", "32"}}) {
+      setenv("FLASHGS_LARGE_BOX_TILES", s.large_box_tiles, 1);
+      setenv("FLASHGS_DEFERRED_ITEM_CHUNKS", s.item_chunks, 1);
+      auto split = make_cuda_renderer();  // reads the variables once
+      unsetenv("FLASHGS_LARGE_BOX_TILES");
+      unsetenv("FLASHGS_DEFERRED_ITEM_CHUNKS");
       split->set_scene(scene);
       for (int index : {0, 10})
         for (const Camera& camera : {cameras[index].resized(1920, 1080), cameras[index].resized(3840, 2160)})
           for (const RenderOptions& o : {RenderOptions{}, tile_keys}) {
             const std::string what = name + " camera " + std::to_string(index) + " " + std::to_string(camera.width) +
-                                     "x" + std::to_string(camera.height) + " " + o.label() + ", blocks above " + huge;
+                                     "x" + std::to_string(camera.height) + " " + o.label() + ", deferred above " +
+                                     s.large_box_tiles + " in items of " + s.item_chunks;
             const Result a = render(*standard, camera, o);
             const Result b = render(*split, camera, o);
             expect_same_counts(what, a.stats, b.stats);

@@ -183,12 +183,12 @@ class CudaRendererImpl final : public CudaRenderer {
     stream_ = stream_handle_.get();
     // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
     if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
-    // And the box sizes (in tiles, bins with macro bins) above which a warp, or a block, emits
-    // a Gaussian's pairs.
+    // And the box size (in tiles, bins with macro bins) above which warps emit a Gaussian's
+    // pairs after preprocess, in work items of how many 32-bin chunks.
     if (const char* tiles = std::getenv("FLASHGS_LARGE_BOX_TILES"))
       large_box_tiles_ = std::max(1, std::min(kMaxBoxThreshold, std::atoi(tiles)));
-    if (const char* tiles = std::getenv("FLASHGS_HUGE_BOX_TILES"))
-      huge_box_tiles_ = std::max(1, std::min(kMaxBoxThreshold, std::atoi(tiles)));
+    if (const char* chunks = std::getenv("FLASHGS_DEFERRED_ITEM_CHUNKS"))
+      item_chunks_ = std::max(1, std::min(cuda::kWarp, std::atoi(chunks)));
     // FLASHGS_CHUNK_CULL=0 projects every Gaussian, =1 culls chunks in any scene (unset: scenes
     // of kChunkCullMinGaussians and more).
     if (const char* cull = std::getenv("FLASHGS_CHUNK_CULL")) chunk_cull_ = std::atoi(cull) != 0 ? kAlways : kNever;
@@ -337,7 +337,7 @@ class CudaRendererImpl final : public CudaRenderer {
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &record_ids_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
             &values_[1], &ranges_, &tile_lists_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
-            &large_footprints_, &large_records_, &huge_footprints_, &huge_records_};
+            &deferred_footprints_, &deferred_records_, &deferred_hits_, &deferred_items_};
   }
 
   // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
@@ -375,12 +375,16 @@ class CudaRendererImpl final : public CudaRenderer {
     return std::sqrt(d2);
   }
 
-  static cuda::DeferredList deferred_list(const DeviceBuffer& footprints, const DeviceBuffer& records) {
+  cuda::DeferredList deferred_list() const {
     cuda::DeferredList list;
-    list.footprints = footprints.as<gm::Footprint>();
-    list.records = records.as<std::uint32_t>();
-    list.capacity = static_cast<std::uint32_t>(
-        std::min(footprints.bytes() / sizeof(gm::Footprint), records.bytes() / sizeof(std::uint32_t)));
+    list.footprints = deferred_footprints_.as<gm::Footprint>();
+    list.records = deferred_records_.as<std::uint32_t>();
+    list.hits = deferred_hits_.as<std::uint32_t>();
+    list.items = deferred_items_.as<uint2>();
+    list.capacity = static_cast<std::uint32_t>(std::min({deferred_footprints_.bytes() / sizeof(gm::Footprint),
+                                                         deferred_records_.bytes() / sizeof(std::uint32_t),
+                                                         deferred_hits_.bytes() / sizeof(std::uint32_t)}));
+    list.item_capacity = static_cast<std::uint32_t>(deferred_items_.bytes() / sizeof(uint2));
     return list;
   }
 
@@ -417,8 +421,7 @@ class CudaRendererImpl final : public CudaRenderer {
       b.values[k] = values_[k].as<std::uint32_t>();
     }
     b.pair_capacity = pair_capacity_;
-    b.large = deferred_list(large_footprints_, large_records_);
-    b.huge = deferred_list(huge_footprints_, huge_records_);
+    b.deferred = deferred_list();
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
     for (int k = 0; k < 2; ++k) b.tile_values[k] = keys_[k].as<std::uint32_t>();
@@ -561,15 +564,14 @@ class CudaRendererImpl final : public CudaRenderer {
     if (fused) grow_records(std::min<std::uint64_t>(n, initial_records_), false);
     else blend_.reserve(std::max<std::size_t>(n, 1) * sizeof(cuda::BlendGaussian), "per-Gaussian blend data");
     if (fused && !baseline && options.warp_cooperative_emit) {
-      // Lists of deferred Gaussians, sized to the projected ones; a frame with more emits the
-      // rest in the preprocess kernel.
+      // The list of deferred Gaussians, sized to the projected ones, and two work items each
+      // (most boxes are one); a frame with more emits the rest in the preprocess kernel.
       const std::size_t projected = record_capacity();
-      const std::size_t large_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 8192 + projected / 8);
-      large_footprints_.reserve(large_cap * sizeof(gm::Footprint), "large-Gaussian footprints");
-      large_records_.reserve(large_cap * sizeof(std::uint32_t), "large-Gaussian records");
-      const std::size_t huge_cap = std::min<std::size_t>(std::max<std::size_t>(n, 1), 4096 + projected / 16);
-      huge_footprints_.reserve(huge_cap * sizeof(gm::Footprint), "huge-Gaussian footprints");
-      huge_records_.reserve(huge_cap * sizeof(std::uint32_t), "huge-Gaussian records");
+      const std::size_t deferred = std::min<std::size_t>(std::max<std::size_t>(n, 1), 12288 + projected * 3 / 16);
+      deferred_footprints_.reserve(deferred * sizeof(gm::Footprint), "deferred-Gaussian footprints");
+      deferred_records_.reserve(deferred * sizeof(std::uint32_t), "deferred-Gaussian records");
+      deferred_hits_.reserve(deferred * sizeof(std::uint32_t), "deferred-Gaussian hits");
+      deferred_items_.reserve(2 * deferred * sizeof(uint2), "deferred work items");
     }
     if (!fused) {
       footprints_.reserve(std::max<std::size_t>(n, 1) * sizeof(gm::Footprint), "per-Gaussian footprints");
@@ -586,7 +588,7 @@ class CudaRendererImpl final : public CudaRenderer {
     args.exp2_alpha = !baseline && options.exp2_alpha;
     args.sh_degree = std::max(0, std::min(device_scene_.sh_degree, options.sh_degree_cap));
     args.large_box_tiles = large_box_tiles_;
-    args.huge_box_tiles = huge_box_tiles_;
+    args.item_chunks = item_chunks_;
     args.chunk_cull = !baseline && (chunk_cull_ == kAlways || (chunk_cull_ == kAuto && n >= kChunkCullMinGaussians));
     if (args.chunk_cull) args.chunk_frame = cuda::chunk_cull_frame(cam, args.geometry, max_opacity_);
     // Fused emission runs the chunk test as a pass of its own and preprocess over the chunks
@@ -755,9 +757,9 @@ class CudaRendererImpl final : public CudaRenderer {
   int region_width_ = 8;
   std::size_t cub_sized_for_gaussians_ = ~std::size_t{0};  // sizes cub_temp_ was last checked for
   std::uint64_t cub_sized_for_pairs_ = 0;
-  static constexpr int kMaxBoxThreshold = 1 << 20;  // the two below at most: a 16384x16384 frame's tiles
+  static constexpr int kMaxBoxThreshold = 1 << 20;  // large_box_tiles_ at most: a 16384x16384 frame's tiles
   int large_box_tiles_ = cuda::kLargeBoxTiles;
-  int huge_box_tiles_ = cuda::kHugeBoxTiles;
+  int item_chunks_ = cuda::kDeferredItemChunks;
   // Chunk culling pays off in large scenes (the 3.5M tiled scene's project stage fell 9%, the
   // 100M one's 2.8x on an H200) and costs a test per 256 Gaussians that cannot pay off when
   // the whole of a small scene is in view (pc_biker's and pc_playbot's orbit views).
@@ -781,7 +783,7 @@ class CudaRendererImpl final : public CudaRenderer {
   // Working memory.
   DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_,
       dense_bins_, tile_order_, tile_places_, chunk_list_, image_,
-      cub_temp_, large_footprints_, large_records_, huge_footprints_, huge_records_;
+      cub_temp_, deferred_footprints_, deferred_records_, deferred_hits_, deferred_items_;
 };
 
 }  // namespace

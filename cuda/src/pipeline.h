@@ -18,11 +18,10 @@ constexpr int kWarp = 32;
 // warp (FlashGS section 4.3): below it one thread's loop is shorter than the warp's
 // bookkeeping (PreprocessArgs::large_box_tiles; FLASHGS_LARGE_BOX_TILES overrides it).
 constexpr int kLargeBoxTiles = 32;
-// By default, boxes of more than this many tiles (bins with macro bins) go to a list that a
-// second kernel emits with a whole block per Gaussian, its warps taking 32-bin chunks side by
-// side: a warp walking a box of several chunks alone sets the large-emission kernel's length
-// (PreprocessArgs::huge_box_tiles; FLASHGS_HUGE_BOX_TILES overrides it).
-constexpr int kHugeBoxTiles = 64;
+// A deferred box is emitted in work items of up to this many 32-bin chunks, a warp each, so
+// that a box of the whole frame is spread over many warps instead of setting the kernel's
+// length (PreprocessArgs::item_chunks; FLASHGS_DEFERRED_ITEM_CHUNKS overrides it, 1 to 32).
+constexpr int kDeferredItemChunks = 4;
 
 // Preprocess takes the Gaussians in chunks of this many (one block each) and skips the
 // projection of a chunk whose bounds lie outside the view (chunk_cull.cuh).
@@ -131,8 +130,8 @@ struct FrameCounters {
   unsigned int by_reason[gm::kCullReasonCount];
   unsigned int max_tile_pairs;     // pairs of the fullest tile (launch_tile_stats, after the blend)
   unsigned long long tile_pairs;   // Gaussian-tile pairs (launch_tile_stats; `pairs` counts bins)
-  unsigned int large;             // Gaussians deferred to the large-emission kernel
-  unsigned int huge;              // Gaussians deferred to the huge-emission kernel
+  unsigned int deferred;           // Gaussians deferred to deferred_emit_kernel (may exceed capacity)
+  unsigned long long deferred_items;  // their work items (may exceed item_capacity)
   unsigned long long chunk_culled; // Gaussians of chunks outside the view (classified, not projected)
   unsigned int listed_chunks;      // chunks the chunk cull left to preprocess (launch_chunk_list)
   unsigned int tiles_by_class[kTileClasses];  // tiles per pair-count class (launch_tile_order)
@@ -141,12 +140,18 @@ struct FrameCounters {
 };
 
 // Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
-// tile loops are spread over the whole GPU instead of holding the warp that met them.
+// tile loops are spread over the whole GPU instead of holding the warp that met them. Each
+// box is cut into work items of up to PreprocessArgs::item_chunks chunks of 32 bins, which
+// name their entry, so a warp's entries and items are reserved by an atomic each.
 struct DeferredList {
   gm::Footprint* footprints = nullptr;  // [capacity]
   std::uint32_t* records = nullptr;     // [capacity] blend record (the pairs' value)
-  std::uint32_t capacity = 0;           // beyond it, the preprocess kernel emits them itself
+  std::uint32_t* hits = nullptr;        // [capacity] 1 once one of the entry's items emitted a pair
+  uint2* items = nullptr;               // [item_capacity] entry, first chunk (kNoDeferredEntry: none)
+  std::uint32_t capacity = 0;           // beyond either capacity, the preprocess kernel emits a box itself
+  std::uint32_t item_capacity = 0;
 };
+constexpr std::uint32_t kNoDeferredEntry = 0xffffffffu;  // an item reserved for a box that did not fit
 
 // Buffers of the frame pipeline; every size is a high-water mark (grown, never shrunk).
 struct FrameBuffers {
@@ -162,10 +167,8 @@ struct FrameBuffers {
   gm::Footprint* footprints = nullptr;    // [gaussians]
   std::uint32_t* pair_counts = nullptr;   // [gaussians] pairs per Gaussian (separate path)
   std::uint32_t* pair_offsets = nullptr;  // [gaussians] inclusive prefix sum of pair_counts
-  // Deferred by the fused kernel: boxes of more than large_box_tiles (a warp per Gaussian) and
-  // of more than huge_box_tiles (a block per Gaussian).
-  DeferredList large;
-  DeferredList huge;
+  // Deferred by the fused kernel: boxes of more than large_box_tiles.
+  DeferredList deferred;
   // Per pair: key (see KeyFormat; 32-bit keys use the front half, the tile part is a bin of
   // `bins`), value = blend record (and tile bits, see BinGrid); two of each for the sort.
   BinGrid bins;
@@ -207,7 +210,7 @@ struct PreprocessArgs {
   bool exp2_alpha;
   int sh_degree;        // bands evaluated (the scene's, capped)
   int large_box_tiles;  // boxes of more tiles go to the warp-cooperative path
-  int huge_box_tiles;   // boxes of more tiles go to the block-per-Gaussian path
+  int item_chunks;      // 32-bin chunks per work item of a deferred box (1 to 32)
   bool chunk_cull;      // skip chunks outside the view (flash geometry only)
   ChunkCullFrame chunk_frame;
 };

@@ -6,8 +6,6 @@
 
 #include <cuda_fp16.h>
 
-#include <cub/block/block_scan.cuh>
-
 #include "bins.cuh"
 #include "chunk_cull.cuh"
 #include "device_common.cuh"
@@ -19,7 +17,7 @@ namespace cuda {
 namespace {
 
 constexpr int kBlock = 256;
-// Blocks of the deferred-emission kernels: enough to fill an H100 several times; the ones past
+// Blocks of the deferred-emission kernel: enough to fill an H100 several times; the ones past
 // the frame's deferred count return at once.
 constexpr unsigned kDeferredEmitBlocks = 1024;
 constexpr float kLog2e = 1.4426950408889634f;
@@ -74,7 +72,8 @@ __device__ __forceinline__ gm::Footprint shfl_footprint(const gm::Footprint& f, 
 }
 
 // A segment of up to 32 chunks of 32 bins of a box (bins counted row-major from the box's
-// first), walked by a warp: lane j handles bin s0 + 32 c + j of chunk c. The bin's column
+// first), walked by a warp: lane j handles bin s0 + 32 c + j of chunk c. A segment stops at
+// the box's end or after `max_chunks` chunks. The bin's column
 // and row advance by a fixed step per chunk, so only the first costs integer divisions.
 struct BoxWalk {
   BinBox bins;
@@ -91,7 +90,9 @@ struct BoxWalk {
     return static_cast<unsigned>(bins.y0 + static_cast<int>(y)) * static_cast<unsigned>(grid.x) +
            static_cast<unsigned>(bins.x0 + static_cast<int>(x));
   }
-  __device__ unsigned chunks(unsigned s0) const { return min(static_cast<unsigned>(kWarp), (box - s0 + kWarp - 1) / kWarp); }
+  __device__ unsigned chunks(unsigned s0, unsigned max_chunks) const {
+    return min(max_chunks, (box - s0 + kWarp - 1) / kWarp);
+  }
   // Column and row (in the box) of bin s0 + lane.
   __device__ void start(unsigned s0, unsigned lane, unsigned& x, unsigned& y) const {
     const unsigned t = s0 + lane;
@@ -117,10 +118,10 @@ __device__ __forceinline__ unsigned walk_bin_tiles(const gm::Footprint& g, const
 
 // Tests the segment at s0 (all lanes call with the same footprint); lane c returns chunk c's
 // ballot of passing bins.
-__device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
+__device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& walk, unsigned s0, unsigned max_chunks,
                                       const gm::CameraParams& cam, bool exact, int shift) {
   const unsigned lane = lane_id();
-  const unsigned chunks = walk.chunks(s0);
+  const unsigned chunks = walk.chunks(s0, max_chunks);
   unsigned x, y;
   walk.start(s0, lane, x, y);
   unsigned my_ballot = 0;
@@ -137,11 +138,11 @@ __device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& wal
 // bins larger than a tile, a passing bin's tiles are tested again for its value (the test
 // kept no more than a bit per bin).
 __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
-                                   unsigned my_ballot, unsigned long long my_base, std::uint32_t depth_bits,
-                                   unsigned record, const gm::CameraParams& cam, bool exact) {
+                                   unsigned max_chunks, unsigned my_ballot, unsigned long long my_base,
+                                   std::uint32_t depth_bits, unsigned record, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
   const unsigned lanes_below = (1u << lane) - 1u;
-  const unsigned chunks = walk.chunks(s0);
+  const unsigned chunks = walk.chunks(s0, max_chunks);
   unsigned x, y;
   walk.start(s0, lane, x, y);
   for (unsigned c = 0; c < chunks; ++c) {
@@ -164,7 +165,7 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
   const BoxWalk walk(g, buf.bins.shift);
   unsigned total = 0;
   for (unsigned s0 = 0; s0 < walk.box; s0 += kWarp * kWarp) {
-    const unsigned my_ballot = warp_test_segment(g, walk, s0, cam, exact, buf.bins.shift);
+    const unsigned my_ballot = warp_test_segment(g, walk, s0, kWarp, cam, exact, buf.bins.shift);
     const unsigned my_count = __popc(my_ballot);
     const unsigned inclusive = warp_inclusive_sum(my_count);
     const unsigned segment_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -172,7 +173,7 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
     unsigned long long base = 0;
     if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
     base = __shfl_sync(kFullMask, base, 0) + (inclusive - my_count);  // lane c: chunk c's offset
-    warp_write_segment(buf, g, walk, s0, my_ballot, base, depth_bits, record, cam, exact);
+    warp_write_segment(buf, g, walk, s0, kWarp, my_ballot, base, depth_bits, record, cam, exact);
     total += segment_total;
   }
   return total;
@@ -343,8 +344,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   int reason = gm::kCulledDegenerate;
   unsigned count = 0;          // pairs of this Gaussian (small path / separate path)
   unsigned passed_mask = 0;    // bins of a box of <= 32 bins that passed the exact test
-  bool large = false;          // emitted by a whole warp (large_emit_kernel, or below)
-  bool deferred = false;       // emitted and counted by large_emit_kernel or huge_emit_kernel
+  bool large = false;          // emitted by a whole warp (deferred_emit_kernel, or below)
   // The flash path: boxes of at most large_box_tiles <= 32 tiles tested by the whole warp.
   const bool balanced = FUSED && args.warp_cooperative && args.exact_tile_test && args.large_box_tiles <= kWarp;
   const int shift = buf.bins.shift;
@@ -401,16 +401,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   if (visible) {
     const BinBox bins(f, shift);
     const unsigned box = bins.count();
-    if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(args.huge_box_tiles)) {
-      const unsigned slot = atomicAdd(&buf.counters->huge, 1u);
-      if (slot < buf.huge.capacity) {
-        buf.huge.footprints[slot] = f;
-        buf.huge.records[slot] = record;
-        deferred = true;
-      } else {
-        large = true;
-      }
-    } else if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(args.large_box_tiles)) {
+    if (FUSED && args.warp_cooperative && box > static_cast<unsigned>(args.large_box_tiles)) {
       large = true;
     } else if (!args.exact_tile_test) {
       count = box;
@@ -459,21 +450,38 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
           }
       }
     }
-    // Large Gaussians: the warp tests 32 tiles at a time (FlashGS section 4.3). Lane c keeps
-    // chunk c's ballot, so a segment of up to 32 chunks is reserved with one atomic and then
-    // written without testing again: a serial atomic per chunk made this loop latency-bound.
+    // Large Gaussians: the warp tests 32 tiles at a time (FlashGS section 4.3), in
+    // deferred_emit_kernel, which takes their boxes in work items: one atomic per warp reserves
+    // its entries, one its items.
     const unsigned large_ballot = __ballot_sync(kFullMask, large);
-    if (large_ballot) {  // to large_emit_kernel, one atomic per warp
+    if (large_ballot) {
+      const unsigned chunks = large ? (BinBox(f, shift).count() + kWarp - 1) / kWarp : 0u;
+      const unsigned my_items = (chunks + args.item_chunks - 1) / args.item_chunks;
+      const unsigned items_inclusive = warp_inclusive_sum(my_items);
+      const unsigned warp_items = __shfl_sync(kFullMask, items_inclusive, kWarp - 1);
       const int leader = __ffs(large_ballot) - 1;
-      unsigned base = 0;
-      if (static_cast<int>(lane) == leader) base = atomicAdd(&buf.counters->large, __popc(large_ballot));
-      base = __shfl_sync(kFullMask, base, leader);
-      const unsigned slot = base + __popc(large_ballot & ((1u << lane) - 1u));
-      if (large && slot < buf.large.capacity) {
-        buf.large.footprints[slot] = f;
-        buf.large.records[slot] = record;
-        large = false;
-        deferred = true;
+      unsigned entry_base = 0;
+      unsigned long long item_base = 0;
+      if (static_cast<int>(lane) == leader) {
+        entry_base = atomicAdd(&buf.counters->deferred, __popc(large_ballot));
+        item_base = atomicAdd(&buf.counters->deferred_items, static_cast<unsigned long long>(warp_items));
+      }
+      entry_base = __shfl_sync(kFullMask, entry_base, leader);
+      item_base = __shfl_sync(kFullMask, item_base, leader);
+      if (large) {
+        const DeferredList& list = buf.deferred;
+        const unsigned entry = entry_base + __popc(large_ballot & ((1u << lane) - 1u));
+        const unsigned long long first_item = item_base + items_inclusive - my_items;
+        const bool fits = entry < list.capacity && first_item + my_items <= list.item_capacity;
+        if (fits) {
+          list.footprints[entry] = f;
+          list.records[entry] = record;
+          list.hits[entry] = 0;
+          large = false;  // counted as off screen below until one of its items emits a pair
+        }
+        // Every item reserved within the capacity is written, so the kernel reads no stale one.
+        for (unsigned j = 0; j < my_items && first_item + j < list.item_capacity; ++j)
+          list.items[first_item + j] = make_uint2(fits ? entry : kNoDeferredEntry, j * args.item_chunks);
       }
     }
     unsigned pending = __ballot_sync(kFullMask, large);  // the list was full: emitted here
@@ -495,8 +503,9 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     if (lane == 0 && warp_total > 0) atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(warp_total));
   }
 
-  if (valid && !deferred) {
-    // A box that met the image around an ellipse that met no tile counts as off screen.
+  if (valid) {
+    // A box that met the image around an ellipse that met no tile counts as off screen, and so
+    // does a deferred one until deferred_emit_kernel finds a tile it touches.
     const int slot = reason == gm::kVisible && count == 0 ? gm::kCulledOffscreen : reason;
     atomicAdd(&block_counts[slot], 1u);
   }
@@ -541,131 +550,56 @@ __global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, F
   preprocess_chunk<DEGREE, FUSED>(scene, buf, args, blockIdx.x, chunk);
 }
 
-// The deferred large Gaussians: a warp per Gaussian, spread over every warp of the grid. A
-// warp tests up to kLargeBatch of its Gaussians before it reserves all their pairs with one
-// atomic: a wait on the contended pair counter for each Gaussian held the kernel back. Boxes
-// of more than one segment (huge ones the huge list had no room for) go through
-// warp_emit_box on their own.
-constexpr int kLargeBatch = 4;
-__global__ void __launch_bounds__(kBlock) large_emit_kernel(FrameBuffers buf, gm::CameraParams cam, bool exact) {
-  const unsigned count = min(buf.counters->large, buf.large.capacity);
+// The deferred Gaussians' work items: a warp per item, spread over every warp of the grid. A
+// warp tests up to kItemBatch items before it reserves all their pairs with one atomic: a
+// wait on the contended pair counter for each item held the kernel back. The first item of
+// an entry to emit a pair moves its Gaussian from off screen (preprocess's count) to visible.
+constexpr int kItemBatch = 4;
+__global__ void __launch_bounds__(kBlock) deferred_emit_kernel(FrameBuffers buf, gm::CameraParams cam, bool exact,
+                                                               unsigned item_chunks) {
+  const DeferredList& list = buf.deferred;
+  const unsigned count =
+      static_cast<unsigned>(min(buf.counters->deferred_items, static_cast<unsigned long long>(list.item_capacity)));
   constexpr unsigned kWarps = kBlock / kWarp;
   const unsigned lane = lane_id();
   const unsigned stride = gridDim.x * kWarps;
-  unsigned visible = 0, offscreen = 0;
-  for (unsigned k0 = blockIdx.x * kWarps + threadIdx.x / kWarp; k0 < count; k0 += kLargeBatch * stride) {
-    unsigned my_ballot[kLargeBatch], my_offset[kLargeBatch];  // lane c: chunk c's ballot, offset in the batch
+  const int shift = buf.bins.shift;
+  unsigned newly_visible = 0;
+  for (unsigned k0 = blockIdx.x * kWarps + threadIdx.x / kWarp; k0 < count; k0 += kItemBatch * stride) {
+    uint2 items[kItemBatch];
+    unsigned my_ballot[kItemBatch], my_offset[kItemBatch];  // lane c: chunk c's ballot, offset in the batch
     unsigned batch_total = 0;
 #pragma unroll
-    for (int j = 0; j < kLargeBatch; ++j) {
+    for (int j = 0; j < kItemBatch; ++j) {
       const unsigned k = k0 + j * stride;
+      items[j] = k < count ? list.items[k] : make_uint2(kNoDeferredEntry, 0);
       my_ballot[j] = 0;
-      unsigned emitted = 0;  // by warp_emit_box, for a box of several segments
-      if (k < count) {
-        const gm::Footprint f = buf.large.footprints[k];
-        const BoxWalk walk(f, buf.bins.shift);
-        if (walk.box <= kWarp * kWarp) my_ballot[j] = warp_test_segment(f, walk, 0, cam, exact, buf.bins.shift);
-        else emitted = warp_emit_box(buf, f, sort_depth(buf.key_format, f.depth), buf.large.records[k], cam, exact);
+      if (items[j].x != kNoDeferredEntry) {
+        const gm::Footprint f = list.footprints[items[j].x];
+        my_ballot[j] = warp_test_segment(f, BoxWalk(f, shift), items[j].y * kWarp, item_chunks, cam, exact, shift);
       }
       const unsigned my_count = __popc(my_ballot[j]);
       const unsigned inclusive = warp_inclusive_sum(my_count);
       my_offset[j] = batch_total + inclusive - my_count;
-      const unsigned total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
-      batch_total += total;
-      if (k < count) {
-        if (total + emitted > 0) ++visible;
-        else ++offscreen;
-      }
+      batch_total += __shfl_sync(kFullMask, inclusive, kWarp - 1);
     }
     if (batch_total == 0) continue;
     unsigned long long base = 0;
     if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(batch_total));
     base = __shfl_sync(kFullMask, base, 0);
 #pragma unroll
-    for (int j = 0; j < kLargeBatch; ++j) {
-      const unsigned k = k0 + j * stride;
-      if (k >= count) break;
-      if (!__any_sync(kFullMask, my_ballot[j] != 0)) continue;  // nothing passed (or emitted already)
-      const gm::Footprint f = buf.large.footprints[k];
-      warp_write_segment(buf, f, BoxWalk(f, buf.bins.shift), 0, my_ballot[j], base + my_offset[j],
-                         sort_depth(buf.key_format, f.depth), buf.large.records[k], cam, exact);
+    for (int j = 0; j < kItemBatch; ++j) {
+      if (!__any_sync(kFullMask, my_ballot[j] != 0)) continue;  // nothing passed, or no item
+      const unsigned entry = items[j].x;
+      const gm::Footprint f = list.footprints[entry];
+      warp_write_segment(buf, f, BoxWalk(f, shift), items[j].y * kWarp, item_chunks, my_ballot[j],
+                         base + my_offset[j], sort_depth(buf.key_format, f.depth), list.records[entry], cam, exact);
+      if (lane == 0 && atomicExch(&list.hits[entry], 1u) == 0) ++newly_visible;
     }
   }
-  if (lane == 0) {
-    if (visible) atomicAdd(&buf.counters->by_reason[gm::kVisible], visible);
-    if (offscreen) atomicAdd(&buf.counters->by_reason[gm::kCulledOffscreen], offscreen);
-  }
-}
-
-// The deferred huge Gaussians: a block per Gaussian. Its warps test 32-tile chunks and keep
-// the ballots in shared memory; a block scan gives each chunk its offset, so a segment of up
-// to kSegmentChunks chunks costs one atomic. Visibility is decided from the block's total.
-constexpr int kSegmentChunks = 1024;                // 32768 tiles: a whole 4K frame in one
-constexpr int kChunksPerThread = kSegmentChunks / kBlock;
-__global__ void __launch_bounds__(kBlock) huge_emit_kernel(FrameBuffers buf, gm::CameraParams cam, bool exact) {
-  using BlockScan = cub::BlockScan<unsigned, kBlock>;
-  __shared__ typename BlockScan::TempStorage scan_storage;
-  __shared__ unsigned ballots[kSegmentChunks];
-  __shared__ unsigned chunk_offsets[kSegmentChunks];
-  __shared__ unsigned long long segment_base;
-  const unsigned count = min(buf.counters->huge, buf.huge.capacity);
-  const unsigned lane = lane_id(), warp = threadIdx.x / kWarp;
-  constexpr unsigned kWarps = kBlock / kWarp;
-  const unsigned lanes_below = (1u << lane) - 1u;
-  for (unsigned h = blockIdx.x; h < count; h += gridDim.x) {
-    const gm::Footprint f = buf.huge.footprints[h];
-    const unsigned record = buf.huge.records[h];
-    const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
-    const int shift = buf.bins.shift;
-    const BinBox bins(f, shift);
-    const unsigned box_w = static_cast<unsigned>(bins.width());
-    const unsigned box = bins.count();
-    unsigned gaussian_total = 0;
-    for (unsigned s0 = 0; s0 < box; s0 += kSegmentChunks * kWarp) {
-      const unsigned chunks = min(static_cast<unsigned>(kSegmentChunks), (box - s0 + kWarp - 1) / kWarp);
-      for (unsigned c = warp; c < chunks; c += kWarps) {
-        const unsigned t = s0 + c * kWarp + lane;
-        const bool pass = t < box && footprint_bin_tiles(f, shift, bins.x0 + static_cast<int>(t % box_w),
-                                                         bins.y0 + static_cast<int>(t / box_w), cam, exact) != 0;
-        const unsigned ballot = __ballot_sync(kFullMask, pass);
-        if (lane == 0) ballots[c] = ballot;
-      }
-      __syncthreads();
-      unsigned counts[kChunksPerThread], sum = 0;
-#pragma unroll
-      for (int k = 0; k < kChunksPerThread; ++k) {
-        const unsigned c = threadIdx.x * kChunksPerThread + k;
-        counts[k] = c < chunks ? __popc(ballots[c]) : 0u;
-        sum += counts[k];
-      }
-      unsigned offset = 0, segment_total = 0;
-      BlockScan(scan_storage).ExclusiveSum(sum, offset, segment_total);
-#pragma unroll
-      for (int k = 0; k < kChunksPerThread; ++k) {
-        const unsigned c = threadIdx.x * kChunksPerThread + k;
-        if (c < chunks) chunk_offsets[c] = offset;
-        offset += counts[k];
-      }
-      if (threadIdx.x == 0 && segment_total > 0)
-        segment_base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
-      __syncthreads();
-      if (segment_total > 0) {
-        for (unsigned c = warp; c < chunks; c += kWarps) {
-          const unsigned ballot = ballots[c];
-          if (ballot & (1u << lane)) {
-            const unsigned t = s0 + c * kWarp + lane;
-            const int bx = bins.x0 + static_cast<int>(t % box_w), by = bins.y0 + static_cast<int>(t / box_w);
-            const unsigned tiles = shift ? footprint_bin_tiles(f, shift, bx, by, cam, exact) : 1u;
-            store_pair(buf, segment_base + chunk_offsets[c] + __popc(ballot & lanes_below),
-                       static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits, pair_value(buf.bins, record, tiles));
-          }
-        }
-      }
-      gaussian_total += segment_total;
-      __syncthreads();  // the shared arrays are reused by the next segment or Gaussian
-    }
-    if (threadIdx.x == 0)
-      atomicAdd(&buf.counters->by_reason[gaussian_total > 0 ? gm::kVisible : gm::kCulledOffscreen], 1u);
+  if (lane == 0 && newly_visible) {
+    atomicAdd(&buf.counters->by_reason[gm::kVisible], newly_visible);
+    atomicSub(&buf.counters->by_reason[gm::kCulledOffscreen], newly_visible);
   }
 }
 
@@ -702,10 +636,9 @@ void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, co
   if (fused) {
     if (buffers.chunk_list) launch_chunk_list(scene, buffers, args, stream);
     launch_for_degree<true>(scene, buffers, args, stream);
-    if (args.warp_cooperative && buffers.large.capacity > 0)
-      large_emit_kernel<<<kDeferredEmitBlocks, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test);
-    if (args.warp_cooperative && buffers.huge.capacity > 0)
-      huge_emit_kernel<<<kDeferredEmitBlocks, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test);
+    if (args.warp_cooperative && buffers.deferred.capacity > 0 && buffers.deferred.item_capacity > 0)
+      deferred_emit_kernel<<<kDeferredEmitBlocks, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test,
+                                                                        static_cast<unsigned>(args.item_chunks));
   } else {
     launch_for_degree<false>(scene, buffers, args, stream);
   }
