@@ -359,6 +359,52 @@ TEST(CudaDeferredEmission, WhereAndInWhatPiecesABoxIsEmittedChangesNoByte) {
   }
 }
 
+// The per-bin sort of binned frames (launch_bin_sort; FLASHGS_BIN_SORT=1 on every frame)
+// gives the blend the order of CUB's radix sort over the whole frame (=0) to the pair, whether a bin is sorted in
+// shared memory or in global memory (FLASHGS_BIN_SORT_SHARED_PAIRS=0: every bin; 64: most of
+// them), and with 16-bit keys, whose runs of equal depth bins the bin sort puts in order itself.
+// 8K frames have more bins than the shared-memory histogram holds (kHistogramBins) and count
+// and scatter with global atomics instead.
+TEST(CudaBinSort, SortsEachBinAsTheWholeFrameSortDoes) {
+  FLASHGS_REQUIRE_CUDA();
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  struct Setting {
+    const char* shared_pairs;
+    const char* key_bits;
+  };
+  for (const std::string& name : {std::string("pc_biker"), std::string("pc_playbot")}) {
+    const auto scene = test::load_shared_scene(name);
+    const std::vector<Camera> cameras = test::load_shared_cameras(name);
+    setenv("FLASHGS_BIN_SORT", "0", 1);
+    auto whole_frame = make_cuda_renderer();  // reads the variables once
+    unsetenv("FLASHGS_BIN_SORT");
+    whole_frame->set_scene(scene);
+    for (const Setting& s : {Setting{"", ""}, Setting{"0", ""}, Setting{"64", ""}, Setting{"", "16"}, Setting{"0", "16"}}) {
+      setenv("FLASHGS_BIN_SORT", "1", 1);  // every frame, whether it pays or not
+      if (*s.shared_pairs) setenv("FLASHGS_BIN_SORT_SHARED_PAIRS", s.shared_pairs, 1);
+      if (*s.key_bits) setenv("FLASHGS_SORT_KEY_BITS", s.key_bits, 1);
+      auto per_bin = make_cuda_renderer();
+      unsetenv("FLASHGS_BIN_SORT");
+      unsetenv("FLASHGS_BIN_SORT_SHARED_PAIRS");
+      unsetenv("FLASHGS_SORT_KEY_BITS");
+      per_bin->set_scene(scene);
+      for (int index : {0, 10})
+        for (const Camera& camera : {cameras[index].resized(1920, 1080), cameras[index].resized(3840, 2160),
+                                     cameras[index].resized(333, 187), cameras[index].resized(7680, 4320)}) {
+          const std::string what = name + " camera " + std::to_string(index) + " " + std::to_string(camera.width) +
+                                   "x" + std::to_string(camera.height) + ", shared pairs '" + s.shared_pairs +
+                                   "', key bits '" + s.key_bits + "'";
+          const Result a = render(*whole_frame, camera, RenderOptions{});
+          const Result b = render(*per_bin, camera, RenderOptions{});
+          expect_same_counts(what, a.stats, b.stats);
+          EXPECT_EQ(a.stats.sorted_pairs, b.stats.sorted_pairs) << what;
+          EXPECT_EQ(a.stats.max_tile_pairs, b.stats.max_tile_pairs) << what;
+          EXPECT_TRUE(a.image.rgb == b.image.rgb) << what;
+        }
+    }
+  }
+}
+
 // The compact keys (tile + a depth bin, ties put in order by the ranges pass) must give the
 // blend exactly the order of the 64-bit keys (tile + the depth's float bits): same kernels on
 // the same order, so the images are equal to the byte. Each key length FLASHGS_SORT_KEY_BITS

@@ -49,5 +49,32 @@ __device__ __forceinline__ std::uint32_t pair_value(const BinGrid& bins, unsigne
   return bins.shift == 0 ? record : record | (tile_bits << kBinTileBitsShift);
 }
 
+// Where one bin's four tile lists go (FrameBuffers::tile_lists; tile q row-major in the bin).
+struct BinLists {
+  std::uint32_t* top;
+  std::uint32_t* bottom;
+  unsigned start, length;  // the bin's range in the sorted values
+  __device__ unsigned list_start(int q) const { return 2 * start + (q & 1) * length; }
+  __device__ std::uint32_t* list(int q) const { return (q < 2 ? top : bottom) + list_start(q); }
+};
+
+// Whether a binned pair value carries tile q of its bin.
+__device__ __forceinline__ bool carries(std::uint32_t value, int q) { return (value >> (kBinTileBitsShift + q)) & 1u; }
+
+// Thread q < 4 records tile q's list of `bin`, `placed[q]` records long (tiles beyond the
+// image's edge have none).
+__device__ __forceinline__ void record_tile_list(const BinGrid& bins, int tiles_x, int tiles_y, uint2* tile_lists,
+                                                 unsigned bin, const BinLists& lists, const unsigned (&placed)[4],
+                                                 unsigned q) {
+  if (q >= 4) return;
+  const int tx = static_cast<int>(bin % static_cast<unsigned>(bins.x)) * 2 + static_cast<int>(q & 1u);
+  const int ty = static_cast<int>(bin / static_cast<unsigned>(bins.x)) * 2 + static_cast<int>(q >> 1);
+  if (tx >= tiles_x || ty >= tiles_y) return;
+  const unsigned count = q == 0 ? placed[0] : q == 1 ? placed[1] : q == 2 ? placed[2] : placed[3];
+  const unsigned start = lists.list_start(static_cast<int>(q));
+  tile_lists[static_cast<std::uint64_t>(ty) * static_cast<unsigned>(tiles_x) + static_cast<unsigned>(tx)] =
+      make_uint2(start, start + count);
+}
+
 }  // namespace cuda
 }  // namespace flashgs

@@ -198,6 +198,14 @@ class CudaRendererImpl final : public CudaRenderer {
       dense_tiles_mode_ = std::atoi(dense) != 0 ? kAlways : kNever;
     // FLASHGS_SORT_KEY_BITS: the compact key's length (tile and depth bin), 16 to 32.
     if (const char* bits = std::getenv("FLASHGS_SORT_KEY_BITS")) sort_key_bits_ = std::max(16, std::min(32, std::atoi(bits)));
+    // FLASHGS_BIN_SORT=1 sorts every binned frame per bin, =0 none (CUB's radix sort over the
+    // whole frame, the path of 64-bit keys and of tile keys; unset: where it pays, see
+    // bin_sort_pays); FLASHGS_BIN_SORT_SHARED_PAIRS (0 to kBinSortSharedPairsMax) is the
+    // largest bin sorted in shared memory.
+    if (const char* bin_sort = std::getenv("FLASHGS_BIN_SORT")) bin_sort_ = std::atoi(bin_sort) != 0 ? kAlways : kNever;
+    if (const char* shared = std::getenv("FLASHGS_BIN_SORT_SHARED_PAIRS"))
+      bin_sort_shared_pairs_ = static_cast<unsigned>(
+          std::max(0, std::min(static_cast<int>(cuda::kBinSortSharedPairsMax), std::atoi(shared))));
     // FLASHGS_INITIAL_RECORDS: the blend records a first frame starts with (tests of growth).
     if (const char* records = std::getenv("FLASHGS_INITIAL_RECORDS"))
       initial_records_ = std::max<long long>(1, std::atoll(records));
@@ -336,7 +344,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &record_ids_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &tile_lists_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
+            &values_[1], &ranges_, &tile_lists_, &bin_fill_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
             &deferred_footprints_, &deferred_records_, &deferred_hits_, &deferred_items_};
   }
 
@@ -421,6 +429,8 @@ class CudaRendererImpl final : public CudaRenderer {
       b.values[k] = values_[k].as<std::uint32_t>();
     }
     b.pair_capacity = pair_capacity_;
+    b.pair_values = bin_sort_frame_ ? keys_[0].as<std::uint32_t>() + pair_capacity_ : b.values[0];
+    b.bin_fill = bin_fill_.as<std::uint32_t>();
     b.deferred = deferred_list();
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
@@ -473,6 +483,17 @@ class CudaRendererImpl final : public CudaRenderer {
     if (!have_last_frame || tiles != last_tiles_ || last_pairs == 0) return false;
     const std::uint64_t fullest = readback_->tile_max[event_set_ ^ 1];
     return fullest * blend_resident_blocks_ > last_pairs;
+  }
+
+  // Whether sorting per bin (launch_bin_sort) pays over CUB's radix sort of the whole frame.
+  // Measured on an H200 (docs/PERFORMANCE.md, v16): it saves 4-14% of a 1080p frame of pc_biker
+  // and pc_playbot (2,040 bins of 200-400 pairs), ties at 4K (8,160 bins: its count and
+  // scatter passes cost what it saves), and loses 15% on 7 x pc_playbot at 1080p (about 700
+  // pairs per bin; bins of more than 2,048 sort in global memory). Judged on the last frame's
+  // bin pairs, as the emission that this decides comes before this frame's count.
+  bool bin_sort_pays(std::uint64_t bins) const {
+    if (bin_sort_ != kAuto) return bin_sort_ == kAlways;
+    return bins <= kBinSortMostBins && last_bin_pairs_ <= kBinSortMostPairsPerBin * bins;
   }
 
   // Stage times of the frame whose events are in `set` (its work must have finished).
@@ -552,6 +573,9 @@ class CudaRendererImpl final : public CudaRenderer {
       key_format_ = cuda::KeyFormat{};
     }
 
+    // The bin sort needs the depth bins of compact keys (depth_bits > 0) in 32-bit keys.
+    bin_sort_frame_ = binned && key_format_.depth_bits > 0 && bin_sort_pays(bins);
+    if (bin_sort_frame_) bin_fill_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "bin fill");
     ranges_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(uint2), "bin ranges");
     if (binned) {
       tile_lists_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile lists");
@@ -649,10 +673,15 @@ class CudaRendererImpl final : public CudaRenderer {
     if (key_format_.depth_bits > 0) end_bit = tile_bits + key_format_.depth_bits;
     else if (baseline || options.minimal_sort_bits) end_bit = std::min(64, 32 + tile_bits);
     check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
-    const int which = cuda::launch_sort(pairs, end_bit, b, stream_);
+    // The bin sort writes the bin ranges and tile lists itself (its stage time includes them).
+    int which = 0;
+    if (bin_sort_frame_) cuda::launch_bin_sort(pairs, cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, stream_);
+    else which = cuda::launch_sort(pairs, end_bit, b, stream_);
     check_cuda(cudaEventRecord(events[kSorted], stream_), "event record");
-    cuda::launch_ranges(pairs, bins, b, which, stream_);
-    if (binned) cuda::launch_tile_lists(pairs, cam.tiles_x, cam.tiles_y, b, which, stream_);
+    if (!bin_sort_frame_) {
+      cuda::launch_ranges(pairs, bins, b, which, stream_);
+      if (binned) cuda::launch_tile_lists(pairs, cam.tiles_x, cam.tiles_y, b, which, stream_);
+    }
     if (dense_tiles_first) cuda::launch_tile_order(bins, b, stream_);
     check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
 
@@ -679,6 +708,7 @@ class CudaRendererImpl final : public CudaRenderer {
     cuda::launch_blend(blend, stream_);
     check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     last_tiles_ = tiles;
+    last_bin_pairs_ = binned ? pairs : 0;
     last_frame_binned_ = binned;
     // The fullest tile and the tile pairs, for the statistics (after the last timed event:
     // not a stage's cost).
@@ -768,9 +798,15 @@ class CudaRendererImpl final : public CudaRenderer {
   // them once and runs again.
   std::uint64_t initial_records_ = std::uint64_t{1} << 21;
   int sort_key_bits_ = 32;  // of a compact key (compact_key_format)
+  unsigned bin_sort_shared_pairs_ = cuda::kBinSortSharedPairsMax;
   enum Mode { kAuto, kAlways, kNever };
   Mode chunk_cull_ = kAuto;
   Mode dense_tiles_mode_ = kAuto;
+  Mode bin_sort_ = kAuto;        // binned frames with compact keys sort per bin (launch_bin_sort)
+  bool bin_sort_frame_ = false;  // this frame does
+  std::uint64_t last_bin_pairs_ = 0;  // the last frame's pairs if it was binned
+  static constexpr std::uint64_t kBinSortMostBins = 4096;          // bin_sort_pays
+  static constexpr std::uint64_t kBinSortMostPairsPerBin = 512;
   std::uint64_t blend_resident_blocks_ = 1;  // warp-blend blocks the device runs at once
   cuda::KeyFormat key_format_;           // this frame's
   cuda::BinGrid bins_;                   // this frame's
@@ -781,7 +817,7 @@ class CudaRendererImpl final : public CudaRenderer {
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
-  DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_,
+  DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_, bin_fill_,
       dense_bins_, tile_order_, tile_places_, chunk_list_, image_,
       cub_temp_, deferred_footprints_, deferred_records_, deferred_hits_, deferred_items_;
 };

@@ -44,7 +44,7 @@ __device__ __forceinline__ void store_pair(const FrameBuffers& b, unsigned long 
       reinterpret_cast<std::uint32_t*>(b.keys[0])[offset] = (bin << b.key_format.depth_bits) | depth;
     else
       b.keys[0][offset] = (static_cast<std::uint64_t>(bin) << 32) | depth;
-    b.values[0][offset] = value;
+    b.pair_values[offset] = value;
   }
 }
 

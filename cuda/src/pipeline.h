@@ -137,6 +137,7 @@ struct FrameCounters {
   unsigned int tiles_by_class[kTileClasses];  // tiles per pair-count class (launch_tile_order)
   unsigned int records;            // blend records wanted (compact records: may exceed capacity)
   unsigned int dense_bins;         // bins listed in FrameBuffers::dense_bins (launch_tile_lists)
+  unsigned int bin_count_blocks;   // blocks of the bin sort's counting pass done (launch_bin_sort)
 };
 
 // Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
@@ -176,6 +177,12 @@ struct FrameBuffers {
   std::uint64_t* keys[2] = {nullptr, nullptr};    // [pair_capacity]
   std::uint32_t* values[2] = {nullptr, nullptr};  // [pair_capacity]
   std::uint64_t pair_capacity = 0;
+  // Where emission writes the pair values: values[0], or for the bin sort the upper half of
+  // keys[0] (as 32-bit words from pair_capacity), which leaves values[] free for the pairs in
+  // bin order (launch_bin_sort).
+  std::uint32_t* pair_values = nullptr;
+  // The bin sort's per-bin counts, then each bin's next free place.
+  std::uint32_t* bin_fill = nullptr;  // [bins]
   // Per bin: [start, end) of its pairs in the sorted list.
   uint2* tile_ranges = nullptr;  // [tile_capacity]
   std::uint64_t tile_capacity = 0;
@@ -235,6 +242,16 @@ void launch_scan(std::size_t gaussians, const FrameBuffers& buffers, cudaStream_
 // Radix sort of `pairs` keys (in buffers.key_format) over bits [0, end_bit); returns which
 // buffer (0/1) holds the result.
 int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, cudaStream_t stream);
+// The sort of binned frames with compact keys, and what the ranges pass and the tile lists do
+// for the others: each pair counted into its bin and put there (unstable), then a block per
+// bin sorts it by key (in shared memory up to `shared_pairs` pairs, at most
+// kBinSortSharedPairsMax; a larger bin in its place in keys[1]), puts runs of equal keys in
+// the exact order and writes its tiles' lists. Fills tile_ranges (per bin), tile_lists and
+// tile_values from keys[0] and pair_values.
+void launch_bin_sort(std::uint64_t pairs, int tiles_x, int tiles_y, const FrameBuffers& buffers,
+                     unsigned shared_pairs, cudaStream_t stream);
+// Pairs a bin may hold to be sorted in shared memory (the default of launch_bin_sort's shared_pairs).
+constexpr unsigned kBinSortSharedPairsMax = 2048;
 // The ranges of the `bins` bins from the sorted keys in buffer `which`, and runs of equal keys
 // put in (depth, Gaussian id) order.
 void launch_ranges(std::uint64_t pairs, std::uint64_t bins, const FrameBuffers& buffers, int which,

@@ -5,62 +5,16 @@
 // bin is a tile, or 2x2 tiles with macro bins: pipeline.h, BinGrid.)
 #include <algorithm>
 
+#include "bins.cuh"
 #include "device_common.cuh"
 #include "pipeline.h"
+#include "sort_order.cuh"
 
 namespace flashgs {
 namespace cuda {
 namespace {
 
 constexpr int kBlock = 256;
-
-// The blend records and which Gaussian each one is (ids null: record r is Gaussian r).
-struct Records {
-  const BlendGaussian* gaussians;
-  const std::uint32_t* ids;
-  std::uint32_t value_mask;  // a pair value's record bits
-};
-
-// The blend order of a pair: its Gaussian's exact depth bits, then its id.
-__device__ __forceinline__ std::uint64_t blend_order(const Records& r, std::uint32_t value) {
-  const std::uint32_t record = value & r.value_mask;
-  const std::uint32_t id = r.ids ? r.ids[record] : record;
-  return (static_cast<std::uint64_t>(__float_as_uint(r.gaussians[record].depth)) << 32) | id;
-}
-
-// Sorts a run of records in place by blend_order: insertion sort for the usual run of 2-3,
-// heap sort for the long runs of a planar scene seen head-on, where insertion would be quadratic.
-__device__ void sort_run(std::uint32_t* v, unsigned n, const Records& records) {
-  if (n <= 16) {
-    for (unsigned a = 1; a < n; ++a) {
-      const std::uint32_t x = v[a];
-      const std::uint64_t key = blend_order(records, x);
-      unsigned b = a;
-      for (; b > 0 && blend_order(records, v[b - 1]) > key; --b) v[b] = v[b - 1];
-      v[b] = x;
-    }
-    return;
-  }
-  auto sift = [v, records](unsigned root, unsigned size) {
-    for (;;) {
-      unsigned child = 2 * root + 1;
-      if (child >= size) return;
-      if (child + 1 < size && blend_order(records, v[child + 1]) > blend_order(records, v[child])) ++child;
-      if (blend_order(records, v[root]) >= blend_order(records, v[child])) return;
-      const std::uint32_t t = v[root];
-      v[root] = v[child];
-      v[child] = t;
-      root = child;
-    }
-  };
-  for (unsigned r = n / 2; r-- > 0;) sift(r, n);
-  for (unsigned end = n - 1; end > 0; --end) {
-    const std::uint32_t t = v[0];
-    v[0] = v[end];
-    v[end] = t;
-    sift(0, end);
-  }
-}
 
 // KEY: std::uint64_t (tile << 32 | depth bits) or std::uint32_t (tile << depth_bits | bin).
 template <typename KEY>
@@ -118,17 +72,6 @@ struct BinListArgs {
   FrameCounters* counters;
 };
 
-// Where one bin's four tile lists go (FrameBuffers::tile_lists; tile q row-major in the bin).
-struct BinLists {
-  std::uint32_t* top;
-  std::uint32_t* bottom;
-  unsigned start, length;  // the bin's range in the sorted values
-  __device__ unsigned list_start(int q) const { return 2 * start + (q & 1) * length; }
-  __device__ std::uint32_t* list(int q) const { return (q < 2 ? top : bottom) + list_start(q); }
-};
-
-__device__ __forceinline__ bool carries(std::uint32_t value, int q) { return (value >> (kBinTileBitsShift + q)) & 1u; }
-
 // The run of values from `first` (up to `end`), lane l holding first + k * 32 + l in v[k].
 __device__ __forceinline__ void load_run(const std::uint32_t* values, unsigned first, unsigned end, unsigned lane,
                                          std::uint32_t (&v)[kListLoads]) {
@@ -153,19 +96,6 @@ __device__ __forceinline__ void place_run(const BinLists& lists, const std::uint
     }
 }
 
-// Lane q < 4 records tile q's list (tiles beyond the image's edge have none).
-__device__ __forceinline__ void record_tile_list(const BinListArgs& a, unsigned bin, const BinLists& lists,
-                                                 const unsigned (&placed)[4], unsigned q) {
-  if (q >= 4) return;
-  const int tx = static_cast<int>(bin % static_cast<unsigned>(a.bins.x)) * 2 + static_cast<int>(q & 1u);
-  const int ty = static_cast<int>(bin / static_cast<unsigned>(a.bins.x)) * 2 + static_cast<int>(q >> 1);
-  if (tx >= a.tiles_x || ty >= a.tiles_y) return;
-  const unsigned count = q == 0 ? placed[0] : q == 1 ? placed[1] : q == 2 ? placed[2] : placed[3];
-  const unsigned start = lists.list_start(static_cast<int>(q));
-  a.tile_lists[static_cast<std::uint64_t>(ty) * static_cast<unsigned>(a.tiles_x) + static_cast<unsigned>(tx)] =
-      make_uint2(start, start + count);
-}
-
 // Binned frames: each tile's list, the records of its bin's values that carry its bit, in
 // bin order. A warp per bin lists the small bins and leaves the dense ones to
 // dense_bin_lists_kernel (FrameBuffers::dense_bins).
@@ -185,7 +115,7 @@ __global__ void __launch_bounds__(kListWarps * kWarp) small_bin_lists_kernel(Bin
     load_run(a.values, run, range.y, lane, v);
     place_run(lists, v, lane, placed);
   }
-  record_tile_list(a, bin, lists, placed, lane);
+  record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, placed, lane);
 }
 
 // The dense bins' lists, a block per bin: warp w takes the w-th run of each round; a first
@@ -226,7 +156,7 @@ __global__ void __launch_bounds__(kListWarps * kWarp) dense_bin_lists_kernel(Bin
 #pragma unroll
     for (int q = 0; q < 4; ++q) placed[q] += total[q];
   }
-  record_tile_list(a, bin, lists, placed, threadIdx.x);
+  record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, placed, threadIdx.x);
 }
 
 // A tile's class: the leading zeros of its pair count, so fuller tiles come first.

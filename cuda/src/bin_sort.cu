@@ -1,0 +1,610 @@
+// Stage `sort` of binned frames with compact keys, shaped for the problem: pairs fall into a
+// few thousand bins of a few hundred pairs each, so instead of four radix passes over the
+// whole frame (CUB: about 12 us each, latency-bound), a counting pass puts every pair in its
+// bin, and a block per bin sorts the bin by key where it is, in shared memory when it fits.
+// The same block then puts runs of equal keys in the exact blend order and writes its four
+// tiles' lists, which the ranges pass and the tile-list kernels do on the other paths.
+// The order is the CUB path's to the pair (bins by key, ties by sort_order.cuh).
+#include <cub/block/block_radix_sort.cuh>
+
+#include <algorithm>
+
+#include "bins.cuh"
+#include "device_common.cuh"
+#include "pipeline.h"
+#include "sort_order.cuh"
+
+namespace flashgs {
+namespace cuda {
+namespace {
+
+// Count and scatter passes: a block of 256 threads takes 4 pairs per thread.
+constexpr int kPassBlock = 256;
+constexpr int kPassItems = 4;
+constexpr unsigned kPassPairs = kPassBlock * kPassItems;
+constexpr unsigned kNoBin = 0xffffffffu;
+
+// The per-bin sort: a block of 4 warps. A bin that fits sorts in registers and shared memory
+// (CUB's block radix sort, 4 or 16 pairs per thread); a larger one sorts in global memory,
+// radix digits of 8 bits.
+constexpr int kSortWarps = 4;
+constexpr int kSortBlock = kSortWarps * kWarp;
+constexpr int kSmallItems = 4;
+constexpr int kLargeItems = 16;
+static_assert(kSortBlock * kLargeItems == static_cast<int>(kBinSortSharedPairsMax), "the largest bin in shared memory");
+using SmallBinSort = cub::BlockRadixSort<std::uint32_t, kSortBlock, kSmallItems, std::uint32_t>;
+using LargeBinSort = cub::BlockRadixSort<std::uint32_t, kSortBlock, kLargeItems, std::uint32_t>;
+constexpr int kDigitBits = 8;
+constexpr unsigned kDigits = 1u << kDigitBits;
+static_assert(kDigits == 2 * kSortBlock, "each thread scans two digits");
+// Loops over a bin load this many words per thread before using any, so that a bin sorted in
+// global memory waits for memory once per batch rather than once per word.
+constexpr int kBatch = 8;
+
+__device__ __forceinline__ unsigned lanes_below() { return (1u << lane_id()) - 1u; }
+
+// Lane l's words of kBatch groups of 32 from `first` (words at `end` and beyond read as 0).
+__device__ __forceinline__ void load_groups(const std::uint32_t* src, unsigned first, unsigned end,
+                                            std::uint32_t (&word)[kBatch]) {
+#pragma unroll
+  for (int g = 0; g < kBatch; ++g) {
+    const unsigned i = first + g * kWarp + lane_id();
+    word[g] = i < end ? src[i] : 0u;
+  }
+}
+
+// Exclusive prefix sum over the block of `value` (all threads call; `warp_totals` holds one
+// word per warp). Returns the block's total in `total`.
+template <int WARPS>
+__device__ __forceinline__ unsigned block_exclusive_sum(unsigned value, unsigned* warp_totals, unsigned& total) {
+  const unsigned warp = threadIdx.x / kWarp;
+  const unsigned inclusive = warp_inclusive_sum(value);
+  if (lane_id() == kWarp - 1) warp_totals[warp] = inclusive;
+  __syncthreads();
+  unsigned before = 0;
+  total = 0;
+#pragma unroll
+  for (int w = 0; w < WARPS; ++w) {
+    if (w == static_cast<int>(warp)) before = total;
+    total += warp_totals[w];
+  }
+  __syncthreads();  // warp_totals may be reused at once
+  return before + inclusive - value;
+}
+
+// The block of the counting pass that finishes last turns the counts into each bin's range
+// and first free place (all threads of every block call this once their counts are added).
+__device__ void finish_count(unsigned bins, std::uint32_t* fill, uint2* __restrict__ bin_ranges,
+                             FrameCounters* counters) {
+  __shared__ bool last;
+  __shared__ unsigned warp_totals[kPassBlock / kWarp];
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    __threadfence();  // cumulative: the block's counts (ordered by the barrier) before the ticket
+    last = atomicAdd(&counters->bin_count_blocks, 1u) == gridDim.x - 1;
+  }
+  __syncthreads();
+  if (!last) return;
+  __threadfence();
+  constexpr int kScanItems = 8;
+  unsigned running = 0;
+  for (unsigned base = 0; base < bins; base += kPassBlock * kScanItems) {  // block-uniform
+    unsigned count[kScanItems], sum = 0;
+#pragma unroll
+    for (int k = 0; k < kScanItems; ++k) {
+      const unsigned b = base + threadIdx.x * kScanItems + k;
+      count[k] = b < bins ? __ldcg(&fill[b]) : 0u;
+      sum += count[k];
+    }
+    unsigned total = 0;
+    unsigned start = running + block_exclusive_sum<kPassBlock / kWarp>(sum, warp_totals, total);
+#pragma unroll
+    for (int k = 0; k < kScanItems; ++k) {
+      const unsigned b = base + threadIdx.x * kScanItems + k;
+      if (b < bins) {
+        bin_ranges[b] = make_uint2(start, start + count[k]);
+        fill[b] = start;
+      }
+      start += count[k];
+    }
+    running += total;
+  }
+}
+
+// A block's pairs in a frame of few bins: kPassBlock x kHistogramItems, counted per bin in
+// shared memory, so that global memory sees one atomic per bin the block touches rather than
+// about one per pair (hot bins serialise those).
+constexpr int kHistogramItems = 8;
+constexpr unsigned kHistogramPairs = kPassBlock * kHistogramItems;
+constexpr unsigned kHistogramBins = 12000;  // 47 KB of counters (a 4K frame has 8,160 bins)
+
+// This block's pairs per bin in `hist` (bins long); keys and bins of its pairs in registers.
+__device__ void block_histogram(std::uint64_t pairs, const std::uint32_t* __restrict__ keys, int depth_bits,
+                                unsigned bins, unsigned* hist, std::uint32_t (&key)[kHistogramItems],
+                                unsigned (&bin)[kHistogramItems]) {
+  for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) hist[b] = 0;
+  const std::uint64_t first = static_cast<std::uint64_t>(blockIdx.x) * kHistogramPairs + threadIdx.x;
+#pragma unroll
+  for (int k = 0; k < kHistogramItems; ++k) {
+    const std::uint64_t i = first + k * kPassBlock;
+    key[k] = i < pairs ? keys[i] : 0u;
+    bin[k] = i < pairs ? key[k] >> depth_bits : kNoBin;
+  }
+  __syncthreads();
+#pragma unroll
+  for (int k = 0; k < kHistogramItems; ++k)
+    if (bin[k] != kNoBin) atomicAdd(&hist[bin[k]], 1u);
+  __syncthreads();
+}
+
+// The counting pass with a shared histogram (bins <= kHistogramBins).
+__global__ void __launch_bounds__(kPassBlock) bin_count_shared_kernel(std::uint64_t pairs,
+                                                                      const std::uint32_t* __restrict__ keys,
+                                                                      int depth_bits, unsigned bins, std::uint32_t* fill,
+                                                                      uint2* __restrict__ bin_ranges,
+                                                                      FrameCounters* counters) {
+  extern __shared__ unsigned hist[];
+  std::uint32_t key[kHistogramItems];
+  unsigned bin[kHistogramItems];
+  block_histogram(pairs, keys, depth_bits, bins, hist, key, bin);
+  for (unsigned b = threadIdx.x; b < bins; b += kPassBlock)
+    if (hist[b] != 0) atomicAdd(&fill[b], hist[b]);
+  finish_count(bins, fill, bin_ranges, counters);
+}
+
+// The scatter pass with a shared histogram: one global atomic per bin reserves the block's
+// places there, shared atomics hand them out.
+__global__ void __launch_bounds__(kPassBlock) bin_scatter_shared_kernel(std::uint64_t pairs,
+                                                                        const std::uint32_t* __restrict__ keys,
+                                                                        const std::uint32_t* __restrict__ values,
+                                                                        int depth_bits, unsigned bins,
+                                                                        std::uint32_t* fill,
+                                                                        std::uint32_t* __restrict__ bin_keys,
+                                                                        std::uint32_t* __restrict__ bin_values) {
+  extern __shared__ unsigned hist[];
+  std::uint32_t key[kHistogramItems], value[kHistogramItems];
+  unsigned bin[kHistogramItems];
+  const std::uint64_t first = static_cast<std::uint64_t>(blockIdx.x) * kHistogramPairs + threadIdx.x;
+#pragma unroll
+  for (int k = 0; k < kHistogramItems; ++k) {
+    const std::uint64_t i = first + k * kPassBlock;
+    value[k] = i < pairs ? values[i] : 0u;
+  }
+  block_histogram(pairs, keys, depth_bits, bins, hist, key, bin);
+  for (unsigned b = threadIdx.x; b < bins; b += kPassBlock)
+    if (hist[b] != 0) hist[b] = atomicAdd(&fill[b], hist[b]);
+  __syncthreads();
+#pragma unroll
+  for (int k = 0; k < kHistogramItems; ++k)
+    if (bin[k] != kNoBin) {
+      const unsigned place = atomicAdd(&hist[bin[k]], 1u);
+      bin_keys[place] = key[k];
+      bin_values[place] = value[k];
+    }
+}
+
+// The counting pass of a frame of many bins: pairs per bin by warp-aggregated atomics.
+__global__ void __launch_bounds__(kPassBlock) bin_count_kernel(std::uint64_t pairs, const std::uint32_t* __restrict__ keys,
+                                                               int depth_bits, unsigned bins, std::uint32_t* fill,
+                                                               uint2* __restrict__ bin_ranges, FrameCounters* counters) {
+  const std::uint64_t first = static_cast<std::uint64_t>(blockIdx.x) * kPassPairs + threadIdx.x;
+  unsigned bin[kPassItems];
+#pragma unroll
+  for (int k = 0; k < kPassItems; ++k) {
+    const std::uint64_t i = first + k * kPassBlock;
+    bin[k] = i < pairs ? keys[i] >> depth_bits : kNoBin;
+  }
+#pragma unroll
+  for (int k = 0; k < kPassItems; ++k) {
+    const unsigned peers = __match_any_sync(kFullMask, bin[k]);
+    if (bin[k] != kNoBin && lane_id() == static_cast<unsigned>(__ffs(peers) - 1)) atomicAdd(&fill[bin[k]], __popc(peers));
+  }
+  finish_count(bins, fill, bin_ranges, counters);
+}
+
+// The scatter pass of a frame of many bins: each pair to its bin's next free place (the
+// order within a bin is whatever the atomics give; the bin sort makes it exact).
+__global__ void __launch_bounds__(kPassBlock) bin_scatter_kernel(std::uint64_t pairs, const std::uint32_t* __restrict__ keys,
+                                                                 const std::uint32_t* __restrict__ values,
+                                                                 int depth_bits, std::uint32_t* fill,
+                                                                 std::uint32_t* __restrict__ bin_keys,
+                                                                 std::uint32_t* __restrict__ bin_values) {
+  const std::uint64_t first = static_cast<std::uint64_t>(blockIdx.x) * kPassPairs + threadIdx.x;
+  std::uint32_t key[kPassItems], value[kPassItems];
+#pragma unroll
+  for (int k = 0; k < kPassItems; ++k) {
+    const std::uint64_t i = first + k * kPassBlock;
+    key[k] = i < pairs ? keys[i] : 0u;
+    value[k] = i < pairs ? values[i] : 0u;
+  }
+#pragma unroll
+  for (int k = 0; k < kPassItems; ++k) {
+    const bool real = first + k * kPassBlock < pairs;
+    const unsigned bin = real ? key[k] >> depth_bits : kNoBin;
+    const unsigned peers = __match_any_sync(kFullMask, bin);
+    const unsigned leader = __ffs(peers) - 1;
+    unsigned base = 0;
+    if (real && lane_id() == leader) base = atomicAdd(&fill[bin], __popc(peers));
+    base = __shfl_sync(kFullMask, base, leader);
+    if (real) {
+      const unsigned place = base + __popc(peers & lanes_below());
+      bin_keys[place] = key[k];
+      bin_values[place] = value[k];
+    }
+  }
+}
+
+// One bin's pairs: keys and values at the same index, in shared or global memory.
+struct PairSpan {
+  std::uint32_t* keys;
+  std::uint32_t* values;
+};
+
+// What the bin sort reads and writes (FrameBuffers' fields; see launch_bin_sort).
+struct BinSortArgs {
+  BinGrid bins;
+  int tiles_x, tiles_y;
+  const uint2* bin_ranges;
+  std::uint32_t* keys;      // the pairs in bin order: values[1]
+  std::uint32_t* values;    // values[0]
+  std::uint32_t* scratch;   // keys[1] as 32-bit words: bin [s, e) may use [2s, 2e)
+  std::uint32_t* top_lists;     // tile_values[0]
+  std::uint32_t* bottom_lists;  // tile_values[1]
+  uint2* tile_lists;
+  Records records;
+  unsigned shared_pairs;  // bins of more pairs sort in global memory
+};
+
+// The shared memory of a bin-sort block.
+struct SortShared {
+  union {  // the block sort's scratch, then the sorted bin
+    SmallBinSort::TempStorage small;
+    LargeBinSort::TempStorage large;
+    struct {
+      std::uint32_t keys[kBinSortSharedPairsMax];
+      std::uint32_t values[kBinSortSharedPairsMax];
+    } sorted;
+  } bin;
+  unsigned counts[kSortWarps][kDigits];  // global-memory sort: per warp and digit a count, then a place
+  unsigned warp_totals[kSortWarps];
+  unsigned low[kSortWarps], high[kSortWarps];
+  unsigned list_counts[kSortWarps][4];
+};
+
+// Warp w's share of n pairs: [lo, hi), consecutive so that each pass is stable.
+struct WarpShare {
+  unsigned lo, hi;
+  __device__ explicit WarpShare(unsigned n) {
+    const unsigned per = (n + kSortWarps - 1) / kSortWarps, warp = threadIdx.x / kWarp;
+    lo = min(n, warp * per);
+    hi = min(n, lo + per);
+  }
+};
+
+__device__ __forceinline__ unsigned digit_of(std::uint32_t key, std::uint32_t low, int shift) {
+  return ((key - low) >> shift) & (kDigits - 1);
+}
+
+// One stable LSD pass over the digit of (key - low) at `shift`: each warp counts its share per
+// digit, a scan turns the counts into places (digit-major, then warp order), and each warp
+// places its share in order, 32 pairs at a time.
+__device__ void radix_pass(PairSpan from, PairSpan to, unsigned n, std::uint32_t low, int shift, SortShared& sh) {
+  const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
+  for (unsigned d = threadIdx.x; d < kSortWarps * kDigits; d += kSortBlock) (&sh.counts[0][0])[d] = 0;
+  __syncthreads();
+  const WarpShare share(n);
+  for (unsigned first = share.lo; first < share.hi; first += kBatch * kWarp) {  // warp-uniform
+    std::uint32_t key[kBatch];
+    load_groups(from.keys, first, share.hi, key);
+#pragma unroll
+    for (int g = 0; g < kBatch; ++g) {
+      const unsigned d = first + g * kWarp + lane < share.hi ? digit_of(key[g], low, shift) : kDigits;
+      const unsigned peers = __match_any_sync(kFullMask, d);
+      if (d < kDigits && lane == static_cast<unsigned>(__ffs(peers) - 1)) sh.counts[warp][d] += __popc(peers);
+      __syncwarp();  // the next group's leader of a digit may be another lane
+    }
+  }
+  __syncthreads();
+  const unsigned d0 = 2 * threadIdx.x, d1 = d0 + 1;
+  unsigned total0 = 0, total1 = 0;
+#pragma unroll
+  for (int w = 0; w < kSortWarps; ++w) {
+    total0 += sh.counts[w][d0];
+    total1 += sh.counts[w][d1];
+  }
+  unsigned all = 0;
+  unsigned place = block_exclusive_sum<kSortWarps>(total0 + total1, sh.warp_totals, all);
+#pragma unroll
+  for (int w = 0; w < kSortWarps; ++w) {
+    const unsigned c = sh.counts[w][d0];
+    sh.counts[w][d0] = place;
+    place += c;
+  }
+#pragma unroll
+  for (int w = 0; w < kSortWarps; ++w) {
+    const unsigned c = sh.counts[w][d1];
+    sh.counts[w][d1] = place;
+    place += c;
+  }
+  __syncthreads();
+  for (unsigned first = share.lo; first < share.hi; first += kBatch * kWarp) {  // warp-uniform
+    std::uint32_t key[kBatch], value[kBatch];
+    load_groups(from.keys, first, share.hi, key);
+    load_groups(from.values, first, share.hi, value);
+#pragma unroll
+    for (int g = 0; g < kBatch; ++g) {
+      const bool real = first + g * kWarp + lane < share.hi;
+      const unsigned d = real ? digit_of(key[g], low, shift) : kDigits;
+      const unsigned peers = __match_any_sync(kFullMask, d);
+      if (real) {
+        const unsigned at = sh.counts[warp][d] + __popc(peers & lanes_below());
+        to.keys[at] = key[g];
+        to.values[at] = value[g];
+      }
+      __syncwarp();
+      if (real && lane == static_cast<unsigned>(__ffs(peers) - 1)) sh.counts[warp][d] += __popc(peers);
+      __syncwarp();
+    }
+  }
+  __syncthreads();
+}
+
+// Folds this thread's keys into the block's smallest and largest (every thread gets both).
+__device__ void block_key_bounds(SortShared& sh, std::uint32_t& low, std::uint32_t& high) {
+  low = __reduce_min_sync(kFullMask, low);
+  high = __reduce_max_sync(kFullMask, high);
+  const unsigned warp = threadIdx.x / kWarp;
+  if (lane_id() == 0) {
+    sh.low[warp] = low;
+    sh.high[warp] = high;
+  }
+  __syncthreads();
+#pragma unroll
+  for (int w = 0; w < kSortWarps; ++w) {
+    low = min(low, sh.low[w]);
+    high = max(high, sh.high[w]);
+  }
+}
+
+// Copies n pairs (kBatch loads per thread in flight), and the smallest and largest key.
+__device__ void copy_pairs(PairSpan from, PairSpan to, unsigned n, std::uint32_t& low, std::uint32_t& high) {
+  low = 0xffffffffu;
+  high = 0;
+  for (unsigned base = 0; base < n; base += kBatch * kSortBlock) {
+    std::uint32_t key[kBatch], value[kBatch];
+#pragma unroll
+    for (int j = 0; j < kBatch; ++j) {
+      const unsigned i = base + j * kSortBlock + threadIdx.x;
+      key[j] = i < n ? from.keys[i] : 0u;
+      value[j] = i < n ? from.values[i] : 0u;
+    }
+#pragma unroll
+    for (int j = 0; j < kBatch; ++j) {
+      const unsigned i = base + j * kSortBlock + threadIdx.x;
+      if (i < n) {
+        to.keys[i] = key[j];
+        to.values[i] = value[j];
+        low = min(low, key[j]);
+        high = max(high, key[j]);
+      }
+    }
+  }
+}
+
+// The smallest and largest key of a span in global memory.
+__device__ void span_key_bounds(PairSpan span, unsigned n, std::uint32_t& low, std::uint32_t& high) {
+  low = 0xffffffffu;
+  high = 0;
+  for (unsigned base = 0; base < n; base += kBatch * kSortBlock) {
+    std::uint32_t key[kBatch];
+#pragma unroll
+    for (int j = 0; j < kBatch; ++j) {
+      const unsigned i = base + j * kSortBlock + threadIdx.x;
+      key[j] = i < n ? span.keys[i] : 0u;
+    }
+#pragma unroll
+    for (int j = 0; j < kBatch; ++j)
+      if (base + j * kSortBlock + threadIdx.x < n) {
+        low = min(low, key[j]);
+        high = max(high, key[j]);
+      }
+  }
+}
+
+// Runs of equal keys (equal depth bins) in the exact blend order.
+__device__ void order_ties(PairSpan span, unsigned n, const Records& records) {
+  for (unsigned base = 0; base < n; base += kBatch * kSortBlock) {
+    bool run_start[kBatch];  // all loads of the batch before any run is sorted
+#pragma unroll
+    for (int j = 0; j < kBatch; ++j) {
+      const unsigned i = base + j * kSortBlock + threadIdx.x;
+      run_start[j] = i + 1 < n && span.keys[i + 1] == span.keys[i] && (i == 0 || span.keys[i - 1] != span.keys[i]);
+    }
+#pragma unroll
+    for (int j = 0; j < kBatch; ++j) {
+      if (!run_start[j]) continue;
+      const unsigned i = base + j * kSortBlock + threadIdx.x;
+      unsigned end = i + 2;
+      while (end < n && span.keys[end] == span.keys[i]) ++end;
+      sort_run(span.values + i, end - i, records);
+    }
+  }
+  __syncthreads();
+}
+
+// The bin's four tile lists from its sorted values: each warp counts its share's values per
+// tile, then writes them after those of the warps before it.
+__device__ void write_tile_lists(const BinSortArgs& a, unsigned bin, const std::uint32_t* values, const BinLists& lists,
+                                 SortShared& sh) {
+  const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
+  const WarpShare share(lists.length);
+  unsigned count[4] = {0, 0, 0, 0};
+  for (unsigned first = share.lo; first < share.hi; first += kBatch * kWarp) {  // warp-uniform
+    std::uint32_t v[kBatch];
+    load_groups(values, first, share.hi, v);
+#pragma unroll
+    for (int g = 0; g < kBatch; ++g)
+#pragma unroll
+      for (int q = 0; q < 4; ++q) count[q] += __popc(__ballot_sync(kFullMask, carries(v[g], q)));
+  }
+  if (lane == 0)
+#pragma unroll
+    for (int q = 0; q < 4; ++q) sh.list_counts[warp][q] = count[q];
+  __syncthreads();
+  unsigned next[4], total[4];
+#pragma unroll
+  for (int q = 0; q < 4; ++q) {
+    next[q] = 0;
+    total[q] = 0;
+    for (unsigned w = 0; w < kSortWarps; ++w) {
+      if (w == warp) next[q] = total[q];
+      total[q] += sh.list_counts[w][q];
+    }
+  }
+  for (unsigned first = share.lo; first < share.hi; first += kBatch * kWarp) {  // warp-uniform
+    std::uint32_t v[kBatch];
+    load_groups(values, first, share.hi, v);
+#pragma unroll
+    for (int g = 0; g < kBatch; ++g)
+#pragma unroll
+      for (int q = 0; q < 4; ++q) {
+        const bool mine = carries(v[g], q);
+        const unsigned ballot = __ballot_sync(kFullMask, mine);
+        if (mine) lists.list(q)[next[q] + __popc(ballot & lanes_below())] = v[g] & kRecordMask;
+        next[q] += __popc(ballot);
+      }
+  }
+  record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, total, threadIdx.x);
+}
+
+// Sorts a bin of at most kSortBlock * ITEMS pairs by (key - low) in registers (CUB), and
+// leaves it in sh.bin.sorted, the keys relative to the bin's smallest. The input order is
+// immaterial (ties are put in the exact order afterwards); so that padding sorts last, it gets
+// a key one bit above every real one.
+template <typename BlockSort, int ITEMS>
+__device__ void sort_in_shared(PairSpan home, unsigned n, BlockSort sorter, SortShared& sh) {
+  std::uint32_t key[ITEMS], value[ITEMS];
+  std::uint32_t low = 0xffffffffu, high = 0;
+#pragma unroll
+  for (int j = 0; j < ITEMS; ++j) {
+    const unsigned i = j * kSortBlock + threadIdx.x;
+    key[j] = i < n ? home.keys[i] : 0u;
+    value[j] = i < n ? home.values[i] : 0u;
+    if (i < n) {
+      low = min(low, key[j]);
+      high = max(high, key[j]);
+    }
+  }
+  block_key_bounds(sh, low, high);
+  const int bits = low == high ? 0 : 32 - __clz(high - low);  // at most 31: bins take a key bit
+#pragma unroll
+  for (int j = 0; j < ITEMS; ++j) key[j] = j * kSortBlock + threadIdx.x < n ? key[j] - low : 1u << bits;
+  sorter.Sort(key, value, 0, bits + 1);
+  __syncthreads();  // the scratch becomes the sorted bin
+#pragma unroll
+  for (int j = 0; j < ITEMS; ++j) {
+    const unsigned place = threadIdx.x * ITEMS + j;  // blocked: thread t holds places t * ITEMS + j
+    if (place < n) {
+      sh.bin.sorted.keys[place] = key[j];
+      sh.bin.sorted.values[place] = value[j];
+    }
+  }
+  __syncthreads();
+}
+
+// Sorts a bin too large for shared memory where it lies, in 8-bit radix passes through its
+// scratch, and leaves it back home.
+__device__ void sort_in_global(PairSpan home, PairSpan scratch, unsigned n, SortShared& sh) {
+  std::uint32_t low, high;
+  span_key_bounds(home, n, low, high);
+  block_key_bounds(sh, low, high);
+  const int bits = low == high ? 0 : 32 - __clz(high - low);
+  PairSpan from = home, to = scratch;
+  for (int shift = 0; shift < bits; shift += kDigitBits) {
+    radix_pass(from, to, n, low, shift, sh);
+    const PairSpan t = from;
+    from = to;
+    to = t;
+  }
+  if (from.keys != home.keys) {  // the scratch is where the bin's bottom lists go
+    copy_pairs(from, home, n, low, high);
+    __syncthreads();
+  }
+}
+
+// A block per bin: sort by key (the bin's keys differ only in their depth bins, and only the
+// bits in which the bin's keys differ are sorted), order the ties, write the lists.
+__global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
+  __shared__ SortShared sh;
+  const unsigned bin = blockIdx.x;
+  const uint2 range = a.bin_ranges[bin];
+  const unsigned n = range.y - range.x;
+  const BinLists lists{a.top_lists, a.bottom_lists, range.x, n};
+  if (n == 0) {  // whole block
+    const unsigned none[4] = {0, 0, 0, 0};
+    record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, none, threadIdx.x);
+    return;
+  }
+  const PairSpan home{a.keys + range.x, a.values + range.x};
+  PairSpan sorted = home;
+  if (n <= a.shared_pairs) {
+    sorted = PairSpan{sh.bin.sorted.keys, sh.bin.sorted.values};
+    if (n <= kSortBlock * kSmallItems) sort_in_shared<SmallBinSort, kSmallItems>(home, n, SmallBinSort(sh.bin.small), sh);
+    else sort_in_shared<LargeBinSort, kLargeItems>(home, n, LargeBinSort(sh.bin.large), sh);
+  } else {
+    sort_in_global(home, PairSpan{a.scratch + 2ull * range.x, a.scratch + 2ull * range.x + n}, n, sh);
+  }
+  order_ties(sorted, n, a.records);
+  write_tile_lists(a, bin, sorted.values, lists, sh);
+}
+
+}  // namespace
+
+void launch_bin_sort(std::uint64_t pairs, int tiles_x, int tiles_y, const FrameBuffers& b, unsigned shared_pairs,
+                     cudaStream_t stream) {
+  const unsigned bins = static_cast<unsigned>(b.bins.x) * static_cast<unsigned>(b.bins.y);
+  if (bins == 0) return;
+  shared_pairs = std::min(shared_pairs, kBinSortSharedPairsMax);
+  if (pairs == 0) {
+    check_cuda(cudaMemsetAsync(b.tile_ranges, 0, bins * sizeof(uint2), stream), "bin range reset");
+  } else {
+    const std::uint32_t* keys = reinterpret_cast<const std::uint32_t*>(b.keys[0]);
+    const int depth_bits = b.key_format.depth_bits;
+    check_cuda(cudaMemsetAsync(b.bin_fill, 0, bins * sizeof(std::uint32_t), stream), "bin count reset");
+    if (bins <= kHistogramBins) {
+      const unsigned blocks = static_cast<unsigned>((pairs + kHistogramPairs - 1) / kHistogramPairs);
+      const std::size_t hist_bytes = bins * sizeof(unsigned);
+      bin_count_shared_kernel<<<blocks, kPassBlock, hist_bytes, stream>>>(pairs, keys, depth_bits, bins, b.bin_fill,
+                                                                          b.tile_ranges, b.counters);
+      check_cuda(cudaGetLastError(), "bin count kernel launch");
+      bin_scatter_shared_kernel<<<blocks, kPassBlock, hist_bytes, stream>>>(pairs, keys, b.pair_values, depth_bits, bins,
+                                                                            b.bin_fill, b.values[1], b.values[0]);
+    } else {
+      const unsigned blocks = static_cast<unsigned>((pairs + kPassPairs - 1) / kPassPairs);
+      bin_count_kernel<<<blocks, kPassBlock, 0, stream>>>(pairs, keys, depth_bits, bins, b.bin_fill, b.tile_ranges,
+                                                          b.counters);
+      check_cuda(cudaGetLastError(), "bin count kernel launch");
+      bin_scatter_kernel<<<blocks, kPassBlock, 0, stream>>>(pairs, keys, b.pair_values, depth_bits, b.bin_fill,
+                                                            b.values[1], b.values[0]);
+    }
+    check_cuda(cudaGetLastError(), "bin scatter kernel launch");
+  }
+  BinSortArgs args{};
+  args.bins = b.bins;
+  args.tiles_x = tiles_x;
+  args.tiles_y = tiles_y;
+  args.bin_ranges = b.tile_ranges;
+  args.keys = b.values[1];
+  args.values = b.values[0];
+  args.scratch = reinterpret_cast<std::uint32_t*>(b.keys[1]);
+  args.top_lists = b.tile_values[0];
+  args.bottom_lists = b.tile_values[1];
+  args.tile_lists = b.tile_lists;
+  args.records = Records{b.blend, b.record_ids, kRecordMask};
+  args.shared_pairs = shared_pairs;
+  bin_sort_kernel<<<bins, kSortBlock, 0, stream>>>(args);
+  check_cuda(cudaGetLastError(), "bin sort kernel launch");
+}
+
+}  // namespace cuda
+}  // namespace flashgs
