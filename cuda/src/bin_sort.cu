@@ -29,12 +29,11 @@ constexpr unsigned kNoBin = 0xffffffffu;
 // radix digits of 8 bits.
 constexpr int kSortWarps = 4;
 constexpr int kSortBlock = kSortWarps * kWarp;
-// Four sizes of bin in shared memory, so that the usual bin of 100-300 pairs does not pay for
-// 2,048 places: 1, 2, 4 or 16 pairs per thread.
-template <int ITEMS>
-using BinBlockSort = cub::BlockRadixSort<std::uint32_t, kSortBlock, ITEMS, std::uint32_t>;
+constexpr int kSmallItems = 4;
 constexpr int kLargeItems = 16;
 static_assert(kSortBlock * kLargeItems == static_cast<int>(kBinSortSharedPairsMax), "the largest bin in shared memory");
+using SmallBinSort = cub::BlockRadixSort<std::uint32_t, kSortBlock, kSmallItems, std::uint32_t>;
+using LargeBinSort = cub::BlockRadixSort<std::uint32_t, kSortBlock, kLargeItems, std::uint32_t>;
 constexpr int kDigitBits = 8;
 constexpr unsigned kDigits = 1u << kDigitBits;
 static_assert(kDigits == 2 * kSortBlock, "each thread scans two digits");
@@ -133,10 +132,8 @@ __device__ void block_histogram(std::uint64_t pairs, const std::uint32_t* __rest
   }
   __syncthreads();
 #pragma unroll
-  for (int k = 0; k < kHistogramItems; ++k) {  // neighbouring pairs share bins: one atomic per bin and warp
-    const unsigned peers = __match_any_sync(kFullMask, bin[k]);
-    if (bin[k] != kNoBin && lane_id() == static_cast<unsigned>(__ffs(peers) - 1)) atomicAdd(&hist[bin[k]], __popc(peers));
-  }
+  for (int k = 0; k < kHistogramItems; ++k)
+    if (bin[k] != kNoBin) atomicAdd(&hist[bin[k]], 1u);
   __syncthreads();
 }
 
@@ -178,18 +175,12 @@ __global__ void __launch_bounds__(kPassBlock) bin_scatter_shared_kernel(std::uin
     if (hist[b] != 0) hist[b] = atomicAdd(&fill[b], hist[b]);
   __syncthreads();
 #pragma unroll
-  for (int k = 0; k < kHistogramItems; ++k) {
-    const unsigned peers = __match_any_sync(kFullMask, bin[k]);
-    const unsigned leader = __ffs(peers) - 1;
-    unsigned base = 0;
-    if (bin[k] != kNoBin && lane_id() == leader) base = atomicAdd(&hist[bin[k]], __popc(peers));
-    base = __shfl_sync(kFullMask, base, leader);
+  for (int k = 0; k < kHistogramItems; ++k)
     if (bin[k] != kNoBin) {
-      const unsigned place = base + __popc(peers & lanes_below());
+      const unsigned place = atomicAdd(&hist[bin[k]], 1u);
       bin_keys[place] = key[k];
       bin_values[place] = value[k];
     }
-  }
 }
 
 // The counting pass of a frame of many bins: pairs per bin by warp-aggregated atomics.
@@ -267,10 +258,8 @@ struct BinSortArgs {
 // The shared memory of a bin-sort block.
 struct SortShared {
   union {  // the block sort's scratch, then the sorted bin
-    BinBlockSort<1>::TempStorage items1;
-    BinBlockSort<2>::TempStorage items2;
-    BinBlockSort<4>::TempStorage items4;
-    BinBlockSort<kLargeItems>::TempStorage items16;
+    SmallBinSort::TempStorage small;
+    LargeBinSort::TempStorage large;
     struct {
       std::uint32_t keys[kBinSortSharedPairsMax];
       std::uint32_t values[kBinSortSharedPairsMax];
@@ -492,9 +481,8 @@ __device__ void write_tile_lists(const BinSortArgs& a, unsigned bin, const std::
 // leaves it in sh.bin.sorted, the keys relative to the bin's smallest. The input order is
 // immaterial (ties are put in the exact order afterwards); so that padding sorts last, it gets
 // a key one bit above every real one.
-template <int ITEMS>
-__device__ void sort_in_shared(PairSpan home, unsigned n, typename BinBlockSort<ITEMS>::TempStorage& scratch,
-                               SortShared& sh) {
+template <typename BlockSort, int ITEMS>
+__device__ void sort_in_shared(PairSpan home, unsigned n, BlockSort sorter, SortShared& sh) {
   std::uint32_t key[ITEMS], value[ITEMS];
   std::uint32_t low = 0xffffffffu, high = 0;
 #pragma unroll
@@ -511,7 +499,7 @@ __device__ void sort_in_shared(PairSpan home, unsigned n, typename BinBlockSort<
   const int bits = low == high ? 0 : 32 - __clz(high - low);  // at most 31: bins take a key bit
 #pragma unroll
   for (int j = 0; j < ITEMS; ++j) key[j] = j * kSortBlock + threadIdx.x < n ? key[j] - low : 1u << bits;
-  BinBlockSort<ITEMS>(scratch).Sort(key, value, 0, bits + 1);
+  sorter.Sort(key, value, 0, bits + 1);
   __syncthreads();  // the scratch becomes the sorted bin
 #pragma unroll
   for (int j = 0; j < ITEMS; ++j) {
@@ -561,10 +549,8 @@ __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
   PairSpan sorted = home;
   if (n <= a.shared_pairs) {
     sorted = PairSpan{sh.bin.sorted.keys, sh.bin.sorted.values};
-    if (n <= kSortBlock) sort_in_shared<1>(home, n, sh.bin.items1, sh);
-    else if (n <= 2 * kSortBlock) sort_in_shared<2>(home, n, sh.bin.items2, sh);
-    else if (n <= 4 * kSortBlock) sort_in_shared<4>(home, n, sh.bin.items4, sh);
-    else sort_in_shared<kLargeItems>(home, n, sh.bin.items16, sh);
+    if (n <= kSortBlock * kSmallItems) sort_in_shared<SmallBinSort, kSmallItems>(home, n, SmallBinSort(sh.bin.small), sh);
+    else sort_in_shared<LargeBinSort, kLargeItems>(home, n, LargeBinSort(sh.bin.large), sh);
   } else {
     sort_in_global(home, PairSpan{a.scratch + 2ull * range.x, a.scratch + 2ull * range.x + n}, n, sh);
   }

@@ -29,27 +29,14 @@ __device__ __forceinline__ std::uint64_t blend_order(const Records& r, std::uint
 // heap sort for the long runs of a planar scene seen head-on, where insertion would be quadratic.
 // `v` may point to global or shared memory.
 __device__ inline void sort_run(std::uint32_t* v, unsigned n, const Records& records) {
-  constexpr unsigned kShortRun = 16;
-  if (n <= kShortRun) {
-    // Every order read first (independent loads, one wait), then insertion sort in registers.
-    std::uint64_t key[kShortRun];
-    std::uint32_t value[kShortRun];
-    for (unsigned a = 0; a < n; ++a) {
-      value[a] = v[a];
-      key[a] = blend_order(records, value[a]);
-    }
+  if (n <= 16) {
     for (unsigned a = 1; a < n; ++a) {
-      const std::uint64_t k = key[a];
-      const std::uint32_t x = value[a];
+      const std::uint32_t x = v[a];
+      const std::uint64_t key = blend_order(records, x);
       unsigned b = a;
-      for (; b > 0 && key[b - 1] > k; --b) {
-        key[b] = key[b - 1];
-        value[b] = value[b - 1];
-      }
-      key[b] = k;
-      value[b] = x;
+      for (; b > 0 && blend_order(records, v[b - 1]) > key; --b) v[b] = v[b - 1];
+      v[b] = x;
     }
-    for (unsigned a = 0; a < n; ++a) v[a] = value[a];
     return;
   }
   auto sift = [v, records](unsigned root, unsigned size) {
