@@ -485,12 +485,13 @@ class CudaRendererImpl final : public CudaRenderer {
     return fullest * blend_resident_blocks_ > last_pairs;
   }
 
-  // Whether sorting per bin (launch_bin_sort) pays over CUB's radix sort of the whole frame:
-  // on frames of at most kBinSortMostBins bins (its count and scatter passes keep a histogram
-  // of every bin in shared memory) whose bins hold few enough pairs to be sorted there (a bin
-  // of more than 2,048 sorts in global memory, slower than CUB's passes). docs/PERFORMANCE.md
-  // v16 has the measurements. Judged on the last frame's bin pairs: the emission that this
-  // decides comes before this frame's count.
+  // Whether sorting per bin (launch_bin_sort) pays over CUB's radix sort of the whole frame.
+  // Measured on an H200 (docs/PERFORMANCE.md, v16): sort + ranges 16-20 us shorter at 1080p
+  // on pc_biker and pc_playbot (2,040 bins of 200-400 pairs), as long or longer at 4K (8,160
+  // bins: its count and scatter passes grow with the pairs while CUB's passes stay latency-
+  // bound), and 0.1 ms longer on 7 x pc_playbot at 1080p (about 700 pairs per bin; bins of
+  // more than 2,048 sort in global memory). Judged on the last frame's bin pairs: the emission
+  // that this decides comes before this frame's count.
   bool bin_sort_pays(std::uint64_t bins) const {
     if (bin_sort_ != kAuto) return bin_sort_ == kAlways;
     return bins <= kBinSortMostBins && last_bin_pairs_ <= kBinSortMostPairsPerBin * bins;
@@ -805,7 +806,7 @@ class CudaRendererImpl final : public CudaRenderer {
   Mode bin_sort_ = kAuto;        // binned frames with compact keys sort per bin (launch_bin_sort)
   bool bin_sort_frame_ = false;  // this frame does
   std::uint64_t last_bin_pairs_ = 0;  // the last frame's pairs if it was binned
-  static constexpr std::uint64_t kBinSortMostBins = 12000;         // bin_sort_pays (kHistogramBins)
+  static constexpr std::uint64_t kBinSortMostBins = 4096;          // bin_sort_pays
   static constexpr std::uint64_t kBinSortMostPairsPerBin = 512;
   std::uint64_t blend_resident_blocks_ = 1;  // warp-blend blocks the device runs at once
   cuda::KeyFormat key_format_;           // this frame's
