@@ -486,7 +486,7 @@ class CudaRendererImpl final : public CudaRenderer {
   }
 
   // Whether sorting per bin (launch_bin_sort) pays over CUB's radix sort of the whole frame.
-  // Measured on an H200 (docs/PERFORMANCE.md, v16): sort + ranges 16-20 us shorter at 1080p
+  // Measured on an H200 (docs/PERFORMANCE.md, v16): sort + ranges 18-41 us shorter at 1080p
   // on pc_biker and pc_playbot (2,040 bins of 200-400 pairs), as long or longer at 4K (8,160
   // bins: its count and scatter passes grow with the pairs while CUB's passes stay latency-
   // bound), and 0.1 ms longer on 7 x pc_playbot at 1080p (about 700 pairs per bin; bins of
