@@ -8,9 +8,11 @@
 #include <cub/block/block_radix_sort.cuh>
 
 #include <algorithm>
+#include <string>
 
 #include "bins.cuh"
 #include "device_common.cuh"
+#include "flashgs/error.h"
 #include "pipeline.h"
 #include "sort_order.cuh"
 
@@ -18,10 +20,8 @@ namespace flashgs {
 namespace cuda {
 namespace {
 
-// Count and scatter passes: a block of 256 threads takes 4 pairs per thread.
+// The scan and scatter passes: blocks of 256 threads.
 constexpr int kPassBlock = 256;
-constexpr int kPassItems = 4;
-constexpr unsigned kPassPairs = kPassBlock * kPassItems;
 constexpr unsigned kNoBin = 0xffffffffu;
 
 // The per-bin sort: a block of 4 warps. A bin that fits sorts in registers and shared memory
@@ -72,6 +72,15 @@ __device__ __forceinline__ unsigned block_exclusive_sum(unsigned value, unsigned
   return before + inclusive - value;
 }
 
+// The frame's pairs as the device counted them, or 0 when emission overflowed a capacity: the
+// host then grows the buffers and runs the frame again, and this one blends nothing rather
+// than reading records that were never written.
+__device__ __forceinline__ std::uint64_t frame_pairs(const FrameCounters* counters, std::uint64_t pair_capacity,
+                                                     std::uint32_t record_capacity) {
+  const std::uint64_t pairs = counters->pairs;
+  return pairs > pair_capacity || counters->records > record_capacity ? 0 : pairs;
+}
+
 // The block of the counting pass that finishes last turns the counts into each bin's range
 // and first free place (all threads of every block call this once their counts are added).
 __device__ void finish_count(unsigned bins, std::uint32_t* fill, uint2* __restrict__ bin_ranges,
@@ -111,126 +120,89 @@ __device__ void finish_count(unsigned bins, std::uint32_t* fill, uint2* __restri
   }
 }
 
-// A block's pairs in a frame of few bins: kPassBlock x kHistogramItems, counted per bin in
-// shared memory, so that global memory sees one atomic per bin the block touches rather than
-// about one per pair (hot bins serialise those).
-constexpr int kHistogramItems = 8;
-constexpr unsigned kHistogramPairs = kPassBlock * kHistogramItems;
-constexpr unsigned kHistogramBins = 12000;  // 47 KB of counters (a 4K frame has 8,160 bins)
+// The counting pass and the scatter pass take the pairs in chunks of kChunkPairs.
+constexpr int kChunkItems = 8;
+constexpr unsigned kChunkPairs = kPassBlock * kChunkItems;
 
-// This block's pairs per bin in `hist` (bins long); keys and bins of its pairs in registers.
-__device__ void block_histogram(std::uint64_t pairs, const std::uint32_t* __restrict__ keys, int depth_bits,
-                                unsigned bins, unsigned* hist, std::uint32_t (&key)[kHistogramItems],
-                                unsigned (&bin)[kHistogramItems]) {
-  for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) hist[b] = 0;
-  const std::uint64_t first = static_cast<std::uint64_t>(blockIdx.x) * kHistogramPairs + threadIdx.x;
+// Thread t's pairs of a chunk: keys, and bins (kNoBin past the frame's pairs).
+__device__ __forceinline__ void load_chunk(std::uint64_t chunk, std::uint64_t pairs, const std::uint32_t* __restrict__ keys,
+                                           int depth_bits, std::uint32_t (&key)[kChunkItems],
+                                           unsigned (&bin)[kChunkItems]) {
+  const std::uint64_t first = chunk * kChunkPairs + threadIdx.x;
 #pragma unroll
-  for (int k = 0; k < kHistogramItems; ++k) {
+  for (int k = 0; k < kChunkItems; ++k) {
     const std::uint64_t i = first + k * kPassBlock;
     key[k] = i < pairs ? keys[i] : 0u;
     bin[k] = i < pairs ? key[k] >> depth_bits : kNoBin;
   }
-  __syncthreads();
-#pragma unroll
-  for (int k = 0; k < kHistogramItems; ++k)
-    if (bin[k] != kNoBin) atomicAdd(&hist[bin[k]], 1u);
-  __syncthreads();
 }
 
-// The counting pass with a shared histogram (bins <= kHistogramBins).
-__global__ void __launch_bounds__(kPassBlock) bin_count_shared_kernel(std::uint64_t pairs,
-                                                                      const std::uint32_t* __restrict__ keys,
-                                                                      int depth_bits, unsigned bins, std::uint32_t* fill,
-                                                                      uint2* __restrict__ bin_ranges,
-                                                                      FrameCounters* counters) {
-  extern __shared__ unsigned hist[];
-  std::uint32_t key[kHistogramItems];
-  unsigned bin[kHistogramItems];
-  block_histogram(pairs, keys, depth_bits, bins, hist, key, bin);
-  for (unsigned b = threadIdx.x; b < bins; b += kPassBlock)
-    if (hist[b] != 0) atomicAdd(&fill[b], hist[b]);
-  finish_count(bins, fill, bin_ranges, counters);
-}
-
-// The scatter pass with a shared histogram: one global atomic per bin reserves the block's
-// places there, shared atomics hand them out.
-__global__ void __launch_bounds__(kPassBlock) bin_scatter_shared_kernel(std::uint64_t pairs,
-                                                                        const std::uint32_t* __restrict__ keys,
-                                                                        const std::uint32_t* __restrict__ values,
-                                                                        int depth_bits, unsigned bins,
-                                                                        std::uint32_t* fill,
-                                                                        std::uint32_t* __restrict__ bin_keys,
-                                                                        std::uint32_t* __restrict__ bin_values) {
-  extern __shared__ unsigned hist[];
-  std::uint32_t key[kHistogramItems], value[kHistogramItems];
-  unsigned bin[kHistogramItems];
-  const std::uint64_t first = static_cast<std::uint64_t>(blockIdx.x) * kHistogramPairs + threadIdx.x;
+// The counting pass: each block counts its chunks' pairs per bin in shared memory and adds
+// them to the bins with one global atomic per bin it met (hot bins serialise atomics per pair).
+__global__ void __launch_bounds__(kPassBlock) bin_count_kernel(FrameCounters* counters, std::uint64_t pair_capacity,
+                                                               std::uint32_t record_capacity,
+                                                               const std::uint32_t* __restrict__ keys, int depth_bits,
+                                                               unsigned bins, std::uint32_t* fill,
+                                                               uint2* __restrict__ bin_ranges) {
+  extern __shared__ unsigned hist[];  // [bins]
+  const std::uint64_t pairs = frame_pairs(counters, pair_capacity, record_capacity);
+  const std::uint64_t chunks = (pairs + kChunkPairs - 1) / kChunkPairs;
+  if (blockIdx.x < chunks) {  // block-uniform
+    for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) hist[b] = 0;
+    __syncthreads();
+    for (std::uint64_t chunk = blockIdx.x; chunk < chunks; chunk += gridDim.x) {
+      std::uint32_t key[kChunkItems];
+      unsigned bin[kChunkItems];
+      load_chunk(chunk, pairs, keys, depth_bits, key, bin);
 #pragma unroll
-  for (int k = 0; k < kHistogramItems; ++k) {
-    const std::uint64_t i = first + k * kPassBlock;
-    value[k] = i < pairs ? values[i] : 0u;
-  }
-  block_histogram(pairs, keys, depth_bits, bins, hist, key, bin);
-  for (unsigned b = threadIdx.x; b < bins; b += kPassBlock)
-    if (hist[b] != 0) hist[b] = atomicAdd(&fill[b], hist[b]);
-  __syncthreads();
-#pragma unroll
-  for (int k = 0; k < kHistogramItems; ++k)
-    if (bin[k] != kNoBin) {
-      const unsigned place = atomicAdd(&hist[bin[k]], 1u);
-      bin_keys[place] = key[k];
-      bin_values[place] = value[k];
+      for (int k = 0; k < kChunkItems; ++k)
+        if (bin[k] != kNoBin) atomicAdd(&hist[bin[k]], 1u);
     }
-}
-
-// The counting pass of a frame of many bins: pairs per bin by warp-aggregated atomics.
-__global__ void __launch_bounds__(kPassBlock) bin_count_kernel(std::uint64_t pairs, const std::uint32_t* __restrict__ keys,
-                                                               int depth_bits, unsigned bins, std::uint32_t* fill,
-                                                               uint2* __restrict__ bin_ranges, FrameCounters* counters) {
-  const std::uint64_t first = static_cast<std::uint64_t>(blockIdx.x) * kPassPairs + threadIdx.x;
-  unsigned bin[kPassItems];
-#pragma unroll
-  for (int k = 0; k < kPassItems; ++k) {
-    const std::uint64_t i = first + k * kPassBlock;
-    bin[k] = i < pairs ? keys[i] >> depth_bits : kNoBin;
-  }
-#pragma unroll
-  for (int k = 0; k < kPassItems; ++k) {
-    const unsigned peers = __match_any_sync(kFullMask, bin[k]);
-    if (bin[k] != kNoBin && lane_id() == static_cast<unsigned>(__ffs(peers) - 1)) atomicAdd(&fill[bin[k]], __popc(peers));
+    __syncthreads();
+    for (unsigned b = threadIdx.x; b < bins; b += kPassBlock)
+      if (hist[b] != 0) atomicAdd(&fill[b], hist[b]);
   }
   finish_count(bins, fill, bin_ranges, counters);
 }
 
-// The scatter pass of a frame of many bins: each pair to its bin's next free place (the
-// order within a bin is whatever the atomics give; the bin sort makes it exact).
-__global__ void __launch_bounds__(kPassBlock) bin_scatter_kernel(std::uint64_t pairs, const std::uint32_t* __restrict__ keys,
+// The scatter pass: each block takes chunks, counts a chunk's pairs per bin in shared memory,
+// reserves its places in each bin with one global atomic and hands them out with shared
+// atomics. The order within a bin is whatever the atomics give; the bin sort makes it exact.
+__global__ void __launch_bounds__(kPassBlock) bin_scatter_kernel(const FrameCounters* counters,
+                                                                 std::uint64_t pair_capacity,
+                                                                 std::uint32_t record_capacity,
+                                                                 const std::uint32_t* __restrict__ keys,
                                                                  const std::uint32_t* __restrict__ values,
-                                                                 int depth_bits, std::uint32_t* fill,
+                                                                 int depth_bits, unsigned bins, std::uint32_t* fill,
                                                                  std::uint32_t* __restrict__ bin_keys,
                                                                  std::uint32_t* __restrict__ bin_values) {
-  const std::uint64_t first = static_cast<std::uint64_t>(blockIdx.x) * kPassPairs + threadIdx.x;
-  std::uint32_t key[kPassItems], value[kPassItems];
+  extern __shared__ unsigned hist[];  // [bins]
+  const std::uint64_t pairs = frame_pairs(counters, pair_capacity, record_capacity);
+  const std::uint64_t chunks = (pairs + kChunkPairs - 1) / kChunkPairs;
+  for (std::uint64_t chunk = blockIdx.x; chunk < chunks; chunk += gridDim.x) {  // block-uniform
+    for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) hist[b] = 0;
+    std::uint32_t key[kChunkItems], value[kChunkItems];
+    unsigned bin[kChunkItems];
+    load_chunk(chunk, pairs, keys, depth_bits, key, bin);
+    const std::uint64_t first = chunk * kChunkPairs + threadIdx.x;
 #pragma unroll
-  for (int k = 0; k < kPassItems; ++k) {
-    const std::uint64_t i = first + k * kPassBlock;
-    key[k] = i < pairs ? keys[i] : 0u;
-    value[k] = i < pairs ? values[i] : 0u;
-  }
+    for (int k = 0; k < kChunkItems; ++k) value[k] = bin[k] != kNoBin ? values[first + k * kPassBlock] : 0u;
+    __syncthreads();
 #pragma unroll
-  for (int k = 0; k < kPassItems; ++k) {
-    const bool real = first + k * kPassBlock < pairs;
-    const unsigned bin = real ? key[k] >> depth_bits : kNoBin;
-    const unsigned peers = __match_any_sync(kFullMask, bin);
-    const unsigned leader = __ffs(peers) - 1;
-    unsigned base = 0;
-    if (real && lane_id() == leader) base = atomicAdd(&fill[bin], __popc(peers));
-    base = __shfl_sync(kFullMask, base, leader);
-    if (real) {
-      const unsigned place = base + __popc(peers & lanes_below());
-      bin_keys[place] = key[k];
-      bin_values[place] = value[k];
-    }
+    for (int k = 0; k < kChunkItems; ++k)
+      if (bin[k] != kNoBin) atomicAdd(&hist[bin[k]], 1u);
+    __syncthreads();
+    for (unsigned b = threadIdx.x; b < bins; b += kPassBlock)
+      if (hist[b] != 0) hist[b] = atomicAdd(&fill[b], hist[b]);
+    __syncthreads();
+#pragma unroll
+    for (int k = 0; k < kChunkItems; ++k)
+      if (bin[k] != kNoBin) {
+        const unsigned place = atomicAdd(&hist[bin[k]], 1u);
+        bin_keys[place] = key[k];
+        bin_values[place] = value[k];
+      }
+    __syncthreads();  // hist is cleared for the next chunk
   }
 }
 
@@ -560,35 +532,32 @@ __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
 
 }  // namespace
 
-void launch_bin_sort(std::uint64_t pairs, int tiles_x, int tiles_y, const FrameBuffers& b, unsigned shared_pairs,
-                     cudaStream_t stream) {
+// Grids of the counting and scatter passes, sized on the host before the pair count is known:
+// the scatter pass takes a 4K frame's chunks one per block; a counting block takes several
+// chunks, so that fewer blocks add their counts to every bin.
+constexpr unsigned kScatterBlocks = 2048;
+constexpr unsigned kCountBlocks = 512;
+
+void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned shared_pairs, cudaStream_t stream) {
   const unsigned bins = static_cast<unsigned>(b.bins.x) * static_cast<unsigned>(b.bins.y);
   if (bins == 0) return;
+  if (bins > kBinSortMaxBins)
+    throw Error("cuda renderer: internal error, a bin sort of " + std::to_string(bins) + " bins (at most " +
+                std::to_string(kBinSortMaxBins) + ")");
   shared_pairs = std::min(shared_pairs, kBinSortSharedPairsMax);
-  if (pairs == 0) {
-    check_cuda(cudaMemsetAsync(b.tile_ranges, 0, bins * sizeof(uint2), stream), "bin range reset");
-  } else {
-    const std::uint32_t* keys = reinterpret_cast<const std::uint32_t*>(b.keys[0]);
-    const int depth_bits = b.key_format.depth_bits;
-    check_cuda(cudaMemsetAsync(b.bin_fill, 0, bins * sizeof(std::uint32_t), stream), "bin count reset");
-    if (bins <= kHistogramBins) {
-      const unsigned blocks = static_cast<unsigned>((pairs + kHistogramPairs - 1) / kHistogramPairs);
-      const std::size_t hist_bytes = bins * sizeof(unsigned);
-      bin_count_shared_kernel<<<blocks, kPassBlock, hist_bytes, stream>>>(pairs, keys, depth_bits, bins, b.bin_fill,
-                                                                          b.tile_ranges, b.counters);
-      check_cuda(cudaGetLastError(), "bin count kernel launch");
-      bin_scatter_shared_kernel<<<blocks, kPassBlock, hist_bytes, stream>>>(pairs, keys, b.pair_values, depth_bits, bins,
-                                                                            b.bin_fill, b.values[1], b.values[0]);
-    } else {
-      const unsigned blocks = static_cast<unsigned>((pairs + kPassPairs - 1) / kPassPairs);
-      bin_count_kernel<<<blocks, kPassBlock, 0, stream>>>(pairs, keys, depth_bits, bins, b.bin_fill, b.tile_ranges,
-                                                          b.counters);
-      check_cuda(cudaGetLastError(), "bin count kernel launch");
-      bin_scatter_kernel<<<blocks, kPassBlock, 0, stream>>>(pairs, keys, b.pair_values, depth_bits, b.bin_fill,
-                                                            b.values[1], b.values[0]);
-    }
-    check_cuda(cudaGetLastError(), "bin scatter kernel launch");
-  }
+  const std::uint64_t most_chunks = std::max<std::uint64_t>(1, (b.pair_capacity + kChunkPairs - 1) / kChunkPairs);
+  const std::size_t hist_bytes = bins * sizeof(unsigned);
+  const std::uint32_t* keys = reinterpret_cast<const std::uint32_t*>(b.keys[0]);
+  const int depth_bits = b.key_format.depth_bits;
+  check_cuda(cudaMemsetAsync(b.bin_fill, 0, bins * sizeof(std::uint32_t), stream), "bin count reset");
+  bin_count_kernel<<<static_cast<unsigned>(std::min<std::uint64_t>(kCountBlocks, most_chunks)), kPassBlock, hist_bytes,
+                     stream>>>(b.counters, b.pair_capacity, b.record_capacity, keys, depth_bits, bins, b.bin_fill,
+                               b.tile_ranges);
+  check_cuda(cudaGetLastError(), "bin count kernel launch");
+  bin_scatter_kernel<<<static_cast<unsigned>(std::min<std::uint64_t>(kScatterBlocks, most_chunks)), kPassBlock,
+                       hist_bytes, stream>>>(b.counters, b.pair_capacity, b.record_capacity, keys, b.pair_values,
+                                             depth_bits, bins, b.bin_fill, b.values[1], b.values[0]);
+  check_cuda(cudaGetLastError(), "bin scatter kernel launch");
   BinSortArgs args{};
   args.bins = b.bins;
   args.tiles_x = tiles_x;

@@ -243,13 +243,18 @@ void launch_scan(std::size_t gaussians, const FrameBuffers& buffers, cudaStream_
 // buffer (0/1) holds the result.
 int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, cudaStream_t stream);
 // The sort of binned frames with compact keys, and what the ranges pass and the tile lists do
-// for the others: each pair counted into its bin and put there (unstable), then a block per
-// bin sorts it by key (in shared memory up to `shared_pairs` pairs, at most
-// kBinSortSharedPairsMax; a larger bin in its place in keys[1]), puts runs of equal keys in
-// the exact order and writes its tiles' lists. Fills tile_ranges (per bin), tile_lists and
-// tile_values from keys[0] and pair_values.
-void launch_bin_sort(std::uint64_t pairs, int tiles_x, int tiles_y, const FrameBuffers& buffers,
-                     unsigned shared_pairs, cudaStream_t stream);
+// for the others: a counting pass turns the pairs per bin into bin ranges, a scatter pass puts
+// each pair in its bin (unstable), then a block per bin sorts it by key (in shared memory up
+// to `shared_pairs` pairs, at most kBinSortSharedPairsMax; a larger bin in its place in
+// keys[1]), puts runs of equal keys in the exact order and writes
+// its tiles' lists. Fills tile_ranges (per bin), tile_lists and tile_values from keys[0] and
+// pair_values. The pair count is read on the device, so the host may queue this before it
+// knows the count; a frame whose emission overflowed a capacity comes out empty.
+void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& buffers, unsigned shared_pairs,
+                     cudaStream_t stream);
+// Bins a frame may have for the bin sort: its passes count pairs per bin in shared memory (48
+// KB; a 4K frame has 8,160 bins).
+constexpr unsigned kBinSortMaxBins = 12000;
 // Pairs a bin may hold to be sorted in shared memory (the default of launch_bin_sort's shared_pairs).
 constexpr unsigned kBinSortSharedPairsMax = 2048;
 // The ranges of the `bins` bins from the sorted keys in buffer `which`, and runs of equal keys

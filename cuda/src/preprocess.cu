@@ -514,10 +514,18 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     atomicAdd(&buf.counters->by_reason[threadIdx.x], block_counts[threadIdx.x]);
 }
 
+// Blocks of fused preprocess an SM should hold: the kernel is latency-bound (1.2 eligible
+// warps per scheduler at 3 blocks of 80 registers, pc_playbot 1080p on an H200), and 4 blocks
+// (64 registers, a few bytes spilled) made the project stage up to 14 us shorter there
+// (docs/PERFORMANCE.md, v17). Degree 3 (108 registers unbounded) and the separate-emission
+// kernel keep the compiler's choice.
+template <int DEGREE, bool FUSED>
+constexpr int kPreprocessBlocksPerSm = FUSED && DEGREE < 3 ? 4 : 1;
+
 // A block per chunk (kChunkSize Gaussians). With a chunk list (launch_chunk_list ran first)
 // the grid walks only the listed chunks; otherwise each block tests its own chunk.
 template <int DEGREE, bool FUSED>
-__global__ void __launch_bounds__(kBlock) preprocess_kernel(DeviceScene scene, FrameBuffers buf,
+__global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>) preprocess_kernel(DeviceScene scene, FrameBuffers buf,
                                                             PreprocessArgs args) {
   static_assert(kBlock == kChunkSize, "a block is one chunk");
   if (buf.chunk_list) {
