@@ -396,6 +396,22 @@ class CudaRendererImpl final : public CudaRenderer {
     return list;
   }
 
+  // A frame that wanted more deferred entries or work items than the list holds emitted the
+  // rest in preprocess, each box walked by the one warp that met it: with thousands of
+  // frame-wide Gaussians (kacytran_try at 4K wants 24k-29k items, 1.3 ms of project stage)
+  // that warp's serial walk set the kernel's length. The next frames get what this one
+  // wanted, and a quarter more.
+  void grow_deferred(std::uint64_t entries, std::uint64_t items) {
+    const cuda::DeferredList list = deferred_list();
+    if (entries > list.capacity) {
+      const std::uint64_t capacity = std::min<std::uint64_t>(entries + entries / 4, device_scene_.count);
+      deferred_footprints_.reserve(capacity * sizeof(gm::Footprint), "deferred-Gaussian footprints");
+      deferred_records_.reserve(capacity * sizeof(std::uint32_t), "deferred-Gaussian records");
+      deferred_hits_.reserve(capacity * sizeof(std::uint32_t), "deferred-Gaussian hits");
+    }
+    if (items > list.item_capacity) deferred_items_.reserve((items + items / 4) * sizeof(uint2), "deferred work items");
+  }
+
   // Blend records the buffers hold: compact ones need an id each as well.
   std::uint32_t record_capacity() const {
     std::size_t records = blend_.bytes() / sizeof(cuda::BlendGaussian);
@@ -759,6 +775,8 @@ class CudaRendererImpl final : public CudaRenderer {
       if (attempt > 0) throw Error("cuda renderer: internal error, pair count changed between identical runs");
     }
     if (!queue_before_count) queue_after_count(frame, pairs);
+    if (args.warp_cooperative && fused)
+      grow_deferred(readback_->counters.deferred, readback_->counters.deferred_items);
     last_tiles_ = tiles;
     last_bin_pairs_ = binned ? pairs : 0;
     last_frame_binned_ = binned;
