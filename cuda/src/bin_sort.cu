@@ -20,7 +20,7 @@ namespace flashgs {
 namespace cuda {
 namespace {
 
-// The scan and scatter passes: blocks of 256 threads.
+// The counting and scatter passes: blocks of 256 threads.
 constexpr int kPassBlock = 256;
 constexpr unsigned kNoBin = 0xffffffffu;
 
