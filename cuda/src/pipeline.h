@@ -246,9 +246,8 @@ int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, c
 // for the others: a counting pass turns the pairs per bin into bin ranges, a scatter pass puts
 // each pair in its bin (unstable), then a block per bin sorts it by key (in shared memory up
 // to `shared_pairs` pairs, at most kBinSortSharedPairsMax; a larger bin in its place in
-// keys[1]), puts runs of equal keys in the exact order and writes
-// its tiles' lists. Fills tile_ranges (per bin), tile_lists and tile_values from keys[0] and
-// pair_values. The pair count is read on the device, so the host may queue this before it
+// keys[1]), puts runs of equal keys in the exact order and writes its tiles' lists. Fills
+// tile_ranges (per bin), tile_lists and tile_values from keys[0] and pair_values. The pair count is read on the device, so the host may queue this before it
 // knows the count; a frame whose emission overflowed a capacity comes out empty.
 void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& buffers, unsigned shared_pairs,
                      cudaStream_t stream);

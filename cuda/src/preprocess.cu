@@ -525,8 +525,8 @@ constexpr int kPreprocessBlocksPerSm = FUSED && DEGREE < 3 ? 4 : 1;
 // A block per chunk (kChunkSize Gaussians). With a chunk list (launch_chunk_list ran first)
 // the grid walks only the listed chunks; otherwise each block tests its own chunk.
 template <int DEGREE, bool FUSED>
-__global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>) preprocess_kernel(DeviceScene scene, FrameBuffers buf,
-                                                            PreprocessArgs args) {
+__global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
+    preprocess_kernel(DeviceScene scene, FrameBuffers buf, PreprocessArgs args) {
   static_assert(kBlock == kChunkSize, "a block is one chunk");
   if (buf.chunk_list) {
     const unsigned listed = buf.counters->listed_chunks;
