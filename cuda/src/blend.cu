@@ -102,13 +102,16 @@ __device__ __forceinline__ float exp2_approx(float x) {
   return y;
 }
 
-// A Gaussian as the EXP2 loop reads it from shared memory: u and v at the region's first
-// pixel (computed once by the lane that loaded it), so a lane's pixel costs one FMA for each.
-// Three 16-byte reads per Gaussian: the colour is read once for both pixels of a lane.
+// A Gaussian as the EXP2 loop reads it from shared memory: its log2 alpha as a polynomial
+// in the pixel's offset (lx, ly) from the region's centre, prepared once by the lane that
+// loaded it, so that a lane evaluates it for its row once (c0 = a0 + a1 ly + a2 ly^2,
+// c1 = b0 + b1 ly: three FMAs) and for each of its pixels with two (c0 + c1 lx + c2 lx^2).
+// Expanded about the centre, no term exceeds the exponent's range over the 8-pixel region
+// (the 0.3 px^2 dilation bounds the conic), so fp32 keeps it to ~1e-5 in log2 alpha.
 struct alignas(16) RegionGaussian {
-  float u0, v0, w1, w3;
-  float w0, w2, log2_opacity, pad0;
-  float red, green, blue, pad1;
+  float a0, a1, a2, b0;
+  float b1, c2, red, green;
+  float blue, pad0, pad1, pad2;
 };
 
 // A tile's blend records in list order, up to 32 at a time (lane j gets the j-th).
@@ -123,10 +126,10 @@ struct TileList {
   }
 };
 
-// The column a finished pixel moves to: every later Gaussian's alpha there is exactly 0 (q
-// overflows to infinity; a finite factor, so 0 * x stays 0 and no NaN appears), so it adds
-// nothing and keeps its transmittance, the background's weight, without a liveness test.
-constexpr float kFinishedX = 1e30f;
+// The column a finished pixel moves to: NaN, so every later Gaussian's exponent there is NaN,
+// fails the 1/255 cut and gives alpha 0, and the pixel keeps its transmittance, the
+// background's weight, without a liveness test in the loop.
+__device__ __forceinline__ float finished_column() { return __int_as_float(0x7fffffff); }
 
 // FlashGS render kernel, a warp per 64-pixel region of a tile: REGION_W x (64 / REGION_W)
 // pixels (16 x 4 strips or 8 x 8 quadrants, four warps per tile), each lane a pair of pixels
@@ -139,11 +142,12 @@ constexpr float kFinishedX = 1e30f;
 // EXP2 (the FlashGS arithmetic; the kernel is issue-bound): each lane first tests the
 // Gaussian it loaded against the region (exact ellipse-rectangle test of the alpha >= 1/255
 // ellipse, with a margin over the blend's rounding), so the loop visits only Gaussians that
-// can change one of the region's pixels; alpha = exp2(log2 o - q') from the pre-scaled
-// whitened rows, the 1/255 cut made on the exponent, FMAs throughout, no branch per pixel
-// (at least one lane of the warp passes the cut on almost every visit, so a branch skipped
-// nothing and cost its own instructions); a finished pixel moves to kFinishedX, so later
-// Gaussians add exactly nothing to it. Otherwise the arithmetic is the CPU's, term for term.
+// can change one of the region's pixels; alpha = exp2 of log2 alpha as a polynomial in the
+// pixel's offset (RegionGaussian), the 1/255 cut made on the exponent, FMAs throughout, no
+// branch per pixel (at least one lane of the warp passes the cut on almost every visit, so a
+// branch skipped nothing and cost its own instructions); a finished pixel's column becomes
+// NaN, so later Gaussians add exactly nothing to it. Otherwise the arithmetic is the CPU's:
+// the same alpha to ~1e-5, and its cut, clamp and stop rule.
 // Only the Gaussians that meet the region are staged, packed in list order, so the loop over
 // them is a counted one. Binned frames (BinGrid): the 4 blocks of a bin blend its tiles, each
 // from its own tile list (FrameBuffers::tile_lists).
@@ -174,8 +178,10 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const float region_mid_y = region_y0 + 0.5f * (kRegionH - 1), region_half_h = 0.5f * (kRegionH - 1);
   const int x0 = static_cast<int>(region_x0) + static_cast<int>(lane % kLanesX) * kLanePixelsX;
   const int y = static_cast<int>(region_y0) + static_cast<int>(lane / kLanesX);
-  float lane_x[kLanePixelsX];  // relative to the region's first pixel
-  const float lane_y = static_cast<float>(y) - region_y0;
+  // EXP2: the lane's pixels relative to the region's centre (the polynomial's origin).
+  const float region_mid_x = region_x0 + 0.5f * (REGION_W - 1);
+  float lane_x[kLanePixelsX];
+  const float lane_y = static_cast<float>(y) - region_mid_y;
   float t[kLanePixelsX], cr[kLanePixelsX], cg[kLanePixelsX], cb[kLanePixelsX];
   unsigned live = 0;  // bit p: pixel p still blending
 #pragma unroll
@@ -183,7 +189,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     cr[p] = cg[p] = cb[p] = 0.0f;
     t[p] = 1.0f;
     if (x0 + p < a.width && y < a.height) live |= 1u << p;
-    lane_x[p] = !EXP2 || (live & (1u << p)) ? static_cast<float>(x0 + p) - region_x0 : kFinishedX;
+    lane_x[p] = !EXP2 || (live & (1u << p)) ? static_cast<float>(x0 + p) - region_mid_x : finished_column();
   }
   const unsigned inside = live;
   TileList list;
@@ -203,7 +209,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     if constexpr (EXP2) {
       live = 0;
 #pragma unroll
-      for (int p = 0; p < kLanePixelsX; ++p) live |= lane_x[p] != kFinishedX ? 1u << p : 0u;
+      for (int p = 0; p < kLanePixelsX; ++p) live |= isnan(lane_x[p]) ? 0u : 1u << p;
     }
     if (!__any_sync(kFullMask, live)) break;
     if (!PIPELINED && lane < n) next = load_gaussian(a.gaussians + record);
@@ -226,11 +232,17 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       }
       const unsigned relevant = __ballot_sync(kFullMask, meets);
       if (meets) {
-        const float ox = next.mean_x - region_x0, oy = next.mean_y - region_y0;
-        batch[warp][__popc(relevant & ((1u << lane) - 1u))] =
-            RegionGaussian{-__fmaf_rn(next.w0, ox, next.w1 * oy), -__fmaf_rn(next.w2, ox, next.w3 * oy),
-                           next.w1, next.w3, next.w0, next.w2, next.opacity, 0.0f, next.red, next.green,
-                           next.blue, 0.0f};
+        // The whitened rows at the region's centre: (u0, v0), and log2 alpha there and around.
+        const float ox = next.mean_x - region_mid_x, oy = next.mean_y - region_mid_y;
+        const float u0 = -__fmaf_rn(next.w0, ox, next.w1 * oy), v0 = -__fmaf_rn(next.w2, ox, next.w3 * oy);
+        batch[warp][__popc(relevant & ((1u << lane) - 1u))] = RegionGaussian{
+            __fmaf_rn(-u0, u0, __fmaf_rn(-v0, v0, next.opacity)),
+            -2.0f * __fmaf_rn(next.w1, u0, next.w3 * v0),
+            -__fmaf_rn(next.w1, next.w1, next.w3 * next.w3),
+            -2.0f * __fmaf_rn(next.w0, u0, next.w2 * v0),
+            -2.0f * __fmaf_rn(next.w0, next.w1, next.w2 * next.w3),
+            -__fmaf_rn(next.w0, next.w0, next.w2 * next.w2),
+            next.red, next.green, next.blue, 0.0f, 0.0f, 0.0f};
       }
       staged = __popc(relevant);
     } else {
@@ -243,26 +255,28 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     for (unsigned j = 0; j < staged && (EXP2 || live); ++j) {
       const Staged& g = batch[warp][j];
       if constexpr (EXP2) {
-        const float uy = __fmaf_rn(g.w1, lane_y, g.u0), vy = __fmaf_rn(g.w3, lane_y, g.v0);
+        const float c0 = __fmaf_rn(__fmaf_rn(g.a2, lane_y, g.a1), lane_y, g.a0);
+        const float c1 = __fmaf_rn(g.b1, lane_y, g.b0), c2 = g.c2;
         const float red = g.red, green = g.green, blue = g.blue;
 #pragma unroll
         for (int p = 0; p < kLanePixelsX; ++p) {
-          const float u = __fmaf_rn(g.w0, lane_x[p], uy), v = __fmaf_rn(g.w2, lane_x[p], vy);
-          const float e = __fmaf_rn(-u, u, __fmaf_rn(-v, v, g.log2_opacity));  // log2 alpha
+          const float e = __fmaf_rn(__fmaf_rn(c2, lane_x[p], c1), lane_x[p], c0);  // log2 alpha
           // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the
           // FMA gives T (1 - alpha) with one rounding: with 1 - alpha exact (alpha >= 1/2),
           // the CPU's T, so the stop rule's decisions on stacked opaque layers are its own.
           const float alpha = e >= kLog2AlphaMin ? fminf(gm::kAlphaMax, exp2_approx(e)) : 0.0f;
           const float next_t = __fmaf_rn(-alpha, t[p], t[p]);
           // The CPU stops before a Gaussian that would take T below the minimum: it adds
-          // nothing, and T stays the background's weight (next_t = t >= the minimum after).
+          // nothing, and T stays the background's weight. The weight is what T loses, alpha T
+          // to within T's last bit (exactly alpha T's rounding for alpha <= 1/2), and 0 then.
           const bool stop = next_t < gm::kTransmittanceMin;
-          const float w = stop ? 0.0f : alpha * t[p];
+          const float kept_t = stop ? t[p] : next_t;
+          const float w = t[p] - kept_t;
           cr[p] = __fmaf_rn(red, w, cr[p]);
           cg[p] = __fmaf_rn(green, w, cg[p]);
           cb[p] = __fmaf_rn(blue, w, cb[p]);
-          t[p] = stop ? t[p] : next_t;
-          lane_x[p] = stop ? kFinishedX : lane_x[p];
+          t[p] = kept_t;
+          lane_x[p] = stop ? finished_column() : lane_x[p];
         }
       } else {
         // The whole region lies beyond the rows this Gaussian can reach: a warp-uniform skip.
