@@ -200,11 +200,14 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     const uint2 range = a.tile_ranges[bin];
     list = TileList{a.values, range.x, range.y};
   }
-  // This batch's records (n of them, lane j the j-th) and, PIPELINED, their Gaussians.
+  // This batch's records (n of them, lane j the j-th) and, PIPELINED, their Gaussians, and the
+  // next batch's records: read a batch early, so that loading its Gaussians waits for no read.
   unsigned record = 0;
   unsigned n = list.take(lane, record);
   BlendGaussian next{};
   if (PIPELINED && lane < n) next = load_gaussian(a.gaussians + record);
+  unsigned ahead_record = 0, ahead_n = 0;
+  if (PIPELINED) ahead_n = list.take(lane, ahead_record);
   while (n > 0) {
     if constexpr (EXP2) {
       live = 0;
@@ -218,13 +221,13 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     if constexpr (EXP2) {
       bool meets = false;
       const float cut = (next.opacity - kLog2AlphaMin) * 1.00001f + 1e-4f;  // q' of alpha = 1/255
+      const float conic_a = __fmaf_rn(next.w0, next.w0, next.w2 * next.w2);
+      const float conic_b = __fmaf_rn(next.w0, next.w1, next.w2 * next.w3);
+      const float conic_c = __fmaf_rn(next.w1, next.w1, next.w3 * next.w3);
       if (lane < n && cut > 0.0f) {
         const float w[4] = {next.w0, next.w1, next.w2, next.w3};
         // Fast divisions: the cut's margin covers their error (it moves the edge minimiser
         // along a flat valley, changing q to second order only).
-        const float conic_a = __fmaf_rn(next.w0, next.w0, next.w2 * next.w2);
-        const float conic_b = __fmaf_rn(next.w0, next.w1, next.w2 * next.w3);
-        const float conic_c = __fmaf_rn(next.w1, next.w1, next.w3 * next.w3);
         meets = gm::whitened_ellipse_meets_rect(w, __fdividef(-conic_b, conic_c), __fdividef(-conic_b, conic_a), cut,
                                                 region_x0 - next.mean_x,
                                                 region_x1 - next.mean_x,
@@ -238,10 +241,10 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
         batch[warp][__popc(relevant & ((1u << lane) - 1u))] = RegionGaussian{
             __fmaf_rn(-u0, u0, __fmaf_rn(-v0, v0, next.opacity)),
             -2.0f * __fmaf_rn(next.w1, u0, next.w3 * v0),
-            -__fmaf_rn(next.w1, next.w1, next.w3 * next.w3),
+            -conic_c,
             -2.0f * __fmaf_rn(next.w0, u0, next.w2 * v0),
-            -2.0f * __fmaf_rn(next.w0, next.w1, next.w2 * next.w3),
-            -__fmaf_rn(next.w0, next.w0, next.w2 * next.w2),
+            -2.0f * conic_b,
+            -conic_a,
             next.red, next.green, next.blue, 0.0f, 0.0f, 0.0f};
       }
       staged = __popc(relevant);
@@ -249,9 +252,17 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       batch[warp][lane] = next;
     }
     __syncwarp();
-    unsigned next_record = 0;
-    const unsigned next_n = list.take(lane, next_record);
-    if (PIPELINED && lane < next_n) next = load_gaussian(a.gaussians + next_record);
+    unsigned next_record = 0, next_n = 0;
+    if constexpr (PIPELINED) {
+      next_record = ahead_record;
+      next_n = ahead_n;
+      if (lane < next_n) next = load_gaussian(a.gaussians + next_record);
+      ahead_n = list.take(lane, ahead_record);
+    } else {
+      next_n = list.take(lane, next_record);
+    }
+    // Unrolled 4 times: more independent work between the loads and the transmittance chain.
+#pragma unroll 4
     for (unsigned j = 0; j < staged && (EXP2 || live); ++j) {
       const Staged& g = batch[warp][j];
       if constexpr (EXP2) {
