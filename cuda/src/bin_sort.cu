@@ -39,19 +39,9 @@ constexpr unsigned kDigits = 1u << kDigitBits;
 static_assert(kDigits == 2 * kSortBlock, "each thread scans two digits");
 // Loops over a bin load this many words per thread before using any, so that a bin sorted in
 // global memory waits for memory once per batch rather than once per word.
-constexpr int kBatch = 8;
+constexpr int kBatch = kWarpLoads;
 
 __device__ __forceinline__ unsigned lanes_below() { return (1u << lane_id()) - 1u; }
-
-// Lane l's words of kBatch groups of 32 from `first` (words at `end` and beyond read as 0).
-__device__ __forceinline__ void load_groups(const std::uint32_t* src, unsigned first, unsigned end,
-                                            std::uint32_t (&word)[kBatch]) {
-#pragma unroll
-  for (int g = 0; g < kBatch; ++g) {
-    const unsigned i = first + g * kWarp + lane_id();
-    word[g] = i < end ? src[i] : 0u;
-  }
-}
 
 // Exclusive prefix sum over the block of `value` (all threads call; `warp_totals` holds one
 // word per warp). Returns the block's total in `total`.
@@ -243,16 +233,6 @@ struct SortShared {
   unsigned list_counts[kSortWarps][4];
 };
 
-// Warp w's share of n pairs: [lo, hi), consecutive so that each pass is stable.
-struct WarpShare {
-  unsigned lo, hi;
-  __device__ explicit WarpShare(unsigned n) {
-    const unsigned per = (n + kSortWarps - 1) / kSortWarps, warp = threadIdx.x / kWarp;
-    lo = min(n, warp * per);
-    hi = min(n, lo + per);
-  }
-};
-
 __device__ __forceinline__ unsigned digit_of(std::uint32_t key, std::uint32_t low, int shift) {
   return ((key - low) >> shift) & (kDigits - 1);
 }
@@ -264,10 +244,10 @@ __device__ void radix_pass(PairSpan from, PairSpan to, unsigned n, std::uint32_t
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   for (unsigned d = threadIdx.x; d < kSortWarps * kDigits; d += kSortBlock) (&sh.counts[0][0])[d] = 0;
   __syncthreads();
-  const WarpShare share(n);
+  const WarpShare share(n, kSortWarps, threadIdx.x / kWarp);
   for (unsigned first = share.lo; first < share.hi; first += kBatch * kWarp) {  // warp-uniform
     std::uint32_t key[kBatch];
-    load_groups(from.keys, first, share.hi, key);
+    load_run(from.keys, first, share.hi, key);
 #pragma unroll
     for (int g = 0; g < kBatch; ++g) {
       const unsigned d = first + g * kWarp + lane < share.hi ? digit_of(key[g], low, shift) : kDigits;
@@ -301,8 +281,8 @@ __device__ void radix_pass(PairSpan from, PairSpan to, unsigned n, std::uint32_t
   __syncthreads();
   for (unsigned first = share.lo; first < share.hi; first += kBatch * kWarp) {  // warp-uniform
     std::uint32_t key[kBatch], value[kBatch];
-    load_groups(from.keys, first, share.hi, key);
-    load_groups(from.values, first, share.hi, value);
+    load_run(from.keys, first, share.hi, key);
+    load_run(from.values, first, share.hi, value);
 #pragma unroll
     for (int g = 0; g < kBatch; ++g) {
       const bool real = first + g * kWarp + lane < share.hi;
@@ -404,48 +384,11 @@ __device__ void order_ties(PairSpan span, unsigned n, const Records& records) {
   __syncthreads();
 }
 
-// The bin's four tile lists from its sorted values: each warp counts its share's values per
-// tile, then writes them after those of the warps before it.
+// The bin's four tile lists from its sorted values.
 __device__ void write_tile_lists(const BinSortArgs& a, unsigned bin, const std::uint32_t* values, const BinLists& lists,
                                  SortShared& sh) {
-  const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
-  const WarpShare share(lists.length);
-  unsigned count[4] = {0, 0, 0, 0};
-  for (unsigned first = share.lo; first < share.hi; first += kBatch * kWarp) {  // warp-uniform
-    std::uint32_t v[kBatch];
-    load_groups(values, first, share.hi, v);
-#pragma unroll
-    for (int g = 0; g < kBatch; ++g)
-#pragma unroll
-      for (int q = 0; q < 4; ++q) count[q] += __popc(__ballot_sync(kFullMask, carries(v[g], q)));
-  }
-  if (lane == 0)
-#pragma unroll
-    for (int q = 0; q < 4; ++q) sh.list_counts[warp][q] = count[q];
-  __syncthreads();
-  unsigned next[4], total[4];
-#pragma unroll
-  for (int q = 0; q < 4; ++q) {
-    next[q] = 0;
-    total[q] = 0;
-    for (unsigned w = 0; w < kSortWarps; ++w) {
-      if (w == warp) next[q] = total[q];
-      total[q] += sh.list_counts[w][q];
-    }
-  }
-  for (unsigned first = share.lo; first < share.hi; first += kBatch * kWarp) {  // warp-uniform
-    std::uint32_t v[kBatch];
-    load_groups(values, first, share.hi, v);
-#pragma unroll
-    for (int g = 0; g < kBatch; ++g)
-#pragma unroll
-      for (int q = 0; q < 4; ++q) {
-        const bool mine = carries(v[g], q);
-        const unsigned ballot = __ballot_sync(kFullMask, mine);
-        if (mine) lists.list(q)[next[q] + __popc(ballot & lanes_below())] = v[g] & kRecordMask;
-        next[q] += __popc(ballot);
-      }
-  }
+  unsigned total[4];
+  write_bin_lists<kSortWarps>(values, lists, sh.list_counts, total);
   record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, total, threadIdx.x);
 }
 

@@ -2,6 +2,7 @@
 // touches, and the pair value that carries them.
 #pragma once
 
+#include "device_common.cuh"
 #include "flashgs/gaussian_math.h"
 #include "pipeline.h"
 
@@ -60,6 +61,77 @@ struct BinLists {
 
 // Whether a binned pair value carries tile q of its bin.
 __device__ __forceinline__ bool carries(std::uint32_t value, int q) { return (value >> (kBinTileBitsShift + q)) & 1u; }
+
+// Counts a loaded run's values (those before `end`) per tile. Groups of 32 past the end are
+// skipped, a whole warp at once: a bin's share is often a few groups of the run.
+__device__ __forceinline__ void count_run_tiles(const std::uint32_t (&v)[kWarpLoads], unsigned first, unsigned end,
+                                                unsigned (&count)[4]) {
+#pragma unroll
+  for (int k = 0; k < kWarpLoads; ++k) {
+    if (first + k * kWarp >= end) break;
+#pragma unroll
+    for (int q = 0; q < 4; ++q) count[q] += __popc(__ballot_sync(kFullMask, carries(v[k], q)));
+  }
+}
+
+// Appends a loaded run's records (values before `end`) to the tile lists in order: tile q's
+// next at place next[q].
+__device__ __forceinline__ void place_run_tiles(const BinLists& lists, const std::uint32_t (&v)[kWarpLoads],
+                                                unsigned first, unsigned end, unsigned (&next)[4]) {
+  const unsigned lanes_below = (1u << lane_id()) - 1u;
+#pragma unroll
+  for (int k = 0; k < kWarpLoads; ++k) {
+    if (first + k * kWarp >= end) break;
+#pragma unroll
+    for (int q = 0; q < 4; ++q) {
+      const bool mine = carries(v[k], q);
+      const unsigned ballot = __ballot_sync(kFullMask, mine);
+      if (mine) lists.list(q)[next[q] + __popc(ballot & lanes_below)] = v[k] & kRecordMask;
+      next[q] += __popc(ballot);
+    }
+  }
+}
+
+// Writes a bin's values (`values`, lists.length of them, in bin order) into its four tile
+// lists in that order, tile q getting the records of the values that carry it, and returns the
+// lists' lengths in `total`. WARPS warps take consecutive shares (with WARPS > 1, all threads
+// of the block, whose warps they must be, call): a first pass counts each share's values per
+// tile into `warp_counts` (shared memory), so that the second knows where its values go.
+template <int WARPS>
+__device__ void write_bin_lists(const std::uint32_t* values, const BinLists& lists, unsigned (*warp_counts)[4],
+                                unsigned (&total)[4]) {
+  const unsigned warp = WARPS == 1 ? 0u : threadIdx.x / kWarp;
+  const WarpShare share(lists.length, WARPS, warp);
+  unsigned next[4] = {0, 0, 0, 0};
+  if constexpr (WARPS > 1) {
+    unsigned count[4] = {0, 0, 0, 0};
+    for (unsigned first = share.lo; first < share.hi; first += kWarpRun) {  // warp-uniform
+      std::uint32_t v[kWarpLoads];
+      load_run(values, first, share.hi, v);
+      count_run_tiles(v, first, share.hi, count);
+    }
+    if (lane_id() == 0)
+#pragma unroll
+      for (int q = 0; q < 4; ++q) warp_counts[warp][q] = count[q];
+    __syncthreads();
+#pragma unroll
+    for (int q = 0; q < 4; ++q) {
+      total[q] = 0;
+      for (unsigned w = 0; w < WARPS; ++w) {
+        if (w == warp) next[q] = total[q];
+        total[q] += warp_counts[w][q];
+      }
+    }
+  }
+  for (unsigned first = share.lo; first < share.hi; first += kWarpRun) {  // warp-uniform
+    std::uint32_t v[kWarpLoads];
+    load_run(values, first, share.hi, v);
+    place_run_tiles(lists, v, first, share.hi, next);
+  }
+  if constexpr (WARPS == 1)
+#pragma unroll
+    for (int q = 0; q < 4; ++q) total[q] = next[q];
+}
 
 // Thread q < 4 records tile q's list of `bin`, `placed[q]` records long (tiles beyond the
 // image's edge have none).

@@ -502,16 +502,17 @@ class CudaRendererImpl final : public CudaRenderer {
   }
 
   // Whether sorting per bin (launch_bin_sort) pays over CUB's radix sort of the whole frame.
-  // Measured on an H200 (docs/PERFORMANCE.md, v16): sort + ranges 18-41 us shorter at 1080p
-  // on pc_biker and pc_playbot (2,040 bins of 200-400 pairs), as long or longer at 4K (8,160
-  // bins: its count and scatter passes grow with the pairs while CUB's passes stay latency-
-  // bound), and 0.1 ms longer on 7 x pc_playbot at 1080p (about 700 pairs per bin; bins of
-  // more than 2,048 sort in global memory). Judged on the last frame's bin pairs: the emission
-  // that this decides comes before this frame's count.
+  // Measured on an H200 (docs/PERFORMANCE.md, v16 and v19): sort + ranges 18-41 us shorter at
+  // 1080p on pc_biker and pc_playbot (2,040 bins of 200-400 pairs); at 4K (8,160 bins), since
+  // the bin blocks write their tile lists without idle groups, 6-24 us shorter on pc_biker and
+  // the same on pc_playbot, with no wait for the host between emission and sort; 0.1 ms longer
+  // on 7 x pc_playbot at 1080p (about 700 pairs per bin; bins of more than 2,048 sort in global
+  // memory). Judged on the last frame's bin pairs: the emission that this decides comes before
+  // this frame's count.
   bool bin_sort_pays(std::uint64_t bins) const {
     if (bins > cuda::kBinSortMaxBins) return false;  // beyond the scatter pass's shared histogram
     if (bin_sort_ != kAuto) return bin_sort_ == kAlways;
-    return bins <= kBinSortMostBins && last_bin_pairs_ <= kBinSortMostPairsPerBin * bins;
+    return last_bin_pairs_ <= kBinSortMostPairsPerBin * bins;
   }
 
   // Stage times of the frame whose events are in `set` (its work must have finished).
@@ -859,7 +860,6 @@ class CudaRendererImpl final : public CudaRenderer {
   Mode bin_sort_ = kAuto;        // binned frames with compact keys sort per bin (launch_bin_sort)
   bool bin_sort_frame_ = false;  // this frame does
   std::uint64_t last_bin_pairs_ = 0;  // the last frame's pairs if it was binned
-  static constexpr std::uint64_t kBinSortMostBins = 4096;          // bin_sort_pays
   static constexpr std::uint64_t kBinSortMostPairsPerBin = 512;
   std::uint64_t blend_resident_blocks_ = 1;  // warp-blend blocks the device runs at once
   cuda::KeyFormat key_format_;           // this frame's

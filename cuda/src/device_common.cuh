@@ -23,6 +23,32 @@ __device__ __forceinline__ unsigned warp_inclusive_sum(unsigned v) {
   return v;
 }
 
+// Words a lane loads at once when a warp walks an array (all in flight before any is used).
+constexpr int kWarpLoads = 8;
+constexpr unsigned kWarpRun = kWarp * kWarpLoads;
+
+// The run of words from `first` (up to `end`; words there and beyond read as 0): lane l gets
+// first + k * 32 + l in word[k].
+__device__ __forceinline__ void load_run(const std::uint32_t* src, unsigned first, unsigned end,
+                                         std::uint32_t (&word)[kWarpLoads]) {
+#pragma unroll
+  for (int k = 0; k < kWarpLoads; ++k) {
+    const unsigned i = first + k * kWarp + lane_id();
+    word[k] = i < end ? src[i] : 0u;
+  }
+}
+
+// Warp `warp` of `warps`' share of n items: [lo, hi), consecutive, so that walking the shares
+// in warp order walks the items in order.
+struct WarpShare {
+  unsigned lo, hi;
+  __device__ WarpShare(unsigned n, unsigned warps, unsigned warp) {
+    const unsigned per = (n + warps - 1) / warps;
+    lo = min(n, warp * per);
+    hi = min(n, lo + per);
+  }
+};
+
 // The depth part of a Gaussian's sort keys in format k (see KeyFormat): the float's bits
 // (positive floats order like their bit patterns), or its clamped bin.
 __device__ __forceinline__ std::uint32_t sort_depth(const KeyFormat& k, float depth) {

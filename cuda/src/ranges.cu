@@ -50,14 +50,11 @@ __global__ void __launch_bounds__(kBlock) tile_max_kernel(std::uint64_t tiles, c
   }
 }
 
-// The tile-list pass. A warp walks values in runs of 32 x kListLoads, every load of a run in
-// flight at once. A warp lists a small bin alone; a dense bin gets a block whose warps take
-// a run each per round, so that a bin of 10^4 values costs a few rounds rather than one
-// warp's serial walk.
+// The tile-list pass (bins.cuh, write_bin_lists). A warp lists a small bin alone; a dense bin
+// gets a block whose warps take a share each, so that a bin of 10^4 values costs a few runs per
+// warp rather than one warp's serial walk.
 constexpr int kListWarps = 8;
-constexpr int kListLoads = 8;
-constexpr unsigned kListRun = kWarp * kListLoads;
-constexpr unsigned kSmallBin = 2 * kListRun;  // values of a bin one warp lists alone
+constexpr unsigned kSmallBin = 2 * kWarpRun;  // values of a bin one warp lists alone
 
 // What both tile-list kernels read and write (FrameBuffers' fields of the same names).
 struct BinListArgs {
@@ -72,30 +69,6 @@ struct BinListArgs {
   FrameCounters* counters;
 };
 
-// The run of values from `first` (up to `end`), lane l holding first + k * 32 + l in v[k].
-__device__ __forceinline__ void load_run(const std::uint32_t* values, unsigned first, unsigned end, unsigned lane,
-                                         std::uint32_t (&v)[kListLoads]) {
-#pragma unroll
-  for (int k = 0; k < kListLoads; ++k) {
-    const unsigned i = first + k * kWarp + lane;
-    v[k] = i < end ? values[i] : 0u;
-  }
-}
-
-// Appends a loaded run's records to the bin's tile lists in order: tile q's next from place next[q].
-__device__ __forceinline__ void place_run(const BinLists& lists, const std::uint32_t (&v)[kListLoads], unsigned lane,
-                                          unsigned (&next)[4]) {
-#pragma unroll
-  for (int k = 0; k < kListLoads; ++k)
-#pragma unroll
-    for (int q = 0; q < 4; ++q) {
-      const bool mine = carries(v[k], q);
-      const unsigned ballot = __ballot_sync(kFullMask, mine);
-      if (mine) lists.list(q)[next[q] + __popc(ballot & ((1u << lane) - 1u))] = v[k] & kRecordMask;
-      next[q] += __popc(ballot);
-    }
-}
-
 // Binned frames: each tile's list, the records of its bin's values that carry its bit, in
 // bin order. A warp per bin lists the small bins and leaves the dense ones to
 // dense_bin_lists_kernel (FrameBuffers::dense_bins).
@@ -109,54 +82,21 @@ __global__ void __launch_bounds__(kListWarps * kWarp) small_bin_lists_kernel(Bin
     if (lane == 0) a.dense_bins[atomicAdd(&a.counters->dense_bins, 1u)] = bin;
     return;
   }
-  unsigned placed[4] = {0, 0, 0, 0};
-  for (unsigned run = range.x; run < range.y; run += kListRun) {  // warp-uniform
-    std::uint32_t v[kListLoads];
-    load_run(a.values, run, range.y, lane, v);
-    place_run(lists, v, lane, placed);
-  }
-  record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, placed, lane);
+  unsigned total[4];
+  write_bin_lists<1>(a.values + range.x, lists, nullptr, total);
+  record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, total, lane);
 }
 
-// The dense bins' lists, a block per bin: warp w takes the w-th run of each round; a first
-// pass of ballots counts each warp's values per tile, so that the second knows where in each
-// tile's list the warp's values go. Blocks beyond the listed bins return at once.
+// The dense bins' lists, a block per bin. Blocks beyond the listed bins return at once.
 __global__ void __launch_bounds__(kListWarps * kWarp) dense_bin_lists_kernel(BinListArgs a) {
   if (blockIdx.x >= a.counters->dense_bins) return;  // whole block
   __shared__ unsigned warp_counts[kListWarps][4];
-  const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   const unsigned bin = a.dense_bins[blockIdx.x];
   const uint2 range = a.bin_ranges[bin];
   const BinLists lists{a.top_lists, a.bottom_lists, range.x, range.y - range.x};
-  unsigned placed[4] = {0, 0, 0, 0};
-  for (unsigned round = range.x; round < range.y; round += kListWarps * kListRun) {  // block-uniform
-    std::uint32_t v[kListLoads];
-    load_run(a.values, round + warp * kListRun, range.y, lane, v);
-    unsigned count[4] = {0, 0, 0, 0};
-#pragma unroll
-    for (int k = 0; k < kListLoads; ++k)
-#pragma unroll
-      for (int q = 0; q < 4; ++q) count[q] += __popc(__ballot_sync(kFullMask, carries(v[k], q)));
-    if (lane == 0)
-#pragma unroll
-      for (int q = 0; q < 4; ++q) warp_counts[warp][q] = count[q];
-    __syncthreads();
-    unsigned next[4], total[4];  // this warp's first place per tile; the round's values per tile
-#pragma unroll
-    for (int q = 0; q < 4; ++q) {
-      next[q] = placed[q];
-      total[q] = 0;
-      for (unsigned w = 0; w < kListWarps; ++w) {
-        if (w == warp) next[q] += total[q];
-        total[q] += warp_counts[w][q];
-      }
-    }
-    __syncthreads();  // read before the next round writes
-    place_run(lists, v, lane, next);
-#pragma unroll
-    for (int q = 0; q < 4; ++q) placed[q] += total[q];
-  }
-  record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, placed, threadIdx.x);
+  unsigned total[4];
+  write_bin_lists<kListWarps>(a.values + range.x, lists, warp_counts, total);
+  record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, total, threadIdx.x);
 }
 
 // A tile's class: the leading zeros of its pair count, so fuller tiles come first.

@@ -87,7 +87,7 @@ void sh_rgb_double(const Scene& scene, std::size_t i, int degree, const double d
 }
 
 // Minimum of q(d) = a dx^2 + 2 b dx dy + c dy^2 over a rectangle of offsets (0 if it holds
-// the centre); see gm::ellipse_meets_rect.
+// the centre); see gm::whitened_ellipse_meets_rect.
 double min_q_over_rect(const RefGaussian& g, double dx0, double dx1, double dy0, double dy1) {
   auto q = [&](double dx, double dy) { return g.a * dx * dx + 2 * g.b * dx * dy + g.c * dy * dy; };
   const bool inside_x = dx0 <= 0 && dx1 >= 0, inside_y = dy0 <= 0 && dy1 >= 0;

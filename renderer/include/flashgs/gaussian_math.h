@@ -314,28 +314,6 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
   return kVisible;
 }
 
-// Does the ellipse q(d) <= t meet the rectangle [dx0, dx1] x [dy0, dy1] (offsets from the
-// centre)? FlashGS's exact test without square roots: if the centre is outside, the minimum
-// of the convex q over the rectangle lies on an edge facing the centre; along such an edge q
-// is a parabola whose minimum is found in closed form and clamped to the edge.
-FLASHGS_HD bool ellipse_meets_rect(float a, float b, float c, float t, float dx0, float dx1,
-                                   float dy0, float dy1) {
-  const bool inside_x = dx0 <= 0.0f && dx1 >= 0.0f;
-  const bool inside_y = dy0 <= 0.0f && dy1 >= 0.0f;
-  if (inside_x && inside_y) return true;
-  if (!inside_x) {
-    const float dx = dx0 > 0.0f ? dx0 : dx1;
-    const float dy = clampf(-b * dx / c, dy0, dy1);
-    if (a * dx * dx + 2.0f * b * dx * dy + c * dy * dy <= t) return true;
-  }
-  if (!inside_y) {
-    const float dy = dy0 > 0.0f ? dy0 : dy1;
-    const float dx = clampf(-b * dy / a, dx0, dx1);
-    if (a * dx * dx + 2.0f * b * dx * dy + c * dy * dy <= t) return true;
-  }
-  return false;
-}
-
 // q at offset (dx, dy) from the whitened rows w (see Footprint::whiten).
 FLASHGS_HD float whitened_q(const float w[4], float dx, float dy) {
   const float u = w[0] * dx + w[1] * dy;
@@ -343,27 +321,23 @@ FLASHGS_HD float whitened_q(const float w[4], float dx, float dy) {
   return u * u + v * v;
 }
 
-// ellipse_meets_rect for the whitened form: the same edge minimisation (the minimiser along
-// an edge, edge_slope_* times the edge's offset, comes from the conic W^T W, where a small
-// error only moves it along a flat valley: q changes to second order), but q itself
-// evaluated without cancellation, so that tiles thousands of pixels along a needle are
-// decided correctly.
+// Does the ellipse q(d) <= t meet the rectangle [dx0, dx1] x [dy0, dy1] of offsets from the
+// centre? FlashGS's exact test without square roots: if the centre is outside, the minimum of
+// the convex q over the rectangle lies on an edge facing the centre, and along such an edge q
+// is a parabola whose minimiser is edge_slope times the edge's offset, clamped to the edge.
+// The minimiser along an edge comes from the conic W^T W, where a small error only moves it
+// along a flat valley (q changes to second order); q itself is evaluated in the whitened form,
+// without cancellation, so that tiles thousands of pixels along a needle are decided correctly.
+// Written without branches (it runs for every lane of a warp at once): each axis's nearest
+// offset is 0 where the rectangle spans the centre, so the two edge points below are always
+// points of the rectangle, one of them its minimum (the centre itself when it is inside).
+// Offsets must be finite (they are for every visible footprint).
 FLASHGS_HD bool whitened_ellipse_meets_rect(const float w[4], float edge_slope_x, float edge_slope_y, float t,
                                             float dx0, float dx1, float dy0, float dy1) {
-  const bool inside_x = dx0 <= 0.0f && dx1 >= 0.0f;
-  const bool inside_y = dy0 <= 0.0f && dy1 >= 0.0f;
-  if (inside_x && inside_y) return true;
-  if (!inside_x) {
-    const float dx = dx0 > 0.0f ? dx0 : dx1;
-    const float dy = clampf(edge_slope_x * dx, dy0, dy1);
-    if (whitened_q(w, dx, dy) <= t) return true;
-  }
-  if (!inside_y) {
-    const float dy = dy0 > 0.0f ? dy0 : dy1;
-    const float dx = clampf(edge_slope_y * dy, dx0, dx1);
-    if (whitened_q(w, dx, dy) <= t) return true;
-  }
-  return false;
+  const float near_x = clampf(0.0f, dx0, dx1), near_y = clampf(0.0f, dy0, dy1);
+  const float q_on_x_edge = whitened_q(w, near_x, clampf(edge_slope_x * near_x, dy0, dy1));
+  const float q_on_y_edge = whitened_q(w, clampf(edge_slope_y * near_y, dx0, dx1), near_y);
+  return minf(q_on_x_edge, q_on_y_edge) <= t;
 }
 
 // The exact test for tile (tx, ty): the rectangle spanned by its pixel centres, clipped to
