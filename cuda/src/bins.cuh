@@ -27,11 +27,17 @@ __device__ __forceinline__ unsigned bin_tiles(int shift, int bx, int by, int tx0
                                               TOUCHES touches) {
   static_assert(kMacroBinShift == 1, "bins are a tile or 2x2 tiles");
   if (shift == 0) return touches(bx, by) ? 1u : 0u;  // a bin of the box is a tile of the box
+  // Every tile is tested, in the box or not (a tile beyond the image's edge is a valid, if
+  // empty, rectangle), and the box applied after: lanes of a warp test different bins, so a
+  // test skipped by one lane was run for another anyway, and without branches there is no
+  // divergence to reconverge.
   unsigned bits = 0;
 #pragma unroll
   for (int k = 0; k < 4; ++k) {
     const int tx = 2 * bx + (k & 1), ty = 2 * by + (k >> 1);
-    if (tx >= tx0 && tx < tx1 && ty >= ty0 && ty < ty1 && touches(tx, ty)) bits |= 1u << k;
+    const bool in_box = tx >= tx0 && tx < tx1 && ty >= ty0 && ty < ty1;
+    const bool touched = touches(tx, ty);
+    bits |= static_cast<unsigned>(in_box & touched) << k;
   }
   return bits;
 }
