@@ -4,7 +4,7 @@
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-ab bench-env bench
 #                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
 #                                       cpu-simd-tests build-prev bench-cpu-prev
-#                                       profile-blend profile-sass
+#                                       profile-blend profile-sass bench-variants kernel-times
 #                                       build-bg wait-build build-prev-bg bench-prev-cuda
 # tools/device/make_deps.sh fills .deps (52 MB; with the tree, just under a call's 64 MiB):
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
@@ -212,6 +212,47 @@ bench_prev_cuda() {  # the earlier tree's CUDA flash (build-prev with PREV_CUDA=
     --warmup 2 --repeat 5 | grep -E "^[0-9]+x|^res"
 }
 
+bench_variants() {  # flash rows of several builds in one call, for an A/B that noise between calls cannot blur.
+  # VARIANTS: "tree" (this tree's flashgs) and NAMEs of .deps/variants/NAME.xz (flashgs of other trees, e.g. from
+  # `ninja app/flashgs` in the prebuild folder, xz-compressed); VARIANT_ROWS: scene[:extra bench args] items (default
+  # pc_biker pc_playbot pc_playbot:--tile=7); VARIANT_RES (default 1920x1080,3840x2160); environment such as
+  # FLASHGS_BIN_SORT=1 applies to every row. Prints "== variant scene args" and the bench rows.
+  local v bin row scene extra
+  mkdir -p /tmp/variants
+  for v in ${VARIANTS:-tree}; do
+    bin=$FLASHGS
+    if [ "$v" != tree ]; then
+      bin=/tmp/variants/$v
+      [ -x "$bin" ] || { xz -d -c "$ROOT/.deps/variants/$v.xz" > "$bin" && chmod +x "$bin"; } || { log "no variant $v"; continue; }
+    fi
+    for row in ${VARIANT_ROWS:-pc_biker pc_playbot pc_playbot:--tile=7}; do
+      scene=${row%%:*}
+      extra=""
+      [ "$row" != "$scene" ] && extra=${row#*:}
+      echo "== $v $scene ${extra//=/ }"
+      "$bin" bench "$SCENES/$scene/point_cloud.ply" --backend cuda -r "${VARIANT_RES:-1920x1080,3840x2160}" \
+        --configs flash --warmup 2 --repeat 5 ${extra//=/ } -o /tmp/variant.json 2>&1 |
+        grep -E "^[0-9]+x[0-9]+ +flash +[0-9]|rror"
+    done
+  done
+}
+
+kernel_times() {  # ncu time of the kernels matching KERNEL_FILTER (default bin_|blend|preprocess) in one frame of
+  # each of VARIANTS (as bench_variants), pc_playbot camera 10 at KERNEL_RES: "variant res kernel ns" lines
+  local v bin res
+  for v in ${VARIANTS:-tree}; do
+    bin=$FLASHGS
+    [ "$v" != tree ] && bin=/tmp/variants/$v
+    [ "$v" != tree ] && [ ! -x "$bin" ] && { xz -d -c "$ROOT/.deps/variants/$v.xz" > "$bin" && chmod +x "$bin"; }
+    for res in ${KERNEL_RES:-1920x1080 3840x2160}; do
+      timeout 120 ncu --csv --metrics gpu__time_duration.sum -k regex:"${KERNEL_FILTER:-bin_|blend|preprocess}" \
+        --launch-skip ${KERNEL_SKIP:-20} --launch-count ${KERNEL_COUNT:-4} "$bin" render \
+        "$SCENES/pc_playbot/point_cloud.ply" --backend cuda -c 10 -r "$res" --repeat 10 -o /tmp/p.ppm 2>/dev/null |
+        grep gpu__time | awk -F'","' -v v="$v" -v r="$res" '{name=$5; sub(/\(.*/, "", name); t=$NF; gsub(/"/, "", t); print v, r, name, t}'
+    done
+  done
+}
+
 bench_scale() {  # pc_playbot copied SCALE_COPIES times in memory (default 20 60 200: 10M, 30M, 100M)
   for copies in ${SCALE_COPIES:-20 60 200}; do
     log "bench scale: $copies x pc_playbot"
@@ -303,6 +344,8 @@ for step in "$@"; do
     bench-prev-cuda) [ -n "${PREV_PID:-}" ] && wait "$PREV_PID"; (FLASHGS=/tmp/prev/b/app/flashgs bench_prev_cuda) ;;
     cpu-simd-tests) cpu_simd_tests ;;
     bench-scale) bench_scale ;;
+    bench-variants) bench_variants ;;
+    kernel-times) kernel_times ;;
     report) report ;;
     profile) profile ;;
     profile-kernels) profile_kernels ;;
