@@ -122,11 +122,19 @@ TEST(ExactTileTest, EllipseRectCases) {
   EXPECT_FALSE(meets(1, 0, 1, 1, 1, 1.5f, 2, -1, 1));       // right of the circle
   EXPECT_FALSE(meets(1, 0, 1, 1, 1, 0.75f, 2, 0.75f, 2));   // corner outside (0.75^2*2 > 1)
   EXPECT_TRUE(meets(1, 0, 1, 1, 1, 0.7f, 2, 0.7f, 2));      // corner inside (0.98 <= 1)
+  EXPECT_TRUE(meets(1, 0, 1, 1, 1, -1, 1, 0.5f, 2));        // spans the centre's column, bottom edge crosses
+  EXPECT_FALSE(meets(1, 0, 1, 1, 1, -1, 1, 1.5f, 2));       // spans the column, below the circle
+  EXPECT_FALSE(meets(1, 0, 1, 1, 1, -3, -1.01f, -0.2f, 0.2f));  // left of the circle, spanning its row
   // A thin diagonal needle along x = y (sigma 10 along it, 0.1 across): reaches (3, 3) but
   // not (3, -3).
   const float h = std::sqrt(0.5f);
   EXPECT_TRUE(meets(h, h, 10, 0.1f, 1, 2.5f, 3.5f, 2.5f, 3.5f));
   EXPECT_FALSE(meets(h, h, 10, 0.1f, 1, 2.5f, 3.5f, -3.5f, -2.5f));
+  // The same needle and a wide rectangle across its path away from its centre: only the edge
+  // minimiser (slope times the edge's offset, clamped) finds where the needle crosses it.
+  EXPECT_TRUE(meets(h, h, 10, 0.1f, 1, -20, 20, 6.5f, 7.5f));
+  EXPECT_FALSE(meets(h, h, 10, 0.1f, 1, -20, 5, 6.5f, 7.5f));
+  EXPECT_FALSE(meets(h, h, 10, 0.1f, 1, -20, 20, 9.5f, 10.5f));  // beyond its reach: q = 2 at (10, 10)
 }
 
 // 3DGS's radius is ceil(3 sqrt(mid + sqrt(max(0.1, mid^2 - det)))): the smallest footprint
