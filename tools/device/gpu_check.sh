@@ -99,6 +99,11 @@ sanitize() {  # SANITIZERS: the compute-sanitizer tools (default memcheck racech
     timeout 300 compute-sanitizer --tool $tool --error-exitcode 9 --print-limit 20 \
       "$TESTS" --gtest_filter=CudaSanitizer.* > "$OUT/sanitizer_$tool.log" 2>&1
     log "sanitizer $tool rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$OUT/sanitizer_$tool.log" | tail -1)"
+    if [ $tool = memcheck ]; then  # the sanitizer frames sort per bin; CUB's sort and its list kernels too
+      FLASHGS_BIN_SORT=0 timeout 300 compute-sanitizer --tool memcheck --error-exitcode 9 --print-limit 20 \
+        "$TESTS" --gtest_filter=CudaSanitizer.* > "$OUT/sanitizer_memcheck_cub_sort.log" 2>&1
+      log "sanitizer memcheck, CUB's sort, rc=$? $(grep -E 'ERROR SUMMARY' "$OUT/sanitizer_memcheck_cub_sort.log" | tail -1)"
+    fi
   done
 }
 
