@@ -131,6 +131,40 @@ struct TileList {
 // background's weight, without a liveness test in the loop.
 __device__ __forceinline__ float finished_column() { return __int_as_float(0x7fffffff); }
 
+// One staged Gaussian on a lane's pixels (EXP2): alpha = exp2 of the polynomial, the 1/255 cut
+// on the exponent, and compositing. STOP_RULE applies the CPU's stop; without it (a Gaussian
+// that cannot take any of the warp's pixels below the minimum T, see the staging) the result
+// is the same with three operations fewer per pixel.
+template <bool STOP_RULE>
+__device__ __forceinline__ void blend_region_gaussian(const RegionGaussian& g, float lane_y,
+                                                      float (&lane_x)[kLanePixelsX], float (&t)[kLanePixelsX],
+                                                      float (&cr)[kLanePixelsX], float (&cg)[kLanePixelsX],
+                                                      float (&cb)[kLanePixelsX]) {
+  const float c0 = __fmaf_rn(__fmaf_rn(g.a2, lane_y, g.a1), lane_y, g.a0);
+  const float c1 = __fmaf_rn(g.b1, lane_y, g.b0), c2 = g.c2;
+  const float red = g.red, green = g.green, blue = g.blue;
+#pragma unroll
+  for (int p = 0; p < kLanePixelsX; ++p) {
+    const float e = __fmaf_rn(__fmaf_rn(c2, lane_x[p], c1), lane_x[p], c0);  // log2 alpha
+    // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the FMA gives
+    // T (1 - alpha) with one rounding: with 1 - alpha exact (alpha >= 1/2), the CPU's T, so the
+    // stop rule's decisions on stacked opaque layers are its own.
+    const float alpha = e >= kLog2AlphaMin ? fminf(gm::kAlphaMax, exp2_approx(e)) : 0.0f;
+    const float next_t = __fmaf_rn(-alpha, t[p], t[p]);
+    // The CPU stops before a Gaussian that would take T below the minimum: it adds nothing,
+    // and T stays the background's weight. The weight is what T loses, alpha T to within T's
+    // last bit (exactly alpha T's rounding for alpha <= 1/2), and 0 then.
+    const bool stop = STOP_RULE && next_t < gm::kTransmittanceMin;
+    const float kept_t = stop ? t[p] : next_t;
+    const float w = t[p] - kept_t;
+    cr[p] = __fmaf_rn(red, w, cr[p]);
+    cg[p] = __fmaf_rn(green, w, cg[p]);
+    cb[p] = __fmaf_rn(blue, w, cb[p]);
+    t[p] = kept_t;
+    if constexpr (STOP_RULE) lane_x[p] = stop ? finished_column() : lane_x[p];
+  }
+}
+
 // FlashGS render kernel, a warp per 64-pixel region of a tile: REGION_W x (64 / REGION_W)
 // pixels (16 x 4 strips or 8 x 8 quadrants, four warps per tile), each lane a pair of pixels
 // in a row. Four warps per tile rather than FlashGS's one: the heaviest tiles (thousands of
@@ -146,8 +180,10 @@ __device__ __forceinline__ float finished_column() { return __int_as_float(0x7ff
 // pixel's offset (RegionGaussian), the 1/255 cut made on the exponent, FMAs throughout, no
 // branch per pixel (at least one lane of the warp passes the cut on almost every visit, so a
 // branch skipped nothing and cost its own instructions); a finished pixel's column becomes
-// NaN, so later Gaussians add exactly nothing to it. Otherwise the arithmetic is the CPU's:
-// the same alpha to ~1e-5, and its cut, clamp and stop rule.
+// NaN, so later Gaussians add exactly nothing to it. The stop rule's test and selects run only
+// from the first staged Gaussian that might take a live pixel's T below the minimum (bounded
+// per batch from each Gaussian's largest alpha over the region). Otherwise the arithmetic is
+// the CPU's: the same alpha to ~1e-5, and its cut, clamp and stop rule.
 // Only the Gaussians that meet the region are staged, packed in list order, so the loop over
 // them is a counted one. Binned frames (BinGrid): the 4 blocks of a bin blend its tiles, each
 // from its own tile list (FrameBuffers::tile_lists).
@@ -218,22 +254,41 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     if (!PIPELINED && lane < n) next = load_gaussian(a.gaussians + record);
     __syncwarp();
     unsigned staged = n;  // Gaussians in batch[warp], in list order
+    unsigned unstoppable = 0;  // EXP2: how many of them cannot stop a pixel
     if constexpr (EXP2) {
       bool meets = false;
       const float cut = (next.opacity - kLog2AlphaMin) * 1.00001f + 1e-4f;  // q' of alpha = 1/255
       const float conic_a = __fmaf_rn(next.w0, next.w0, next.w2 * next.w2);
       const float conic_b = __fmaf_rn(next.w0, next.w1, next.w2 * next.w3);
       const float conic_c = __fmaf_rn(next.w1, next.w1, next.w3 * next.w3);
+      float q_min = 0.0f;
       if (lane < n && cut > 0.0f) {
         const float w[4] = {next.w0, next.w1, next.w2, next.w3};
         // Fast divisions: the cut's margin covers their error (it moves the edge minimiser
         // along a flat valley, changing q to second order only).
-        meets = gm::whitened_ellipse_meets_rect(w, __fdividef(-conic_b, conic_c), __fdividef(-conic_b, conic_a), cut,
-                                                region_x0 - next.mean_x,
-                                                region_x1 - next.mean_x,
-                                                region_y0 - next.mean_y, region_y1 - next.mean_y);
+        q_min = gm::whitened_q_min_on_rect(w, __fdividef(-conic_b, conic_c), __fdividef(-conic_b, conic_a),
+                                           region_x0 - next.mean_x, region_x1 - next.mean_x,
+                                           region_y0 - next.mean_y, region_y1 - next.mean_y);
+        meets = q_min <= cut;
       }
       const unsigned relevant = __ballot_sync(kFullMask, meets);
+      // The stop rule can only act where T may fall below its minimum. At most, a staged
+      // Gaussian leaves 1 - (its alpha at the region's nearest point) of a pixel's T (log2
+      // alpha = opacity - q_min, with a margin over the loop's rounding), so the staged
+      // Gaussians whose running product of these, times the lowest T of the warp's live
+      // pixels, stays above twice the minimum cannot stop a pixel: a prefix of the batch.
+      float kept = meets ? 1.0f - fminf(gm::kAlphaMax, exp2_approx(next.opacity - q_min + 1e-3f)) : 1.0f;
+#pragma unroll
+      for (int offset = 1; offset < kWarp; offset <<= 1) {
+        const float before = __shfl_up_sync(kFullMask, kept, offset);
+        if (lane >= static_cast<unsigned>(offset)) kept *= before;
+      }
+      float lowest_t = INFINITY;
+#pragma unroll
+      for (int p = 0; p < kLanePixelsX; ++p) lowest_t = isnan(lane_x[p]) ? lowest_t : fminf(lowest_t, t[p]);
+      // T > 0, so its bits order as the floats do.
+      lowest_t = __uint_as_float(__reduce_min_sync(kFullMask, __float_as_uint(lowest_t)));
+      unstoppable = __popc(__ballot_sync(kFullMask, meets && lowest_t * kept >= 2.0f * gm::kTransmittanceMin));
       if (meets) {
         // The whitened rows at the region's centre: (u0, v0), and log2 alpha there and around.
         const float ox = next.mean_x - region_mid_x, oy = next.mean_y - region_mid_y;
@@ -262,34 +317,17 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       next_n = list.take(lane, next_record);
     }
     // Unrolled 4 times: more independent work between the loads and the transmittance chain.
+    if constexpr (EXP2) {
 #pragma unroll 4
-    for (unsigned j = 0; j < staged && (EXP2 || live); ++j) {
-      const Staged& g = batch[warp][j];
-      if constexpr (EXP2) {
-        const float c0 = __fmaf_rn(__fmaf_rn(g.a2, lane_y, g.a1), lane_y, g.a0);
-        const float c1 = __fmaf_rn(g.b1, lane_y, g.b0), c2 = g.c2;
-        const float red = g.red, green = g.green, blue = g.blue;
-#pragma unroll
-        for (int p = 0; p < kLanePixelsX; ++p) {
-          const float e = __fmaf_rn(__fmaf_rn(c2, lane_x[p], c1), lane_x[p], c0);  // log2 alpha
-          // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the
-          // FMA gives T (1 - alpha) with one rounding: with 1 - alpha exact (alpha >= 1/2),
-          // the CPU's T, so the stop rule's decisions on stacked opaque layers are its own.
-          const float alpha = e >= kLog2AlphaMin ? fminf(gm::kAlphaMax, exp2_approx(e)) : 0.0f;
-          const float next_t = __fmaf_rn(-alpha, t[p], t[p]);
-          // The CPU stops before a Gaussian that would take T below the minimum: it adds
-          // nothing, and T stays the background's weight. The weight is what T loses, alpha T
-          // to within T's last bit (exactly alpha T's rounding for alpha <= 1/2), and 0 then.
-          const bool stop = next_t < gm::kTransmittanceMin;
-          const float kept_t = stop ? t[p] : next_t;
-          const float w = t[p] - kept_t;
-          cr[p] = __fmaf_rn(red, w, cr[p]);
-          cg[p] = __fmaf_rn(green, w, cg[p]);
-          cb[p] = __fmaf_rn(blue, w, cb[p]);
-          t[p] = kept_t;
-          lane_x[p] = stop ? finished_column() : lane_x[p];
-        }
-      } else {
+      for (unsigned j = 0; j < unstoppable; ++j)
+        blend_region_gaussian<false>(batch[warp][j], lane_y, lane_x, t, cr, cg, cb);
+#pragma unroll 4
+      for (unsigned j = unstoppable; j < staged; ++j)
+        blend_region_gaussian<true>(batch[warp][j], lane_y, lane_x, t, cr, cg, cb);
+    } else {
+#pragma unroll 4
+      for (unsigned j = 0; j < staged && live; ++j) {
+        const Staged& g = batch[warp][j];
         // The whole region lies beyond the rows this Gaussian can reach: a warp-uniform skip.
         if (fabsf(region_mid_y - g.mean_y) > g.reach_y + region_half_h) continue;
         const float dy = static_cast<float>(y) - g.mean_y;

@@ -504,16 +504,20 @@ class CudaRendererImpl final : public CudaRenderer {
   // Whether sorting per bin (launch_bin_sort) pays over CUB's radix sort of the whole frame.
   // Measured on an H200 (docs/PERFORMANCE.md, v16 and v19): sort + ranges 18-41 us shorter at
   // 1080p on pc_biker and pc_playbot (2,040 bins of 200-400 pairs); at 4K (8,160 bins), since
-  // the bin blocks write their tile lists without idle groups, 7-31 us shorter on five real
-  // scenes, with no wait for the host between emission and sort, but 55 us longer on
-  // kacytran_try, whose frame-covering Gaussians put a chunk's pairs in ~2,048 bins; 0.1 ms
-  // longer on 7 x pc_playbot at 1080p (about 700 pairs per bin; bins of more than 2,048 sort
-  // in global memory). Judged on the last frame's bin pairs: the emission that this decides
-  // comes before this frame's count.
+  // the bin blocks write their tile lists without idle groups, 6-24 us shorter on pc_biker and
+  // the same on pc_playbot, with no wait for the host between emission and sort; 0.1 ms longer
+  // on 7 x pc_playbot at 1080p (about 700 pairs per bin; bins of more than 2,048 sort in global
+  // memory). Judged on the last frame's bin pairs: the emission that this decides comes before
+  // this frame's count.
   bool bin_sort_pays(std::uint64_t bins) const {
     if (bins > cuda::kBinSortMaxBins) return false;  // beyond the scatter pass's shared histogram
     if (bin_sort_ != kAuto) return bin_sort_ == kAlways;
-    return last_bin_pairs_ <= kBinSortMostPairsPerBin * bins;
+    if (last_bin_pairs_ > kBinSortMostPairsPerBin * bins) return false;
+    // Frames whose Gaussians cover much of the frame (kacytran_try: ~200 bin pairs per visible
+    // Gaussian, against ~4 on pc_playbot) lose at 4K: a chunk of pairs meets ~2,048 bins, and
+    // the counting passes pay a global atomic per bin and chunk. At 1080p they still win.
+    return bins <= kBinSortAnyCoverageBins || last_records_ == 0 ||
+           last_bin_pairs_ <= kBinSortMostPairsPerGaussian * last_records_;
   }
 
   // Stage times of the frame whose events are in `set` (its work must have finished).
@@ -781,6 +785,7 @@ class CudaRendererImpl final : public CudaRenderer {
       grow_deferred(readback_->counters.deferred, readback_->counters.deferred_items);
     last_tiles_ = tiles;
     last_bin_pairs_ = binned ? pairs : 0;
+    last_records_ = compact_records_ ? readback_->counters.records : 0;
     last_frame_binned_ = binned;
     if (out) check_cuda(cudaStreamSynchronize(stream_), "frame");
     last_frame_complete_ = true;
@@ -862,6 +867,9 @@ class CudaRendererImpl final : public CudaRenderer {
   bool bin_sort_frame_ = false;  // this frame does
   std::uint64_t last_bin_pairs_ = 0;  // the last frame's pairs if it was binned
   static constexpr std::uint64_t kBinSortMostPairsPerBin = 512;
+  static constexpr std::uint64_t kBinSortAnyCoverageBins = 4096;     // 1080p-class frames
+  static constexpr std::uint64_t kBinSortMostPairsPerGaussian = 32;
+  std::uint64_t last_records_ = 0;  // the last frame's blend records (visible Gaussians), 0 if not counted
   std::uint64_t blend_resident_blocks_ = 1;  // warp-blend blocks the device runs at once
   cuda::KeyFormat key_format_;           // this frame's
   cuda::BinGrid bins_;                   // this frame's

@@ -321,23 +321,29 @@ FLASHGS_HD float whitened_q(const float w[4], float dx, float dy) {
   return u * u + v * v;
 }
 
-// Does the ellipse q(d) <= t meet the rectangle [dx0, dx1] x [dy0, dy1] of offsets from the
-// centre? FlashGS's exact test without square roots: if the centre is outside, the minimum of
-// the convex q over the rectangle lies on an edge facing the centre, and along such an edge q
-// is a parabola whose minimiser is edge_slope times the edge's offset, clamped to the edge.
-// The minimiser along an edge comes from the conic W^T W, where a small error only moves it
-// along a flat valley (q changes to second order); q itself is evaluated in the whitened form,
-// without cancellation, so that tiles thousands of pixels along a needle are decided correctly.
+// The minimum of q over the rectangle [dx0, dx1] x [dy0, dy1] of offsets from the centre, and
+// whether the ellipse q(d) <= t meets that rectangle. FlashGS's exact test without square
+// roots: if the centre is outside, the minimum of the convex q over the rectangle lies on an
+// edge facing the centre, and along such an edge q is a parabola whose minimiser is edge_slope
+// times the edge's offset, clamped to the edge. The minimiser along an edge comes from the
+// conic W^T W, where a small error only moves it along a flat valley (q changes to second
+// order); q itself is evaluated in the whitened form, without cancellation, so that tiles
+// thousands of pixels along a needle are decided correctly.
 // Written without branches (it runs for every lane of a warp at once): each axis's nearest
 // offset is 0 where the rectangle spans the centre, so the two edge points below are always
 // points of the rectangle, one of them its minimum (the centre itself when it is inside).
 // Offsets must be finite (they are for every visible footprint).
-FLASHGS_HD bool whitened_ellipse_meets_rect(const float w[4], float edge_slope_x, float edge_slope_y, float t,
-                                            float dx0, float dx1, float dy0, float dy1) {
+FLASHGS_HD float whitened_q_min_on_rect(const float w[4], float edge_slope_x, float edge_slope_y, float dx0,
+                                       float dx1, float dy0, float dy1) {
   const float near_x = clampf(0.0f, dx0, dx1), near_y = clampf(0.0f, dy0, dy1);
   const float q_on_x_edge = whitened_q(w, near_x, clampf(edge_slope_x * near_x, dy0, dy1));
   const float q_on_y_edge = whitened_q(w, clampf(edge_slope_y * near_y, dx0, dx1), near_y);
-  return minf(q_on_x_edge, q_on_y_edge) <= t;
+  return minf(q_on_x_edge, q_on_y_edge);
+}
+
+FLASHGS_HD bool whitened_ellipse_meets_rect(const float w[4], float edge_slope_x, float edge_slope_y, float t,
+                                            float dx0, float dx1, float dy0, float dy1) {
+  return whitened_q_min_on_rect(w, edge_slope_x, edge_slope_y, dx0, dx1, dy0, dy1) <= t;
 }
 
 // The exact test for tile (tx, ty): the rectangle spanned by its pixel centres, clipped to
