@@ -17,6 +17,8 @@
 #include <cstring>
 #include <string>
 
+#include <unistd.h>
+
 namespace {
 
 bool send_key(Display* d, const char* name, bool down) {
@@ -39,7 +41,14 @@ bool send_key(Display* d, const char* name, bool down) {
 }
 
 bool close_window(Display* d, int x, int y) {
-  const ::Window target = top_level_at(d, x, y);
+  // The window may still be on its way to the screen on a loaded machine: wait for it to be
+  // mapped there (up to 10 s), rather than failing at once.
+  ::Window target = top_level_at(d, x, y);
+  for (int attempt = 0; !target && attempt < 200; ++attempt) {
+    usleep(50000);
+    XSync(d, False);
+    target = top_level_at(d, x, y);
+  }
   if (!target) {
     std::fprintf(stderr, "x11_input: no window at %d,%d\n", x, y);
     return false;

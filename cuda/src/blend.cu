@@ -93,6 +93,8 @@ __global__ void __launch_bounds__(kTile * kTile) blend_per_pixel_kernel(BlendArg
 constexpr int kWarpsPerBlock = 4;
 constexpr int kLanePixelsX = 2;      // pixels per lane, side by side in a row
 constexpr int kRegionsPerTile = 4;   // 64-pixel regions, a warp each
+constexpr int kBlendUnroll = 4;      // staged Gaussians per step of the loop
+constexpr float kBoundWorthT = 32.0f * gm::kTransmittanceMin;  // see the staging's stop bound
 
 // 2^x by the hardware unit alone: x >= log2(1/255) here, so no denormal handling is needed
 // (exp2f adds a range check and two scalings around the same instruction).
@@ -276,19 +278,24 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       // Gaussian leaves 1 - (its alpha at the region's nearest point) of a pixel's T (log2
       // alpha = opacity - q_min, with a margin over the loop's rounding), so the staged
       // Gaussians whose running product of these, times the lowest T of the warp's live
-      // pixels, stays above twice the minimum cannot stop a pixel: a prefix of the batch.
-      float kept = meets ? 1.0f - fminf(gm::kAlphaMax, exp2_approx(next.opacity - q_min + 1e-3f)) : 1.0f;
-#pragma unroll
-      for (int offset = 1; offset < kWarp; offset <<= 1) {
-        const float before = __shfl_up_sync(kFullMask, kept, offset);
-        if (lane >= static_cast<unsigned>(offset)) kept *= before;
-      }
+      // pixels, stays above twice the minimum cannot stop a pixel: a prefix of the batch,
+      // cut to whole groups of the loop's unrolling. Near the minimum, where almost any
+      // Gaussian might stop a pixel, the bound is not worth its scan.
       float lowest_t = INFINITY;
 #pragma unroll
       for (int p = 0; p < kLanePixelsX; ++p) lowest_t = isnan(lane_x[p]) ? lowest_t : fminf(lowest_t, t[p]);
       // T > 0, so its bits order as the floats do.
       lowest_t = __uint_as_float(__reduce_min_sync(kFullMask, __float_as_uint(lowest_t)));
-      unstoppable = __popc(__ballot_sync(kFullMask, meets && lowest_t * kept >= 2.0f * gm::kTransmittanceMin));
+      if (lowest_t >= kBoundWorthT) {
+        float kept = meets ? 1.0f - fminf(gm::kAlphaMax, exp2_approx(next.opacity - q_min + 1e-3f)) : 1.0f;
+#pragma unroll
+        for (int offset = 1; offset < kWarp; offset <<= 1) {
+          const float before = __shfl_up_sync(kFullMask, kept, offset);
+          if (lane >= static_cast<unsigned>(offset)) kept *= before;
+        }
+        unstoppable = __popc(__ballot_sync(kFullMask, meets && lowest_t * kept >= 2.0f * gm::kTransmittanceMin));
+        unstoppable &= ~static_cast<unsigned>(kBlendUnroll - 1);
+      }
       if (meets) {
         // The whitened rows at the region's centre: (u0, v0), and log2 alpha there and around.
         const float ox = next.mean_x - region_mid_x, oy = next.mean_y - region_mid_y;
@@ -316,16 +323,16 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     } else {
       next_n = list.take(lane, next_record);
     }
-    // Unrolled 4 times: more independent work between the loads and the transmittance chain.
+    // Unrolled: more independent work between the loads and the transmittance chain.
     if constexpr (EXP2) {
-#pragma unroll 4
+#pragma unroll kBlendUnroll
       for (unsigned j = 0; j < unstoppable; ++j)
         blend_region_gaussian<false>(batch[warp][j], lane_y, lane_x, t, cr, cg, cb);
-#pragma unroll 4
+#pragma unroll kBlendUnroll
       for (unsigned j = unstoppable; j < staged; ++j)
         blend_region_gaussian<true>(batch[warp][j], lane_y, lane_x, t, cr, cg, cb);
     } else {
-#pragma unroll 4
+#pragma unroll kBlendUnroll
       for (unsigned j = 0; j < staged && live; ++j) {
         const Staged& g = batch[warp][j];
         // The whole region lies beyond the rows this Gaussian can reach: a warp-uniform skip.
