@@ -91,7 +91,8 @@ tests() {  # GPU_TEST_FILTER: a gtest filter (default: every test but the saniti
   fi
 }
 
-sanitize() {  # SANITIZERS: the compute-sanitizer tools (default memcheck racecheck)
+sanitize() {  # SANITIZERS: the compute-sanitizer tools (default memcheck racecheck; racecheck takes ~5 of a
+  # session's 30 device minutes: SANITIZERS=memcheck where no shared-memory code changed since its last clean run)
   export FLASHGS_SANITIZER_SCENE=pc_biker
   for tool in ${SANITIZERS:-memcheck racecheck}; do
     log "compute-sanitizer $tool"
@@ -243,8 +244,9 @@ bench_variants() {  # flash rows of several builds in one call, for an A/B that 
 }
 
 kernel_times() {  # ncu time of the kernels matching KERNEL_FILTER (default bin_|blend|preprocess) in one frame of
-  # each of VARIANTS (as bench_variants), pc_playbot camera 10 at KERNEL_RES: "variant res kernel ns" lines
-  local v bin res
+  # each of VARIANTS (as bench_variants), pc_playbot camera 10 at KERNEL_RES: "variant res kernel ns" lines.
+  # Enough frames that a filter matching one kernel per frame still reaches the skipped and counted launches.
+  local v bin res frames=$(( ${KERNEL_SKIP:-20} + ${KERNEL_COUNT:-4} + 2 ))
   for v in ${VARIANTS:-tree}; do
     bin=$FLASHGS
     [ "$v" != tree ] && bin=/tmp/variants/$v
@@ -252,7 +254,7 @@ kernel_times() {  # ncu time of the kernels matching KERNEL_FILTER (default bin_
     for res in ${KERNEL_RES:-1920x1080 3840x2160}; do
       timeout 120 ncu --csv --metrics gpu__time_duration.sum -k regex:"${KERNEL_FILTER:-bin_|blend|preprocess}" \
         --launch-skip ${KERNEL_SKIP:-20} --launch-count ${KERNEL_COUNT:-4} "$bin" render \
-        "$SCENES/pc_playbot/point_cloud.ply" --backend cuda -c 10 -r "$res" --repeat 10 -o /tmp/p.ppm 2>/dev/null |
+        "$SCENES/pc_playbot/point_cloud.ply" --backend cuda -c 10 -r "$res" --repeat $frames -o /tmp/p.ppm 2>/dev/null |
         grep gpu__time | awk -F'","' -v v="$v" -v r="$res" '{name=$5; sub(/\(.*/, "", name); t=$NF; gsub(/"/, "", t); print v, r, name, t}'
     done
   done
