@@ -302,14 +302,17 @@ profile_kernels() {  # each kernel's GPU time in one frame: KERNEL_SCENES, KERNE
   done
 }
 
-profile_blend() {  # one blend kernel in detail: stall reasons, instruction mix, hot lines
-  log "ncu blend ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-1920x1080}"
+profile_blend() {  # one kernel (PROFILE_KERNEL, an ncu regex; default the warp blend) in detail: speed of light,
+  # stall reasons, instruction mix, occupancy, memory
+  local kernel=${PROFILE_KERNEL:-blend_warp}
+  local report=$OUT/ncu_${kernel//[^A-Za-z0-9_]/_}.txt
+  log "ncu $kernel ${PROFILE_SCENE:-pc_playbot} ${PROFILE_RES:-1920x1080}"
   timeout 240 ncu --section SpeedOfLight --section WarpStateStats --section SchedulerStats --section InstructionStats \
-    --section Occupancy --section LaunchStats -k regex:blend_warp --launch-skip 3 --launch-count 1 \
-    "$FLASHGS" render "$SCENES/${PROFILE_SCENE:-pc_playbot}/point_cloud.ply" --backend cuda -c 10 \
-    -r "${PROFILE_RES:-1920x1080}" --repeat 5 -o /tmp/p.ppm > "$OUT/ncu_blend.txt" 2>&1
+    --section Occupancy --section LaunchStats --section MemoryWorkloadAnalysis -k regex:"$kernel" --launch-skip 3 \
+    --launch-count 1 "$FLASHGS" render "$SCENES/${PROFILE_SCENE:-pc_playbot}/point_cloud.ply" --backend cuda -c 10 \
+    -r "${PROFILE_RES:-1920x1080}" --repeat 5 -o /tmp/p.ppm > "$report" 2>&1
   log "ncu rc=$?"
-  grep -vE "^==|^\s*$|----" "$OUT/ncu_blend.txt" | tail -75
+  grep -vE "^==|^\s*$|----" "$report" | tail -90
 }
 
 profile_sass() {  # executed instructions per SASS line of PROFILE_KERNELS (binaries built with -lineinfo)
