@@ -137,6 +137,44 @@ TEST(ExactTileTest, EllipseRectCases) {
   EXPECT_FALSE(meets(h, h, 10, 0.1f, 1, -20, 20, 9.5f, 10.5f));  // beyond its reach: q = 2 at (10, 10)
 }
 
+// q's minimum over a rectangle, as the CUDA blend's stop bound uses it (the least share of T a
+// Gaussian can leave a pixel of an 8x8 region): no point of the rectangle may have a smaller q,
+// beyond float rounding. Random footprints, regions at random offsets from their centres,
+// each rectangle sampled on a 33 x 33 grid (pixel centres and points between them).
+TEST(ExactTileTest, RectMinimumOfQIsALowerBoundOverTheRect) {
+  const Camera camera = test_camera(256, 192);
+  const gm::CameraParams cam = make_camera_params(camera);
+  const gm::GeometryParams geo = make_geometry_params(RenderOptions{});
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+  int rects = 0, centre_outside = 0;
+  double worst_excess = 0;  // how far below q_min a sample went, relative to max(1, q_min)
+  for (int n = 0; n < 3000; ++n) {
+    const RandomGaussian g = random_gaussian(rng);
+    gm::Footprint f;
+    if (gm::project(cam, geo, g.position, g.scale, g.quat, g.opacity, f) != gm::kVisible) continue;
+    // Regions within a few sigma: offsets up to ~4x the threshold ellipse's reach plus the region.
+    const float reach = 4.0f * std::sqrt(f.threshold / std::min(f.conic_a, f.conic_c)) + 8.0f;
+    for (int r = 0; r < 4; ++r) {
+      const float x0 = f.mean_x + std::min(reach, 200.0f) * uni(rng), y0 = f.mean_y + std::min(reach, 200.0f) * uni(rng);
+      const float dx0 = x0 - f.mean_x, dx1 = dx0 + 7.0f, dy0 = y0 - f.mean_y, dy1 = dy0 + 7.0f;
+      const float q_min = gm::whitened_q_min_on_rect(f.whiten, f.edge_slope_x, f.edge_slope_y, dx0, dx1, dy0, dy1);
+      ++rects;
+      centre_outside += (dx0 > 0 || dx1 < 0 || dy0 > 0 || dy1 < 0) ? 1 : 0;
+      for (int i = 0; i <= 32; ++i)
+        for (int j = 0; j <= 32; ++j) {
+          const float q = gm::whitened_q(f.whiten, dx0 + 7.0f * i / 32, dy0 + 7.0f * j / 32);
+          worst_excess = std::max(worst_excess, (q_min - q) / std::max(1.0, static_cast<double>(q_min)));
+        }
+    }
+  }
+  ASSERT_GT(centre_outside, 2000) << "too few rectangles away from the centre to test the edge minimisers";
+  std::printf("q minimum over %d rectangles (%d without the centre): worst sample below it by %.3g (relative)\n",
+              rects, centre_outside, worst_excess);
+  // The blend's margin is 1e-3 in log2 alpha, for q of a few units: this is 100 times tighter.
+  EXPECT_LT(worst_excess, 1e-5);
+}
+
 // 3DGS's radius is ceil(3 sqrt(mid + sqrt(max(0.1, mid^2 - det)))): the smallest footprint
 // (covariance 0.3 I from the dilation alone) gets radius ceil(3 sqrt(0.3 + sqrt(0.1))) = 3,
 // not ceil(3 sqrt(0.3)) = 2. With its centre at x = 14.25, getRect's last tile is
