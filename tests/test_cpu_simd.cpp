@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <future>
+#include <random>
 #include <thread>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #endif
 
 #include "cpu_frame.h"  // simd_alpha and its bound
+#include "flashgs/frame_params.h"
 #include "flashgs/generators.h"
 #include "flashgs/renderer.h"
 #include "test_support.h"
@@ -204,6 +206,58 @@ TEST(CpuSimdBlend, AlphaWithinItsBoundOnEveryTarget) {
   hwy::SetSupportedTargetsForTest(0);
 #else
   expect_simd_alpha_within_its_bound("scalar");
+#endif
+}
+
+// The vector exact tile test (cpu_emit_simd.cpp) keeps the tiles the scalar test keeps, in
+// the same order, on every target this CPU runs: footprints from a pixel to wider than the
+// image, needles included, on an odd-sized and a 1080p image (partial tiles at the edges).
+void expect_exact_box_tiles_match_the_scalar_test(const std::string& what) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  const float eye[3] = {0.0f, 0.0f, -3.0f}, target[3] = {0.0f, 0.0f, 0.0f}, up[3] = {0.0f, -1.0f, 0.0f};
+  std::uint64_t boxes = 0, wide_boxes = 0, kept = 0;
+  for (const Camera& camera : {look_at_camera(eye, target, up, 93, 61, 60.0f), look_at_camera(eye, target, up, 1920, 1080, 60.0f)}) {
+    const gm::CameraParams cam = make_camera_params(camera);
+    const gm::GeometryParams geo = make_geometry_params(RenderOptions{});
+    std::vector<std::uint32_t> vector_tiles, scalar_tiles;
+    for (int n = 0; n < 4000; ++n) {
+      const float position[3] = {4.0f * (uni(rng) - 0.5f), 3.0f * (uni(rng) - 0.5f), 2.0f * (uni(rng) - 0.5f)};
+      const float scale[3] = {std::pow(10.0f, -3.0f + 3.5f * uni(rng)), std::pow(10.0f, -3.0f + 3.5f * uni(rng)),
+                              std::pow(10.0f, -3.0f + 3.5f * uni(rng))};
+      float quat[4], norm = 0.0f;
+      for (float& q : quat) norm += (q = normal(rng)) * q;
+      for (float& q : quat) q /= std::sqrt(norm);
+      gm::Footprint f;
+      if (gm::project(cam, geo, position, scale, quat, 0.02f + 0.98f * uni(rng), f) != gm::kVisible) continue;
+      ++boxes;
+      wide_boxes += f.tile_x1 - f.tile_x0 > 16 ? 1 : 0;
+      vector_tiles.assign(cpu::exact_box_tiles_room(f), 0u);
+      vector_tiles.resize(cpu::exact_box_tiles(f, cam.width, cam.height, cam.tiles_x, vector_tiles.data()));
+      scalar_tiles.clear();
+      for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
+        for (int tx = f.tile_x0; tx < f.tile_x1; ++tx)
+          if (gm::footprint_touches_tile(f, tx, ty, cam.width, cam.height))
+            scalar_tiles.push_back(static_cast<std::uint32_t>(ty * cam.tiles_x + tx));
+      kept += scalar_tiles.size();
+      ASSERT_EQ(vector_tiles, scalar_tiles) << what << ": footprint " << n << " at " << f.mean_x << "," << f.mean_y;
+    }
+  }
+  EXPECT_GT(boxes, 5000u) << what;
+  EXPECT_GT(wide_boxes, 200u) << what << ": too few boxes wider than a vector";
+  EXPECT_GT(kept, 100000u) << what;
+}
+
+TEST(CpuSimdEmit, ExactBoxTilesAreTheScalarTestsOnEveryTarget) {
+#ifdef FLASHGS_HAVE_HWY
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    expect_exact_box_tiles_match_the_scalar_test(hwy::TargetName(target));
+  }
+  hwy::SetSupportedTargetsForTest(0);
+#else
+  expect_exact_box_tiles_match_the_scalar_test("scalar");
 #endif
 }
 

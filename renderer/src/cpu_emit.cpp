@@ -14,6 +14,9 @@ namespace {
 // several chunks each, taken dynamically, even that out.
 constexpr int kChunksPerThread = 8;
 constexpr std::int64_t kMinChunkGaussians = 4096;
+// Boxes at least this many tiles wide take the vector test (exact_box_tiles); narrower ones
+// the scalar test, which a call and a vector of mostly idle lanes would not beat.
+constexpr int kVectorBoxWidth = 4;
 
 }  // namespace
 
@@ -43,7 +46,7 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
       // The outputs as this thread's locals (swapped in and back, capacity kept): the vectors'
       // headers sit side by side in frame, and a push_back to one would invalidate the cache
       // line of the others' (false sharing cost more than the work at 2 threads).
-      std::vector<std::uint32_t> out_tiles, counts;
+      std::vector<std::uint32_t> out_tiles, counts, box_tiles;
       std::vector<std::uint64_t> out_keys;
       out_tiles.swap(frame.chunk_tiles[c]);
       out_keys.swap(frame.chunk_keys[c]);
@@ -61,14 +64,22 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
         const std::uint64_t key_low =
             (static_cast<std::uint64_t>(gm::depth_bits(f.depth)) << 32) | static_cast<std::uint64_t>(i);
         const std::size_t emitted_before = out_keys.size();
-        for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
-          for (int tx = f.tile_x0; tx < f.tile_x1; ++tx) {
-            if (exact && !gm::footprint_touches_tile(f, tx, ty, width, height)) continue;
-            const std::uint32_t tile = static_cast<std::uint32_t>(ty) * tiles_x + tx;
-            out_tiles.push_back(tile);
-            out_keys.push_back(key_low);
-            counts[tile]++;
-          }
+        if (exact && f.tile_x1 - f.tile_x0 >= kVectorBoxWidth) {
+          if (box_tiles.size() < exact_box_tiles_room(f)) box_tiles.resize(exact_box_tiles_room(f));
+          const std::size_t touched = exact_box_tiles(f, width, height, tiles_x, box_tiles.data());
+          out_tiles.insert(out_tiles.end(), box_tiles.begin(), box_tiles.begin() + touched);
+          out_keys.insert(out_keys.end(), touched, key_low);
+          for (std::size_t k = 0; k < touched; ++k) counts[box_tiles[k]]++;
+        } else {
+          for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
+            for (int tx = f.tile_x0; tx < f.tile_x1; ++tx) {
+              if (exact && !gm::footprint_touches_tile(f, tx, ty, width, height)) continue;
+              const std::uint32_t tile = static_cast<std::uint32_t>(ty) * tiles_x + tx;
+              out_tiles.push_back(tile);
+              out_keys.push_back(key_low);
+              counts[tile]++;
+            }
+        }
         if (out_keys.size() > emitted_before) {
           my_visible++;
         } else {  // the box reached the image, the ellipse did not
