@@ -227,14 +227,24 @@ void expect_exact_box_tiles_match_the_scalar_test(const std::string& what) {
       const float scale[3] = {std::pow(10.0f, -3.0f + 3.5f * uni(rng)), std::pow(10.0f, -3.0f + 3.5f * uni(rng)),
                               std::pow(10.0f, -3.0f + 3.5f * uni(rng))};
       float quat[4], norm = 0.0f;
-      for (float& q : quat) norm += (q = normal(rng)) * q;
+      for (float& q : quat) {
+        q = normal(rng);
+        norm += q * q;
+      }
       for (float& q : quat) q /= std::sqrt(norm);
       gm::Footprint f;
       if (gm::project(cam, geo, position, scale, quat, 0.02f + 0.98f * uni(rng), f) != gm::kVisible) continue;
       ++boxes;
       wide_boxes += f.tile_x1 - f.tile_x0 > 16 ? 1 : 0;
-      vector_tiles.assign(cpu::exact_box_tiles_room(f), 0u);
-      vector_tiles.resize(cpu::exact_box_tiles(f, cam.width, cam.height, cam.tiles_x, vector_tiles.data()));
+      // Sentinels past the room the function asks for: it must not write there.
+      const std::size_t room = cpu::exact_box_tiles_room(f);
+      constexpr std::uint32_t kSentinel = 0xdeadbeefu;
+      vector_tiles.assign(room + 64, kSentinel);
+      const std::size_t count = cpu::exact_box_tiles(f, cam.width, cam.height, cam.tiles_x, vector_tiles.data());
+      ASSERT_TRUE(std::all_of(vector_tiles.begin() + room, vector_tiles.end(),
+                              [](std::uint32_t v) { return v == kSentinel; }))
+          << what << ": wrote past its room (" << room << ")";
+      vector_tiles.resize(count);
       scalar_tiles.clear();
       for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
         for (int tx = f.tile_x0; tx < f.tile_x1; ++tx)
@@ -258,6 +268,29 @@ TEST(CpuSimdEmit, ExactBoxTilesAreTheScalarTestsOnEveryTarget) {
   hwy::SetSupportedTargetsForTest(0);
 #else
   expect_exact_box_tiles_match_the_scalar_test("scalar");
+#endif
+}
+
+// FLASHGS_CPU_SIMD caps the SIMD target (e.g. AVX2 on an AVX-512 host); a name the build or
+// the CPU lacks gets one line naming it and the best target; unset again, the best target.
+TEST(CpuSimdTarget, TheEnvironmentCapsTheTarget) {
+#ifdef FLASHGS_HAVE_HWY
+  const std::string best = make_cpu_renderer(1, CpuBlend::simd)->name();
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    setenv("FLASHGS_CPU_SIMD", hwy::TargetName(target), 1);
+    const std::string name = make_cpu_renderer(1, CpuBlend::simd)->name();
+    EXPECT_NE(name.find(std::string(hwy::TargetName(target)) + " blend"), std::string::npos) << name;
+  }
+  setenv("FLASHGS_CPU_SIMD", "NO_SUCH_TARGET", 1);
+  testing::internal::CaptureStderr();
+  const std::string fallback = make_cpu_renderer(1, CpuBlend::simd)->name();
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find("FLASHGS_CPU_SIMD=NO_SUCH_TARGET: not a SIMD target"), std::string::npos) << said;
+  EXPECT_EQ(fallback, best);
+  unsetenv("FLASHGS_CPU_SIMD");
+  EXPECT_EQ(make_cpu_renderer(1, CpuBlend::simd)->name(), best);
+#else
+  GTEST_SKIP() << "built without Highway: the scalar kernel only";
 #endif
 }
 

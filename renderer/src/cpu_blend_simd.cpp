@@ -10,8 +10,14 @@
 // bound of the scalar kernel's (test_cpu_simd.cpp, every real scene). The pruning margins
 // (0.5 in q, a pixel) dwarf these roundings. For a given CPU (target) and any thread count the
 // bytes are the same.
+#include <strings.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <string>
 
 #include "cpu_frame.h"
 
@@ -376,6 +382,30 @@ void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::si
 
 std::string simd_target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
 
+void apply_simd_target_limit() {
+  hwy::DisableTargets(0);  // what the CPU supports, whatever an earlier renderer chose
+  const char* wanted = std::getenv("FLASHGS_CPU_SIMD");
+  if (!wanted || !*wanted) return;
+  std::int64_t chosen = 0;
+  std::string names;
+  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    names += std::string(names.empty() ? "" : ", ") + hwy::TargetName(target);
+    if (strcasecmp(hwy::TargetName(target), wanted) == 0) chosen = target;
+  }
+  if (chosen == 0) {
+    // Once per value: a process makes several renderers.
+    static std::mutex said_mutex;
+    static std::string said;
+    const std::lock_guard<std::mutex> lock(said_mutex);
+    if (said != wanted)
+      std::fprintf(stderr, "FLASHGS_CPU_SIMD=%s: not a SIMD target this build has and this CPU runs (%s); using the best\n",
+                   wanted, names.c_str());
+    said = wanted;
+    return;
+  }
+  hwy::DisableTargets(chosen - 1);  // Highway's better targets are the lower bits
+}
+
 }  // namespace cpu
 }  // namespace flashgs
 #endif  // HWY_ONCE
@@ -394,6 +424,12 @@ void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::si
 }
 
 std::string simd_target_name() { return "scalar"; }
+
+void apply_simd_target_limit() {
+  const char* wanted = std::getenv("FLASHGS_CPU_SIMD");
+  if (wanted && *wanted)
+    std::fprintf(stderr, "FLASHGS_CPU_SIMD=%s: this build has no SIMD kernels (built without Highway)\n", wanted);
+}
 
 }  // namespace cpu
 }  // namespace flashgs

@@ -73,6 +73,9 @@ std::size_t ExactBoxTiles(const gm::Footprint& f, int width, int height, int til
   return count;
 }
 
+// How far past the last kept tile CompressStore may write: a vector.
+std::size_t VectorLanes() { return hn::Lanes(FloatTag()); }
+
 }  // namespace HWY_NAMESPACE
 }  // namespace cpu
 }  // namespace flashgs
@@ -83,15 +86,16 @@ namespace flashgs {
 namespace cpu {
 
 HWY_EXPORT(ExactBoxTiles);
+HWY_EXPORT(VectorLanes);
 
 std::size_t exact_box_tiles(const gm::Footprint& f, int width, int height, int tiles_x, std::uint32_t* out) {
   return HWY_DYNAMIC_DISPATCH(ExactBoxTiles)(f, width, height, tiles_x, out);
 }
 
 std::size_t exact_box_tiles_room(const gm::Footprint& f) {
-  // CompressStore writes a whole vector: room for the widest target's past the last tile.
+  // CompressStore writes a whole vector of the target exact_box_tiles runs on.
   return static_cast<std::size_t>(f.tile_x1 - f.tile_x0) * static_cast<std::size_t>(f.tile_y1 - f.tile_y0) +
-         HWY_MAX_BYTES / sizeof(float);
+         HWY_DYNAMIC_DISPATCH(VectorLanes)();
 }
 
 }  // namespace cpu

@@ -18,11 +18,17 @@ namespace flashgs {
 
 namespace {
 
+// The blend kernel's name, after FLASHGS_CPU_SIMD has picked the SIMD target.
+std::string blend_kernel_name(CpuBlend blend) {
+  cpu::apply_simd_target_limit();
+  return blend == CpuBlend::scalar ? "scalar" : cpu::simd_target_name();
+}
+
 class CpuRenderer final : public Renderer {
  public:
   CpuRenderer(int threads, CpuBlend blend)
       : kernel_(blend == CpuBlend::scalar ? cpu::BlendKernel::scalar : cpu::BlendKernel::simd),
-        kernel_name_(blend == CpuBlend::scalar ? "scalar" : cpu::simd_target_name()) {
+        kernel_name_(blend_kernel_name(blend)) {
 #ifdef _OPENMP
     frame_.threads = threads > 0 ? threads : omp_get_max_threads();
 #else
