@@ -65,7 +65,8 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
             (static_cast<std::uint64_t>(gm::depth_bits(f.depth)) << 32) | static_cast<std::uint64_t>(i);
         const std::size_t emitted_before = out_keys.size();
         if (exact && f.tile_x1 - f.tile_x0 >= kVectorBoxWidth) {
-          if (box_tiles.size() < exact_box_tiles_room(f)) box_tiles.resize(exact_box_tiles_room(f));
+          const std::size_t room = exact_box_tiles_room(f);
+          if (box_tiles.size() < room) box_tiles.resize(room);
           const std::size_t touched = exact_box_tiles(f, width, height, tiles_x, box_tiles.data());
           out_tiles.insert(out_tiles.end(), box_tiles.begin(), box_tiles.begin() + touched);
           out_keys.insert(out_keys.end(), touched, key_low);
