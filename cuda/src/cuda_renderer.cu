@@ -504,11 +504,11 @@ class CudaRendererImpl final : public CudaRenderer {
   // Whether sorting per bin (launch_bin_sort) pays over CUB's radix sort of the whole frame.
   // Measured on an H200 (docs/PERFORMANCE.md, v16 and v19): sort + ranges 18-41 us shorter at
   // 1080p on pc_biker and pc_playbot (2,040 bins of 200-400 pairs); at 4K (8,160 bins), since
-  // the bin blocks write their tile lists without idle groups, 6-24 us shorter on pc_biker and
-  // the same on pc_playbot, with no wait for the host between emission and sort; 0.1 ms longer
-  // on 7 x pc_playbot at 1080p (about 700 pairs per bin; bins of more than 2,048 sort in global
-  // memory). Judged on the last frame's bin pairs: the emission that this decides comes before
-  // this frame's count.
+  // the bin blocks write their tile lists without idle groups, 7-31 us shorter on five real
+  // scenes (v19), with no wait for the host between emission and sort, but not for frames of
+  // frame-covering Gaussians (below, v20); 0.1 ms longer on 7 x pc_playbot at 1080p (about 700
+  // pairs per bin; bins of more than 2,048 sort in global memory). Judged on the last frame's
+  // bin pairs and blend records: the emission that this decides comes before this frame's count.
   bool bin_sort_pays(std::uint64_t bins) const {
     if (bins > cuda::kBinSortMaxBins) return false;  // beyond the scatter pass's shared histogram
     if (bin_sort_ != kAuto) return bin_sort_ == kAlways;
