@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <future>
 #include <random>
 #include <thread>
@@ -197,17 +198,21 @@ void expect_simd_alpha_within_its_bound(const std::string& what) {
   EXPECT_EQ(let_through, 0u) << what << ": values below power_cut passed 1/255";
 }
 
-TEST(CpuSimdBlend, AlphaWithinItsBoundOnEveryTarget) {
+// Runs check(target name) on every SIMD target this build has and this CPU runs (without
+// Highway: once, "scalar"), then goes back to what the CPU supports.
+void on_every_target(const std::function<void(const std::string&)>& check) {
 #ifdef FLASHGS_HAVE_HWY
   for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
     hwy::SetSupportedTargetsForTest(target);
-    expect_simd_alpha_within_its_bound(hwy::TargetName(target));
+    check(hwy::TargetName(target));
   }
   hwy::SetSupportedTargetsForTest(0);
 #else
-  expect_simd_alpha_within_its_bound("scalar");
+  check("scalar");
 #endif
 }
+
+TEST(CpuSimdBlend, AlphaWithinItsBoundOnEveryTarget) { on_every_target(expect_simd_alpha_within_its_bound); }
 
 // The vector exact tile test (cpu_emit_simd.cpp) keeps the tiles the scalar test keeps, in
 // the same order, on every target this CPU runs: footprints from a pixel to wider than the
@@ -260,15 +265,7 @@ void expect_exact_box_tiles_match_the_scalar_test(const std::string& what) {
 }
 
 TEST(CpuSimdEmit, ExactBoxTilesAreTheScalarTestsOnEveryTarget) {
-#ifdef FLASHGS_HAVE_HWY
-  for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
-    hwy::SetSupportedTargetsForTest(target);
-    expect_exact_box_tiles_match_the_scalar_test(hwy::TargetName(target));
-  }
-  hwy::SetSupportedTargetsForTest(0);
-#else
-  expect_exact_box_tiles_match_the_scalar_test("scalar");
-#endif
+  on_every_target(expect_exact_box_tiles_match_the_scalar_test);
 }
 
 // FLASHGS_CPU_SIMD caps the SIMD target (e.g. AVX2 on an AVX-512 host); a name the build or
