@@ -526,6 +526,40 @@ TEST(CudaMacroBins, ChangeNoByteAndNoTileCount) {
   }
 }
 
+// The warp blend leaves the stop rule out for the staged Gaussians that cannot take a pixel
+// below the minimum T (blend.cu's stop bound); with the rule run everywhere
+// (FLASHGS_BLEND_STOP_BOUND=0) every byte must be the same, on frames where pixels stop:
+// opaque real scenes, hundreds of stacked layers, opacities at the cut.
+TEST(CudaBlend, StopBoundKeepsEveryByte) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto compare = [](const std::string& what, const std::shared_ptr<const Scene>& scene,
+                          const std::vector<Camera>& cameras) {
+    auto bounded = make_cuda_renderer();
+    setenv("FLASHGS_BLEND_STOP_BOUND", "0", 1);
+    auto everywhere = make_cuda_renderer();
+    unsetenv("FLASHGS_BLEND_STOP_BOUND");
+    bounded->set_scene(scene);
+    everywhere->set_scene(scene);
+    for (const Camera& camera : cameras) {
+      const Result a = render(*bounded, camera, RenderOptions{});
+      const Result b = render(*everywhere, camera, RenderOptions{});
+      EXPECT_TRUE(a.image.rgb == b.image.rgb) << what << " " << camera.name;
+    }
+  };
+  const auto demo = test::load_demo_scene();
+  const auto demo_cameras = test::load_demo_cameras();
+  compare("demo", demo, {demo_cameras[0].resized(1001, 563), demo_cameras[3].resized(1920, 1080)});
+  for (const std::string& name : test::shared_scene_names()) {
+    const std::vector<Camera> cameras = test::load_shared_cameras(name);
+    const auto scene = test::load_shared_scene(name);
+    compare(name, scene, {cameras[0], cameras[10].resized(3840, 2160), inside_camera(*scene, 1001, 563)});
+  }
+  for (const char* name : {"stacked", "equal_depth", "opacity_edges"}) {
+    const StressCase c = make_stress_case(name);
+    compare(name, std::make_shared<const Scene>(c.scene), c.cameras);
+  }
+}
+
 // Same tile counts as the CPU, tile by tile.
 TEST(CudaStats, TileCountsMatchTheCpu) {
   FLASHGS_REQUIRE_CUDA();

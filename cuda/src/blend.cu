@@ -286,7 +286,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       for (int p = 0; p < kLanePixelsX; ++p) lowest_t = isnan(lane_x[p]) ? lowest_t : fminf(lowest_t, t[p]);
       // T > 0, so its bits order as the floats do.
       lowest_t = __uint_as_float(__reduce_min_sync(kFullMask, __float_as_uint(lowest_t)));
-      if (lowest_t >= kBoundWorthT) {
+      if (a.stop_bound && lowest_t >= kBoundWorthT) {
         float kept = meets ? 1.0f - fminf(gm::kAlphaMax, exp2_approx(next.opacity - q_min + 1e-3f)) : 1.0f;
 #pragma unroll
         for (int offset = 1; offset < kWarp; offset <<= 1) {

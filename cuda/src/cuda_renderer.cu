@@ -183,6 +183,9 @@ class CudaRendererImpl final : public CudaRenderer {
     stream_ = stream_handle_.get();
     // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
     if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
+    // FLASHGS_BLEND_STOP_BOUND=0 runs the blend's stop rule on every staged Gaussian: the same
+    // image, slower (the tests compare the two).
+    if (const char* bound = std::getenv("FLASHGS_BLEND_STOP_BOUND")) stop_bound_ = std::atoi(bound) != 0;
     // And the box size (in tiles, bins with macro bins) above which warps emit a Gaussian's
     // pairs after preprocess, in work items of how many 32-bin chunks.
     if (const char* tiles = std::getenv("FLASHGS_LARGE_BOX_TILES"))
@@ -615,6 +618,7 @@ class CudaRendererImpl final : public CudaRenderer {
                                                          : cuda::BlendKernel::warp_tile);
     blend.exp2_alpha = f.args->exp2_alpha;
     blend.region_width = region_width_;
+    blend.stop_bound = stop_bound_;
     blend.bins = bins_;
     blend.values = b.values[which];
     blend.tile_ranges = b.tile_ranges;
@@ -846,6 +850,7 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t pair_capacity_ = 0;
   std::size_t last_tiles_ = 0;
   int region_width_ = 8;
+  bool stop_bound_ = true;
   std::size_t cub_sized_for_gaussians_ = ~std::size_t{0};  // sizes cub_temp_ was last checked for
   std::uint64_t cub_sized_for_pairs_ = 0;
   static constexpr int kMaxBoxThreshold = 1 << 20;  // large_box_tiles_ at most: a 16384x16384 frame's tiles

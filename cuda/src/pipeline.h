@@ -279,6 +279,7 @@ struct BlendArgs {
   BlendKernel kernel;
   bool exp2_alpha;
   int region_width;              // warp blend: a warp's region, 16 x 4 or 8 x 8 pixels
+  bool stop_bound;               // warp blend (exp2): no stop rule where no pixel can stop
   const std::uint32_t* values;   // sorted pair values (blend records; tile bits when binned)
   BinGrid bins;                  // warp blend: what tile_ranges and tile_order index (per pixel: tiles)
   const uint2* tile_ranges;
