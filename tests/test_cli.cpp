@@ -15,6 +15,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "flashgs/demo_scene.h"
@@ -221,8 +222,8 @@ TEST(CliBench, TiledSceneIsBenchedAndTooManyCopiesAreRefused) {
   EXPECT_FALSE(fs::exists(dir + "/c.json"));
 }
 
-// fp16_sh in the sweeps: `report` has its row (group "precision", column fp16_sh set, an
-// error against the fp64 reference) beside flash's, and `bench` its row.
+// The fp16 options in the sweeps: `report` has their rows (group "precision", columns fp16_sh
+// and fp16_shape set, an error against the fp64 reference) beside flash's, and `bench` theirs.
 std::vector<std::vector<std::string>> read_csv(const std::string& path) {
   std::vector<std::vector<std::string>> rows;
   std::ifstream in(path);
@@ -235,7 +236,7 @@ std::vector<std::vector<std::string>> read_csv(const std::string& path) {
   return rows;
 }
 
-TEST(CliReport, Fp16ShIsSweptWithItsErrorAgainstTheReference) {
+TEST(CliReport, Fp16OptionsAreSweptWithTheirErrorAgainstTheReference) {
   const std::string dir = scratch_dir("report_fp16");
   const CliResult r = run_cli("report --backend cpu -r 64x36 --camera-list 0 --repeat 1 --ref-window 16 -o " + dir);
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -246,24 +247,33 @@ TEST(CliReport, Fp16ShIsSweptWithItsErrorAgainstTheReference) {
     EXPECT_NE(it, rows[0].end()) << "no column " << name;
     return static_cast<std::size_t>(it - rows[0].begin());
   };
-  const std::size_t config = column("config"), group = column("group"), fp16 = column("fp16_sh"),
-                    psnr = column("psnr_vs_fp64_db");
+  const std::size_t config = column("config"), group = column("group"), fp16_sh = column("fp16_sh"),
+                    fp16_shape = column("fp16_shape"), psnr = column("psnr_vs_fp64_db");
   std::map<std::string, std::vector<std::string>> by_name;
   for (std::size_t i = 1; i < rows.size(); ++i)
     if (rows[i].size() == rows[0].size()) by_name[rows[i][config]] = rows[i];
-  ASSERT_TRUE(by_name.count("fp16-sh")) << r.output;
   ASSERT_TRUE(by_name.count("flash"));
-  EXPECT_EQ(by_name["fp16-sh"][group], "precision");
-  EXPECT_EQ(by_name["fp16-sh"][fp16], "1");
-  EXPECT_EQ(by_name["flash"][fp16], "0");
-  const double fp16_psnr = std::strtod(by_name["fp16-sh"][psnr].c_str(), nullptr);
-  EXPECT_GT(fp16_psnr, 40.0) << by_name["fp16-sh"][psnr];
-  EXPECT_NE(by_name["fp16-sh"][psnr], by_name["flash"][psnr]) << "fp16_sh must change the image";
+  EXPECT_EQ(by_name["flash"][fp16_sh], "0");
+  EXPECT_EQ(by_name["flash"][fp16_shape], "0");
+  // name, fp16_sh, fp16_shape
+  for (const auto& [name, sh, shape] : {std::tuple<std::string, const char*, const char*>{"fp16-sh", "1", "0"},
+                                        {"fp16-shape", "0", "1"},
+                                        {"fp16-all", "1", "1"}}) {
+    ASSERT_TRUE(by_name.count(name)) << name << "\n" << r.output;
+    EXPECT_EQ(by_name[name][group], "precision") << name;
+    EXPECT_EQ(by_name[name][fp16_sh], sh) << name;
+    EXPECT_EQ(by_name[name][fp16_shape], shape) << name;
+    const double fp16_psnr = std::strtod(by_name[name][psnr].c_str(), nullptr);
+    EXPECT_GT(fp16_psnr, 40.0) << name << " " << by_name[name][psnr];
+    EXPECT_NE(by_name[name][psnr], by_name["flash"][psnr]) << name << " must change the image";
+  }
 
   const CliResult bench = run_cli("bench --backend cpu -r 32x18 --camera-list 0 --warmup 0 --repeat 1 --configs "
-                                  "flash-fp16_sh --json " + dir + "/b.json");
+                                  "flash-fp16_sh,flash-fp16_shape,flash-fp16_sh-fp16_shape --json " + dir + "/b.json");
   ASSERT_EQ(bench.exit_code, 0) << bench.output;
-  EXPECT_NE(bench.output.find("\n32x18      flash-fp16_sh "), std::string::npos) << bench.output;
+  for (const char* label : {"flash-fp16_sh", "flash-fp16_shape", "flash-fp16_sh-fp16_shape"})
+    EXPECT_NE(bench.output.find(std::string("\n32x18      ") + label + " "), std::string::npos) << label << "\n"
+                                                                                               << bench.output;
 }
 
 TEST(CliGenerate, RefusesToOverwriteAScene) {

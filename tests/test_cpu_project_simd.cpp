@@ -100,7 +100,7 @@ void expect_same_bytes(const Scene& scene, const Camera& camera, const RenderOpt
       if (!same && first == scene.size()) first = i;
     }
     const std::string where = what + " " + options.label() + " sh" + std::to_string(options.sh_degree_cap) +
-                              (options.fp16_sh ? " fp16" : "") + " " + target_name(target);
+                              " " + target_name(target);
     EXPECT_EQ(wrong_cull, 0u) << where << ": first at " << first << " (scalar " << int(scalar.cull[first])
                               << ", simd " << int(simd.cull[first]) << ")";
     EXPECT_EQ(wrong_footprint, 0u) << where << ": first at " << first;
@@ -128,7 +128,8 @@ std::vector<RenderOptions> geometry_configs() {
   return configs;
 }
 
-// Every geometry configuration at the scene's full SH, then every SH cap with and without fp16 SH.
+// Every geometry configuration at the scene's full SH, then every SH cap with and without fp16 SH,
+// then the shapes as halves (fp16_shape) alone and with fp16 SH.
 void expect_same_bytes_for_every_option(const Scene& scene, const Camera& camera, const std::string& what,
                                         Totals& totals) {
   for (const RenderOptions& options : geometry_configs()) expect_same_bytes(scene, camera, options, what, totals);
@@ -139,6 +140,8 @@ void expect_same_bytes_for_every_option(const Scene& scene, const Camera& camera
       o.fp16_sh = fp16;
       expect_same_bytes(scene, camera, o, what, totals);
     }
+  for (const RenderOptions& o : fp16_configs())
+    if (o.fp16_shape) expect_same_bytes(scene, camera, o, what, totals);
 }
 
 // The first n Gaussians of a scene.

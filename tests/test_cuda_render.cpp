@@ -278,15 +278,15 @@ TEST(CudaSanitizer, Frames) {
           std::accumulate(r.stats.tile_pair_counts.begin(), r.stats.tile_pair_counts.end(), std::uint64_t{0});
       EXPECT_EQ(sum, r.stats.kv_pairs) << camera.name << " " << o.label();
     }
-  // The SH bands as halves (fp16_sh), on the demo scene: it has higher bands to read, the
-  // sanitizer's real scene (pc_biker) has none.
+  // The fp16 storage options (fp16_sh, fp16_shape, both), on the demo scene: it has higher
+  // bands to read, the sanitizer's real scene (pc_biker) has none.
   auto demo_gpu = make_cuda_renderer();
   const auto demo = test::load_demo_scene();
   demo_gpu->set_scene(demo);
-  RenderOptions half_sh;
-  half_sh.fp16_sh = true;
+  std::vector<RenderOptions> precisions = fp16_configs();
+  precisions.push_back(RenderOptions{});  // and back: the scene is re-packed each time
   for (const Camera& camera : sanitizer_cameras(*demo, test::load_demo_cameras()))
-    for (const RenderOptions& o : {half_sh, RenderOptions{}}) {  // and back: the scene is re-packed twice
+    for (const RenderOptions& o : precisions) {
       const Result r = render(*demo_gpu, camera, o);
       EXPECT_EQ(count_non_finite(r.image), 0u) << camera.name << " " << o.label();
     }
@@ -716,43 +716,48 @@ TEST(CudaEdgeCases, SceneTooLargeIsAnError) {
   EXPECT_GT(r.stats.kv_pairs, 0u);
 }
 
-// RenderOptions::fp16_sh: the GPU stores the higher SH bands as halves (8 bytes per 4
-// coefficients instead of 16) and evaluates the same half values as the CPU, so CUDA fp16
-// matches CPU fp16 within the usual bound; switching the option on one renderer re-packs the
-// scene, and fp32 -> fp16 -> fp32 gives the bytes of fresh renderers.
-void check_fp16_sh(const std::string& name, std::shared_ptr<const Scene> scene, const Camera& camera) {
-  RenderOptions fp16;
-  fp16.fp16_sh = true;
+// The fp16 storage options: the GPU stores the higher SH bands as halves (fp16_sh: 8 bytes per
+// 4 coefficients instead of 16) and each Gaussian's rotation, scale and opacity as one record
+// of halves (fp16_shape: 40 bytes per Gaussian instead of 56), and evaluates the same half
+// values as the CPU, so CUDA matches the CPU within the usual bound with the same pairs;
+// switching an option on one renderer re-packs the scene, and fp32 -> fp16 -> fp32 gives the
+// bytes of fresh renderers.
+void check_fp16(const std::string& name, std::shared_ptr<const Scene> scene, const Camera& camera) {
   auto cpu = make_cpu_renderer();
   cpu->set_scene(scene);
-  auto toggled = make_cuda_renderer();
-  toggled->set_scene(scene);
-  const Result fp32_first = render(*toggled, camera, RenderOptions{});
-  const Result half = render(*toggled, camera, fp16);
-  const Result fp32_again = render(*toggled, camera, RenderOptions{});
-  expect_match(name + " " + fp16.label(), render(*cpu, camera, fp16), half);
-  EXPECT_GT(compare_images(fp32_first.image, half.image).max_abs, 0.0) << name << ": fp16_sh changed nothing";
   auto fresh = [&](const RenderOptions& o) {
     auto gpu = make_cuda_renderer();
     gpu->set_scene(scene);
     return render(*gpu, camera, o);
   };
-  EXPECT_EQ(fp32_first.image.rgb, fresh(RenderOptions{}).image.rgb) << name;
-  EXPECT_EQ(fp32_again.image.rgb, fp32_first.image.rgb) << name << ": fp32 after fp16";
-  EXPECT_EQ(half.image.rgb, fresh(fp16).image.rgb) << name;
-  // The higher bands in half the bytes, the rest of the scene unchanged.
   const std::uint64_t groups_of_4 = (static_cast<std::uint64_t>(scene->sh_rest_per_gaussian()) + 3) / 4;
-  EXPECT_EQ(fp32_first.stats.scene_device_bytes - half.stats.scene_device_bytes, scene->size() * groups_of_4 * 8)
-      << name << ": fp32 " << fp32_first.stats.scene_device_bytes << " B, fp16 " << half.stats.scene_device_bytes
-      << " B";
-  EXPECT_EQ(fp32_again.stats.scene_device_bytes, fp32_first.stats.scene_device_bytes) << name;
+  const Result fp32_fresh = fresh(RenderOptions{});
+  for (const RenderOptions& fp16 : fp16_configs()) {
+    const std::string what = name + " " + fp16.label();
+    auto toggled = make_cuda_renderer();
+    toggled->set_scene(scene);
+    const Result fp32_first = render(*toggled, camera, RenderOptions{});
+    const Result half = render(*toggled, camera, fp16);
+    const Result fp32_again = render(*toggled, camera, RenderOptions{});
+    expect_match(what, render(*cpu, camera, fp16), half);
+    EXPECT_GT(compare_images(fp32_first.image, half.image).max_abs, 0.0) << what << " changed nothing";
+    EXPECT_EQ(fp32_first.image.rgb, fp32_fresh.image.rgb) << what;
+    EXPECT_EQ(fp32_again.image.rgb, fp32_first.image.rgb) << what << ": fp32 after fp16";
+    EXPECT_EQ(half.image.rgb, fresh(fp16).image.rgb) << what;
+    // Fewer bytes by exactly what the option packs; the rest of the scene unchanged.
+    const std::uint64_t saved = scene->size() * ((fp16.fp16_sh ? groups_of_4 * 8 : 0) + (fp16.fp16_shape ? 16 : 0));
+    EXPECT_EQ(fp32_first.stats.scene_device_bytes - half.stats.scene_device_bytes, saved)
+        << what << ": fp32 " << fp32_first.stats.scene_device_bytes << " B, fp16 " << half.stats.scene_device_bytes
+        << " B";
+    EXPECT_EQ(fp32_again.stats.scene_device_bytes, fp32_first.stats.scene_device_bytes) << what;
+  }
 }
 
-TEST(CudaFp16Sh, MatchesTheCpuAndTogglesLikeFreshRenderers) {
+TEST(CudaFp16, MatchesTheCpuAndTogglesLikeFreshRenderers) {
   FLASHGS_REQUIRE_CUDA();
-  check_fp16_sh("demo", test::load_demo_scene(), test::load_demo_cameras()[5].resized(1001, 563));
+  check_fp16("demo", test::load_demo_scene(), test::load_demo_cameras()[5].resized(1001, 563));
   for (const std::string& name : test::shared_scene_names())
-    check_fp16_sh(name, test::load_shared_scene(name), test::load_shared_cameras(name)[0]);
+    check_fp16(name, test::load_shared_scene(name), test::load_shared_cameras(name)[0]);
 }
 
 }  // namespace

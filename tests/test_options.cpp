@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 #include <iterator>
+#include <map>
 #include <ostream>
 #include <set>
 #include <string>
@@ -194,33 +195,44 @@ TEST(ReportSweep, EverySwitchIsSweptAloneAndLeftOut) {
   }
 }
 
-// fp16_sh is a precision option, not a switch: off by default and for the baseline, seen by
-// both backends, named in the label, and swept by the report in a group of its own.
-TEST(OptionsTable, Fp16ShIsOffByDefaultAndNamedInTheLabel) {
+// fp16_sh and fp16_shape are precision options, not switches: off by default and for the
+// baseline, seen by both backends, named in the label, part of equality, and swept by the
+// report in a group of their own.
+TEST(OptionsTable, Fp16OptionsAreOffByDefaultAndNamedInTheLabel) {
   EXPECT_FALSE(RenderOptions{}.fp16_sh);
   EXPECT_FALSE(RenderOptions::baseline().fp16_sh);
+  EXPECT_FALSE(RenderOptions{}.fp16_shape);
+  EXPECT_FALSE(RenderOptions::baseline().fp16_shape);
   RenderOptions o;
   o.fp16_sh = true;
   EXPECT_EQ(o.label(), "flash-fp16_sh");
   for (Backend b : {Backend::cpu, Backend::cuda}) EXPECT_TRUE(o.seen_by(b).fp16_sh) << backend_name(b);
+  RenderOptions shape;
+  shape.fp16_shape = true;
+  EXPECT_EQ(shape.label(), "flash-fp16_shape");
+  EXPECT_FALSE(shape == RenderOptions{});
+  for (Backend b : {Backend::cpu, Backend::cuda}) EXPECT_TRUE(shape.seen_by(b).fp16_shape) << backend_name(b);
   RenderOptions b = RenderOptions::baseline();
-  b.fp16_sh = true;
-  EXPECT_EQ(b.label(), "baseline-fp16_sh");
+  b.fp16_sh = b.fp16_shape = true;
+  EXPECT_EQ(b.label(), "baseline-fp16_sh-fp16_shape");
 }
 
-TEST(ReportSweep, Fp16ShIsSweptOnEveryBackend) {
-  int swept = 0;
+TEST(ReportSweep, Fp16OptionsAreSweptOnEveryBackend) {
+  std::map<std::string, RenderOptions> swept;
   for (const cli::SweepConfig& c : cli::sweep_configs()) {
-    if (!c.options.fp16_sh) continue;
-    ++swept;
-    EXPECT_EQ(c.name, "fp16-sh");
+    if (!c.options.fp16_sh && !c.options.fp16_shape) continue;
     EXPECT_EQ(c.group, "precision");
     EXPECT_FALSE(c.gpu_only);
-    RenderOptions expected;
-    expected.fp16_sh = true;
-    EXPECT_EQ(c.options, expected);
+    swept[c.name] = c.options;
   }
-  EXPECT_EQ(swept, 1);
+  RenderOptions sh, shape, all;
+  sh.fp16_sh = true;
+  shape.fp16_shape = true;
+  all.fp16_sh = all.fp16_shape = true;
+  EXPECT_EQ(swept.size(), 3u);
+  EXPECT_EQ(swept["fp16-sh"], sh);
+  EXPECT_EQ(swept["fp16-shape"], shape);
+  EXPECT_EQ(swept["fp16-all"], all);
 }
 
 }  // namespace

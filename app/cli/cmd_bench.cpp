@@ -44,13 +44,11 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 }
 
 // The configurations by name (their labels): baseline, flash, flash with one switch off, and
-// flash with the SH as halves (fp16_sh, the one precision option that changes the scene's bytes).
+// flash with the precision options that change the scene's bytes (fp16_sh, fp16_shape, both).
 std::vector<std::pair<std::string, RenderOptions>> known_configs() {
   std::vector<std::pair<std::string, RenderOptions>> out;
   for (const RenderOptions& o : single_switch_configs()) out.emplace_back(o.label(), o);
-  RenderOptions fp16;
-  fp16.fp16_sh = true;
-  out.emplace_back(fp16.label(), fp16);
+  for (const RenderOptions& o : fp16_configs()) out.emplace_back(o.label(), o);
   return out;
 }
 

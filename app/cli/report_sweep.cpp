@@ -40,10 +40,9 @@ std::vector<SweepConfig> sweep_configs() {
     o.tau = 1.0f / static_cast<float>(denominator);
     out.push_back({"tau=1/" + std::to_string(denominator), "tau", o, false});
   }
-  // Not exact: the SH coefficients as halves (fewer scene bytes on the GPU).
-  RenderOptions fp16;
-  fp16.fp16_sh = true;
-  out.push_back({"fp16-sh", "precision", fp16, false});
+  // Not exact: the SH coefficients, the shapes or both as halves (fewer scene bytes on the GPU).
+  for (const RenderOptions& o : fp16_configs())
+    out.push_back({o.fp16_sh && o.fp16_shape ? "fp16-all" : o.fp16_sh ? "fp16-sh" : "fp16-shape", "precision", o, false});
   add_group(gpu_only, "gpu-only-", "gpu alone", "gpu left out", true);
   return out;
 }

@@ -22,8 +22,8 @@ struct SweepConfig {
 };
 
 // baseline; flash (everything on, default tau); each switch every backend honours alone and
-// each left out; tau = 1/128 ... 1/16; the SH as halves (fp16_sh); and each GPU-only switch
-// alone and left out.
+// each left out; tau = 1/128 ... 1/16; the SH, the shapes or both as halves (fp16-sh,
+// fp16-shape, fp16-all); and each GPU-only switch alone and left out.
 std::vector<SweepConfig> sweep_configs();
 
 // Error of a set of images against another, pooled over cameras / windows.

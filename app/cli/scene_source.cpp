@@ -107,6 +107,8 @@ void RenderArgs::add_to(CLI::App* command) {
       ->delimiter(',')->expected(3)->check(finite_in(0.0, 1.0));
   command->add_option("--sh-degree", sh_degree, "use at most this many SH bands")->check(CLI::Range(0, 3));
   command->add_flag("--fp16-sh", fp16_sh, "use the SH coefficients as half values (not exact; see flashgs report)");
+  command->add_flag("--fp16-shape", fp16_shape,
+                    "use each Gaussian's rotation, scale and opacity as half values (not exact; see flashgs report)");
   command->add_option("--backend", backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
 }
 
@@ -117,6 +119,7 @@ RenderOptions RenderArgs::options() const {
   for (int k = 0; k < 3; ++k) o.background[k] = background[k];
   o.sh_degree_cap = sh_degree;
   o.fp16_sh = fp16_sh;
+  o.fp16_shape = fp16_shape;
   return o;
 }
 

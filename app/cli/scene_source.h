@@ -47,6 +47,7 @@ struct RenderArgs {
   std::vector<float> background = {0, 0, 0};
   int sh_degree = 3;
   bool fp16_sh = false;
+  bool fp16_shape = false;
   std::string backend = "auto";
   void add_to(CLI::App* command);
   RenderOptions options() const;

@@ -26,6 +26,7 @@ struct ViewerArgs {
   float tau = kDefaultTau;
   int sh_degree = 3;
   bool fp16_sh = false;          // the SH coefficients as half values (RenderOptions::fp16_sh)
+  bool fp16_shape = false;       // rotation, scale and opacity as half values (RenderOptions::fp16_shape)
   std::vector<float> background = {0, 0, 0};
   bool heatmap = false;
   bool orbit = false;            // start in orbit mode

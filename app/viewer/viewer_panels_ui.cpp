@@ -292,6 +292,9 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
       ImGui::Checkbox("fp16 SH", &o.fp16_sh);
       if (ImGui::IsItemHovered())
         ImGui::SetTooltip("the SH coefficients as half values: half the GPU bytes of the SH bands, not exact");
+      ImGui::Checkbox("fp16 shape", &o.fp16_shape);
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("rotation, scale and opacity as half values: 16 GPU bytes instead of 32, not exact");
     }
     ImGui::EndTable();
   }

@@ -12,6 +12,7 @@
 #include "device_common.cuh"
 #include "flashgs/model_constants.h"
 #include "pipeline.h"
+#include "scene_access.cuh"
 
 namespace flashgs {
 namespace cuda {
@@ -37,22 +38,21 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
   __shared__ int all_bounded;
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * kChunkSize + threadIdx.x;
   const bool valid = i < scene.count;
-  float4 po = make_float4(0, 0, 0, 0), q = make_float4(1, 0, 0, 0), sd = make_float4(0, 0, 0, 0);
-  if (valid) {
-    po = scene.position_opacity[i];
-    q = scene.rotation[i];
-    sd = scene.scale_dc_r[i];
-  }
-  const float q_norm2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
-  const bool ok = !valid || (bounded(po.x) && bounded(po.y) && bounded(po.z) && bounded(po.w) && bounded(sd.x) &&
-                             bounded(sd.y) && bounded(sd.z) && fabsf(q_norm2 - 1.0f) <= 1e-3f);
+  GaussianShape g{{0, 0, 0}, 0, {1, 0, 0, 0}, {0, 0, 0}, 0};
+  if (valid) g = load_shape(scene, i);
+  const float* q = g.quaternion;
+  const float q_norm2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  const bool ok = !valid || (bounded(g.position[0]) && bounded(g.position[1]) && bounded(g.position[2]) &&
+                             bounded(g.opacity) && bounded(g.scale[0]) && bounded(g.scale[1]) && bounded(g.scale[2]) &&
+                             fabsf(q_norm2 - 1.0f) <= 1e-3f);
   if (threadIdx.x == 0) all_bounded = 1;
   __syncthreads();
   if (!ok) all_bounded = 0;
 
   // The box of the centres (an invalid thread repeats the chunk's first Gaussian).
-  const float4 first = scene.position_opacity[static_cast<std::size_t>(blockIdx.x) * kChunkSize];
-  const float p[3] = {valid ? po.x : first.x, valid ? po.y : first.y, valid ? po.z : first.z};
+  const float4 first = load_position_opacity(scene, static_cast<std::size_t>(blockIdx.x) * kChunkSize);
+  const float p[3] = {valid ? g.position[0] : first.x, valid ? g.position[1] : first.y,
+                      valid ? g.position[2] : first.z};
   for (int a = 0; a < 3; ++a) {
     const float lo = Reduce(storage).Reduce(p[a], Smaller());
     __syncthreads();
@@ -68,10 +68,10 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
   }
   const float radius = Reduce(storage).Reduce(static_cast<float>(sqrt(d2)), Larger());
   __syncthreads();
-  const float scale = fmaxf(fabsf(sd.x), fmaxf(fabsf(sd.y), fabsf(sd.z)));
+  const float scale = fmaxf(fabsf(g.scale[0]), fmaxf(fabsf(g.scale[1]), fabsf(g.scale[2])));
   const float max_scale = Reduce(storage).Reduce(valid ? scale : 0.0f, Larger());
   __syncthreads();
-  const float min_opacity = Reduce(storage).Reduce(valid ? po.w : INFINITY, Smaller());
+  const float min_opacity = Reduce(storage).Reduce(valid ? g.opacity : INFINITY, Smaller());
   if (threadIdx.x == 0) {
     shared_radius = radius;
     shared_scale = max_scale;

@@ -232,17 +232,18 @@ class CudaRendererImpl final : public CudaRenderer {
   std::string name() const override { return "cuda (" + device_name_ + ")"; }
   void* stream() const override { return stream_; }
 
-  // Uploaded in the SH precision of the last frame, so that a viewer in fp16 mode loads a
-  // new scene once. The bounds are the scene's, so a later re-pack of its SH keeps them.
+  // Uploaded in the precision of the last frame, so that a viewer in an fp16 mode loads a
+  // new scene once. The bounds are the scene's, so a later re-pack keeps them.
   void set_scene(std::shared_ptr<const Scene> scene) override {
     if (!scene) throw Error("cuda renderer: null scene");
-    upload_scene(std::move(scene), device_scene_.sh_half);
+    upload_scene(std::move(scene), device_scene_.sh_half, device_scene_.shape_half);
     compute_bounds(*scene_);
   }
 
-  // The scene on the device in the layout of DeviceScene, its SH as floats or (`sh_half`,
-  // RenderOptions::fp16_sh) as halves.
-  void upload_scene(std::shared_ptr<const Scene> scene, bool sh_half) {
+  // The scene on the device in the layout of DeviceScene: its SH as floats or (`sh_half`,
+  // RenderOptions::fp16_sh) as halves, its rotation, scale and opacity as floats or
+  // (`shape_half`, RenderOptions::fp16_shape) as one record of halves.
+  void upload_scene(std::shared_ptr<const Scene> scene, bool sh_half, bool shape_half) {
     const std::size_t n = scene->size();
     if (n >= (std::size_t{1} << 32) - 1)
       throw Error("cuda renderer: " + std::to_string(n) + " Gaussians exceed the 32-bit Gaussian index");
@@ -258,8 +259,8 @@ class CudaRendererImpl final : public CudaRenderer {
     const std::size_t m = std::max<std::size_t>(n, 1);
     const std::size_t chunks = (n + cuda::kChunkSize - 1) / cuda::kChunkSize;
     new_pos.reserve(m * sizeof(float4), "scene positions");
-    new_rot.reserve(m * sizeof(float4), "scene rotations");
-    new_scale.reserve(m * sizeof(float4), "scene scales");
+    new_rot.reserve(m * sizeof(float4), shape_half ? "scene rotations, scales and opacities" : "scene rotations");
+    if (!shape_half) new_scale.reserve(m * sizeof(float4), "scene scales");
     new_dc.reserve(m * sizeof(float2), "scene colours");
     if (stride_vec4 > 0) new_rest.reserve(n * stride_vec4 * rest_group_bytes, "scene SH bands");
     new_chunks.reserve(std::max<std::size_t>(chunks, 1) * sizeof(cuda::ChunkBound), "scene chunk bounds");
@@ -268,18 +269,35 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation");
     const Scene& sc = *scene;
     cuda::SceneUploader uploader(stream_);
-    uploader.upload(new_pos.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
-      const float* p = &sc.positions[i * 3];
-      *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], sc.opacities[i]);
-    });
-    uploader.upload(new_rot.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
-      const float* q = &sc.rotations[i * 4];
-      *static_cast<float4*>(dst) = make_float4(q[0], q[1], q[2], q[3]);
-    });
-    uploader.upload(new_scale.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
-      const float* sv = &sc.scales[i * 3];
-      *static_cast<float4*>(dst) = make_float4(sv[0], sv[1], sv[2], dc(i * 3));
-    });
+    if (shape_half) {
+      uploader.upload(new_pos.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
+        const float* p = &sc.positions[i * 3];
+        *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], dc(i * 3));
+      });
+      uploader.upload(new_rot.as<void>(), sizeof(uint4), n, [&](std::size_t i, void* dst) {
+        const float* q = &sc.rotations[i * 4];
+        const float* sv = &sc.scales[i * 3];
+        const auto pair = [](float low, float high) {
+          return static_cast<unsigned>(gm::float_to_half_bits(low)) |
+                 static_cast<unsigned>(gm::float_to_half_bits(high)) << 16;
+        };
+        *static_cast<uint4*>(dst) = make_uint4(pair(q[0], q[1]), pair(q[2], q[3]), pair(sv[0], sv[1]),
+                                               pair(sv[2], sc.opacities[i]));
+      });
+    } else {
+      uploader.upload(new_pos.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
+        const float* p = &sc.positions[i * 3];
+        *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], sc.opacities[i]);
+      });
+      uploader.upload(new_rot.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
+        const float* q = &sc.rotations[i * 4];
+        *static_cast<float4*>(dst) = make_float4(q[0], q[1], q[2], q[3]);
+      });
+      uploader.upload(new_scale.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
+        const float* sv = &sc.scales[i * 3];
+        *static_cast<float4*>(dst) = make_float4(sv[0], sv[1], sv[2], dc(i * 3));
+      });
+    }
     uploader.upload(new_dc.as<void>(), sizeof(float2), n, [&](std::size_t i, void* dst) {
       *static_cast<float2*>(dst) = make_float2(dc(i * 3 + 1), dc(i * 3 + 2));
     });
@@ -299,9 +317,15 @@ class CudaRendererImpl final : public CudaRenderer {
     next.sh_degree = degree;
     next.rest_stride_vec4 = stride_vec4;
     next.sh_half = sh_half;
-    next.position_opacity = new_pos.as<float4>();
-    next.rotation = new_rot.as<float4>();
-    next.scale_dc_r = new_scale.as<float4>();
+    next.shape_half = shape_half;
+    if (shape_half) {
+      next.position_dc_r = new_pos.as<float4>();
+      next.shape_record = new_rot.as<uint4>();
+    } else {
+      next.position_opacity = new_pos.as<float4>();
+      next.rotation = new_rot.as<float4>();
+      next.scale_dc_r = new_scale.as<float4>();
+    }
     next.dc_gb = new_dc.as<float2>();
     next.sh_rest = sh_half ? nullptr : new_rest.as<float4>();
     next.sh_rest_half = sh_half ? new_rest.as<uint2>() : nullptr;
@@ -375,6 +399,8 @@ class CudaRendererImpl final : public CudaRenderer {
     bounds_radius_ = std::sqrt(radius2);
     max_opacity_ = 1.0f;  // a sigmoid's; a scene built in code may hold more (NaN is never culled by chunk)
     for (std::size_t i = 0; i < n; ++i) max_opacity_ = std::max(max_opacity_, scene.opacities[i]);
+    // fp16_shape may round the largest opacity up (rounding keeps the order, so this is the max).
+    max_opacity_ = std::max(max_opacity_, gm::round_to_half(max_opacity_));
   }
 
   double distance_to_bounds_centre(const gm::CameraParams& cam) const {
@@ -653,8 +679,9 @@ class CudaRendererImpl final : public CudaRenderer {
     if (!scene_) throw Error("cuda renderer: no scene set");
     if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
     if (surface) check_surface(surface, camera);
-    // A frame in the other SH precision re-packs the scene from its host copy first.
-    if (options.fp16_sh != device_scene_.sh_half) upload_scene(scene_, options.fp16_sh);
+    // A frame in another precision re-packs the scene from its host copy first.
+    if (options.fp16_sh != device_scene_.sh_half || options.fp16_shape != device_scene_.shape_half)
+      upload_scene(scene_, options.fp16_sh, options.fp16_shape);
     const gm::CameraParams cam = make_camera_params(camera);
     // The emission kernels keep a box's tile range in 16 bits.
     if (cam.tiles_x > 0xffff || cam.tiles_y > 0xffff)

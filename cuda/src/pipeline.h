@@ -65,17 +65,21 @@ struct ChunkCullFrame {
 // The constants for camera `cam` and flash geometry `geo`; `max_opacity` of the scene.
 ChunkCullFrame chunk_cull_frame(const gm::CameraParams& cam, const gm::GeometryParams& geo, float max_opacity);
 
-// The scene on the device, in a compact layout sized to its SH degree (56 bytes per Gaussian
-// for degree 0, plus 48/96/192 bytes of higher bands for degree 1/2/3, or 24/48/96 bytes as
-// halves under RenderOptions::fp16_sh).
+// The scene on the device, in a compact layout sized to its SH degree: 56 bytes per Gaussian
+// for degree 0 (40 under RenderOptions::fp16_shape), plus 48/96/192 bytes of higher bands for
+// degree 1/2/3 (24/48/96 bytes as halves under RenderOptions::fp16_sh). Read a Gaussian's
+// shape through load_shape (scene_access.cuh), which knows both layouts.
 struct DeviceScene {
   std::size_t count = 0;
   int sh_degree = 0;
   int rest_stride_vec4 = 0;           // groups of 4 higher-band SH coefficients per Gaussian (padded)
   bool sh_half = false;               // fp16_sh: sh_rest_half instead of sh_rest, DC rounded to halves
+  bool shape_half = false;            // fp16_shape: position_dc_r and shape_record instead of the next three
   float4* position_opacity = nullptr;  // [count] world x, y, z; opacity in [0, 1]
   float4* rotation = nullptr;          // [count] unit quaternion w, x, y, z
   float4* scale_dc_r = nullptr;        // [count] linear scale x, y, z; SH DC red
+  float4* position_dc_r = nullptr;     // [count] world x, y, z; SH DC red
+  uint4* shape_record = nullptr;       // [count] halves: quaternion w, x, y, z; scale x, y, z; opacity
   float2* dc_gb = nullptr;             // [count] SH DC green, blue
   float4* sh_rest = nullptr;           // [count][rest_stride_vec4] bands 1.., [k][channel], zero padded
   uint2* sh_rest_half = nullptr;       // the same as IEEE halves, 4 per uint2 (lowest bits first)

@@ -4,13 +4,12 @@
 
 #include <algorithm>
 
-#include <cuda_fp16.h>
-
 #include "bins.cuh"
 #include "chunk_cull.cuh"
 #include "device_common.cuh"
 #include "flashgs/gaussian_math.h"
 #include "pipeline.h"
+#include "scene_access.cuh"
 
 namespace flashgs {
 namespace cuda {
@@ -39,10 +38,10 @@ __device__ __forceinline__ void colour(const DeviceScene& scene, unsigned i, con
 #pragma unroll
       for (int k = 0; k < kVec; ++k) {
         const uint2 v = __ldg(scene.sh_rest_half + first + k);
-        rest[4 * k + 0] = __half2float(__ushort_as_half(static_cast<unsigned short>(v.x & 0xffffu)));
-        rest[4 * k + 1] = __half2float(__ushort_as_half(static_cast<unsigned short>(v.x >> 16)));
-        rest[4 * k + 2] = __half2float(__ushort_as_half(static_cast<unsigned short>(v.y & 0xffffu)));
-        rest[4 * k + 3] = __half2float(__ushort_as_half(static_cast<unsigned short>(v.y >> 16)));
+        rest[4 * k + 0] = low_half(v.x);
+        rest[4 * k + 1] = high_half(v.x);
+        rest[4 * k + 2] = low_half(v.y);
+        rest[4 * k + 3] = high_half(v.y);
       }
     } else {
 #pragma unroll
@@ -315,7 +314,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   if (chunk == kChunkClassify) {  // the whole block: only the centre and opacity are read
     int reason = gm::kCulledOffscreen;
     if (valid) {
-      const float4 po = __ldg(scene.position_opacity + i);
+      const float4 po = load_position_opacity(scene, i);
       const float pos[3] = {po.x, po.y, po.z};
       float view[3];
       gm::to_view(cam, pos, view);
@@ -349,15 +348,10 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
   const bool balanced = FUSED && args.warp_cooperative && args.exact_tile_test && args.large_box_tiles <= kWarp;
   const int shift = buf.bins.shift;
   unsigned small_box = 0;
-  float4 po{}, sd{};
+  GaussianShape g{};
   if (valid) {
-    po = __ldg(scene.position_opacity + i);
-    const float4 q = __ldg(scene.rotation + i);
-    sd = __ldg(scene.scale_dc_r + i);
-    const float pos[3] = {po.x, po.y, po.z};
-    const float scale[3] = {sd.x, sd.y, sd.z};
-    const float quat[4] = {q.x, q.y, q.z, q.w};
-    reason = gm::project(cam, args.geometry, pos, scale, quat, po.w, f);
+    g = load_shape(scene, i);
+    reason = gm::project(cam, args.geometry, g.position, g.scale, g.quaternion, g.opacity, f);
   }
   const bool visible = reason == gm::kVisible;  // (valid)
   // This Gaussian's blend record, the value of its pairs: claimed by the warp with one atomic
@@ -371,27 +365,26 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     record = base + __popc(ballot & ((1u << lane) - 1u));
   }
   if (visible && record < buf.record_capacity) {
-    const float pos[3] = {po.x, po.y, po.z};
     const float2 gb = __ldg(scene.dc_gb + i);
-    const float dc[3] = {sd.w, gb.x, gb.y};
+    const float dc[3] = {g.dc_red, gb.x, gb.y};
     float rgb[3];
-    colour<DEGREE>(scene, i, cam, pos, dc, rgb);
+    colour<DEGREE>(scene, i, cam, g.position, dc, rgb);
     if (buf.record_ids) buf.record_ids[record] = i;
     float4* out = reinterpret_cast<float4*>(buf.blend + record);
     if (args.exp2_alpha) {
       // w' = sqrt(log2(e) / 2) w, so o e^(-q/2) = exp2(log2 o - (u'^2 + v'^2)): one exp2.
       const float hs = sqrtf(0.5f * kLog2e);
       out[0] = make_float4(f.mean_x, f.mean_y, hs * f.whiten[0], hs * f.whiten[1]);
-      out[1] = make_float4(hs * f.whiten[2], hs * f.whiten[3], log2f(po.w), rgb[0]);
+      out[1] = make_float4(hs * f.whiten[2], hs * f.whiten[3], log2f(g.opacity), rgb[0]);
     } else {
       out[0] = make_float4(f.mean_x, f.mean_y, f.whiten[0], f.whiten[1]);
-      out[1] = make_float4(f.whiten[2], f.whiten[3], po.w, rgb[0]);
+      out[1] = make_float4(f.whiten[2], f.whiten[3], g.opacity, rgb[0]);
     }
     // Rows farther than reach_y from the centre have q > 2 ln(255 o), i.e. alpha < 1/255
     // (min over dx of q at offset dy is dy^2 / Sigma_yy); the margins cover rounding, so
     // the blend may skip them without changing a pixel.
     const float det_w = f.whiten[0] * f.whiten[3] - f.whiten[1] * f.whiten[2];
-    const float q_cut = 2.0f * logf(255.0f * po.w) + 0.01f;
+    const float q_cut = 2.0f * logf(255.0f * g.opacity) + 0.01f;
     const float conic_a = f.whiten[0] * f.whiten[0] + f.whiten[2] * f.whiten[2];
     float reach_y = q_cut > 0.0f ? sqrtf(q_cut * conic_a) / fabsf(det_w) + 0.01f : -1.0f;
     if (!(reach_y < 1e30f) && q_cut > 0.0f) reach_y = 1e30f;  // degenerate: never skip

@@ -53,9 +53,14 @@ struct Frame {
   // such frame (the renderer resets half_sh_of with the scene).
   const Scene* half_sh_of = nullptr;
   std::vector<float> half_sh_dc, half_sh_rest;
-  // BlendGaussian's opacity-only terms (log2_opacity, q_cut) of scene `opacity_terms_of` with
-  // `opacity_terms_size` Gaussians, made by its first frame (the renderer resets it with the scene).
-  const Scene* opacity_terms_of = nullptr;
+  // RenderOptions::fp16_shape: the rotations, scales and opacities of scene `half_shape_of`
+  // rounded to halves, made by its first such frame (reset with the scene as above).
+  const Scene* half_shape_of = nullptr;
+  std::vector<float> half_rotations, half_scales, half_opacities;
+  // BlendGaussian's opacity-only terms (log2_opacity, q_cut) of the `opacity_terms_size`
+  // opacities at `opacity_terms_of` (the scene's or their halves), made by the first frame that
+  // reads them (the renderer resets it with the scene).
+  const float* opacity_terms_of = nullptr;
   std::size_t opacity_terms_size = 0;
   std::vector<float> log2_opacity, q_cut;  // [gaussians]
 
@@ -83,19 +88,29 @@ struct TileJob {
   const float* background;  // [3]
 };
 
+// The per-Gaussian arrays the project stage reads: the scene's, or under the fp16 options their
+// half values (Frame's copies). Layouts as in Scene.
+struct SceneArrays {
+  std::int64_t count;
+  const float* positions;  // [count][3]
+  const float* scales;     // [count][3]
+  const float* rotations;  // [count][4]
+  const float* opacities;  // [count]
+  const float* dc;         // [count][3]
+  const float* rest;       // [count][rest_n]
+  int rest_n;
+};
+
 // Which kernel projects: both give the same bytes (the SIMD one runs gm::project's operations
 // per lane, in its order); the scalar one is the reference the tests compare with.
 enum class ProjectKernel { simd, scalar };
 void project(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats,
              ProjectKernel kernel = ProjectKernel::simd);
-// Projects Gaussians [begin, end) into frame.footprints, cull and blend_data; `dc` and `rest`
-// are the scene's SH coefficients or their halves (fp16_sh), `degree` the bands used. The
-// scalar reference (cpu_project.cpp) and the SIMD kernel (cpu_project_simd.cpp; without
-// Highway it is the scalar one).
-void project_block_scalar(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
-                          std::int64_t begin, std::int64_t end);
-void project_block_simd(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
-                        std::int64_t begin, std::int64_t end);
+// Projects Gaussians [begin, end) of `scene` into frame.footprints, cull and blend_data;
+// `degree` is the SH bands used. The scalar reference (cpu_project.cpp) and the SIMD kernel
+// (cpu_project_simd.cpp; without Highway it is the scalar one).
+void project_block_scalar(const SceneArrays& scene, int degree, Frame& frame, std::int64_t begin, std::int64_t end);
+void project_block_simd(const SceneArrays& scene, int degree, Frame& frame, std::int64_t begin, std::int64_t end);
 // BlendGaussian's row-pruning terms from its whitened rows, in double: (a c - b^2) / a =
 // det(W)^2 / a (Lagrange's identity); det(W) = w0 w3 - w1 w2 adds two non-negative terms, so a
 // needle (a nearly singular conic) keeps an accurate row minimum.

@@ -9,12 +9,9 @@ namespace flashgs {
 namespace cpu {
 namespace {
 
-// The scalar reference for one Gaussian. `dc` and `rest`: the scene's SH coefficients, or
-// their half values (RenderOptions::fp16_sh).
+// The scalar reference for one Gaussian.
 template <int DEGREE>
-void project_range(const Scene& scene, const float* dc, const float* rest, Frame& frame, std::int64_t begin,
-                   std::int64_t end) {
-  const int rest_n = scene.sh_rest_per_gaussian();
+void project_range(const SceneArrays& scene, Frame& frame, std::int64_t begin, std::int64_t end) {
   for (std::int64_t i = begin; i < end; ++i) {
     gm::Footprint& f = frame.footprints[i];
     const float opacity = scene.opacities[i];
@@ -30,53 +27,87 @@ void project_range(const Scene& scene, const float* dc, const float* rest, Frame
     g.log2_opacity = frame.log2_opacity[i];
     g.q_cut = frame.q_cut[i];
     set_row_pruning(g);
-    gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], dc + i * 3,
-                          DEGREE > 0 ? rest + i * rest_n : nullptr, g.rgb);
+    gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], scene.dc + i * 3,
+                          DEGREE > 0 ? scene.rest + i * scene.rest_n : nullptr, g.rgb);
   }
 }
 
-// log2_opacity and q_cut depend on the opacity alone: computed once per scene, not per frame.
-void cache_opacity_terms(const Scene& scene, Frame& frame) {
-  if (frame.opacity_terms_of == &scene && frame.opacity_terms_size == scene.size()) return;
-  const std::int64_t n = static_cast<std::int64_t>(scene.size());
-  frame.log2_opacity.resize(scene.size());
-  frame.q_cut.resize(scene.size());
+// log2_opacity and q_cut depend on the opacity alone: computed once per scene (and precision),
+// not per frame.
+void cache_opacity_terms(const SceneArrays& scene, Frame& frame) {
+  const std::size_t n = static_cast<std::size_t>(scene.count);
+  if (frame.opacity_terms_of == scene.opacities && frame.opacity_terms_size == n) return;
+  frame.log2_opacity.resize(n);
+  frame.q_cut.resize(n);
 #pragma omp parallel for schedule(static) num_threads(frame.threads)
-  for (std::int64_t i = 0; i < n; ++i) {
+  for (std::int64_t i = 0; i < scene.count; ++i) {
     const float opacity = scene.opacities[i];
     const float power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
     frame.log2_opacity[i] = std::log2(opacity);
     frame.q_cut[i] = -2.0f * power_cut;  // exact: power_cut = -0.5 q_cut
   }
-  frame.opacity_terms_of = &scene;
-  frame.opacity_terms_size = scene.size();
+  frame.opacity_terms_of = scene.opacities;
+  frame.opacity_terms_size = n;
+}
+
+// `in` rounded to half values into `out` (the CUDA backend stores the halves instead).
+void round_to_halves(const std::vector<float>& in, std::vector<float>& out, int threads) {
+  out.resize(in.size());
+  const std::int64_t n = static_cast<std::int64_t>(in.size());
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (std::int64_t k = 0; k < n; ++k) out[k] = gm::round_to_half(in[k]);
 }
 
 // The scene's SH coefficients as half values, rounded once per scene: a frame then costs what
-// an exact one does (the CUDA backend stores them as halves instead).
+// an exact one does.
 void round_sh_to_halves(const Scene& scene, Frame& frame) {
   if (frame.half_sh_of == &scene) return;
-  frame.half_sh_dc.resize(scene.sh_dc.size());
-  frame.half_sh_rest.resize(scene.sh_rest.size());
-  auto round_all = [&frame](const std::vector<float>& in, std::vector<float>& out) {
-    const std::int64_t n = static_cast<std::int64_t>(in.size());
-#pragma omp parallel for schedule(static) num_threads(frame.threads)
-    for (std::int64_t k = 0; k < n; ++k) out[k] = gm::round_to_half(in[k]);
-  };
-  round_all(scene.sh_dc, frame.half_sh_dc);
-  round_all(scene.sh_rest, frame.half_sh_rest);
+  round_to_halves(scene.sh_dc, frame.half_sh_dc, frame.threads);
+  round_to_halves(scene.sh_rest, frame.half_sh_rest, frame.threads);
   frame.half_sh_of = &scene;
+}
+
+// The same for the rotations, scales and opacities.
+void round_shape_to_halves(const Scene& scene, Frame& frame) {
+  if (frame.half_shape_of == &scene) return;
+  round_to_halves(scene.rotations, frame.half_rotations, frame.threads);
+  round_to_halves(scene.scales, frame.half_scales, frame.threads);
+  round_to_halves(scene.opacities, frame.half_opacities, frame.threads);
+  frame.half_shape_of = &scene;
+}
+
+// What the frame reads of the scene under `options`' precision.
+SceneArrays scene_arrays(const Scene& scene, const RenderOptions& options, Frame& frame) {
+  SceneArrays a{static_cast<std::int64_t>(scene.size()),
+                scene.positions.data(),
+                scene.scales.data(),
+                scene.rotations.data(),
+                scene.opacities.data(),
+                scene.sh_dc.data(),
+                scene.sh_rest.data(),
+                scene.sh_rest_per_gaussian()};
+  if (options.fp16_sh) {
+    round_sh_to_halves(scene, frame);
+    a.dc = frame.half_sh_dc.data();
+    a.rest = frame.half_sh_rest.data();
+  }
+  if (options.fp16_shape) {
+    round_shape_to_halves(scene, frame);
+    a.scales = frame.half_scales.data();
+    a.rotations = frame.half_rotations.data();
+    a.opacities = frame.half_opacities.data();
+  }
+  return a;
 }
 
 }  // namespace
 
-void project_block_scalar(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
-                          std::int64_t begin, std::int64_t end) {
+void project_block_scalar(const SceneArrays& scene, int degree, Frame& frame, std::int64_t begin, std::int64_t end) {
   switch (degree) {
-    case 0: project_range<0>(scene, dc, rest, frame, begin, end); break;
-    case 1: project_range<1>(scene, dc, rest, frame, begin, end); break;
-    case 2: project_range<2>(scene, dc, rest, frame, begin, end); break;
-    default: project_range<3>(scene, dc, rest, frame, begin, end); break;
+    case 0: project_range<0>(scene, frame, begin, end); break;
+    case 1: project_range<1>(scene, frame, begin, end); break;
+    case 2: project_range<2>(scene, frame, begin, end); break;
+    default: project_range<3>(scene, frame, begin, end); break;
   }
 }
 
@@ -90,14 +121,8 @@ void project(const Scene& scene, const RenderOptions& options, Frame& frame, Fra
   }
   // A scene pays only for the SH bands it has (and the viewer's cap).
   const int degree = std::max(0, std::min(scene.sh_degree, options.sh_degree_cap));
-  const float* dc = scene.sh_dc.data();
-  const float* rest = scene.sh_rest.data();
-  if (options.fp16_sh) {
-    round_sh_to_halves(scene, frame);
-    dc = frame.half_sh_dc.data();
-    rest = frame.half_sh_rest.data();
-  }
-  cache_opacity_terms(scene, frame);
+  const SceneArrays arrays = scene_arrays(scene, options, frame);
+  cache_opacity_terms(arrays, frame);
   // Blocks of Gaussians (a multiple of every SIMD width), so that only the last one has a tail
   // for the SIMD kernel's scalar code.
   constexpr std::int64_t kBlock = 1024;
@@ -109,7 +134,7 @@ void project(const Scene& scene, const RenderOptions& options, Frame& frame, Fra
 #pragma omp parallel for schedule(dynamic, 1) num_threads(frame.threads)
   for (std::int64_t b = 0; b < blocks; ++b)
     errors.capture([&] {
-      project_block(scene, dc, rest, degree, frame, b * kBlock, std::min(count, (b + 1) * kBlock));
+      project_block(arrays, degree, frame, b * kBlock, std::min(count, (b + 1) * kBlock));
     });
   errors.rethrow();
   std::uint64_t near = 0, offscreen = 0, low_opacity = 0, degenerate = 0;

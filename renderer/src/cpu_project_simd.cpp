@@ -26,9 +26,9 @@ namespace HWY_NAMESPACE {
 
 #if HWY_TARGET == HWY_SCALAR
 // One lane is the scalar code.
-void ProjectBlock(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
+void ProjectBlock(const SceneArrays& scene, int degree, Frame& frame,
                   std::int64_t begin, std::int64_t end) {
-  project_block_scalar(scene, dc, rest, degree, frame, begin, end);
+  project_block_scalar(scene, degree, frame, begin, end);
 }
 #else
 namespace hn = hwy::HWY_NAMESPACE;
@@ -123,7 +123,7 @@ class CullReasons {
 // gm::project for the lanes of Gaussians [i, i + lanes); fills `out`, returns false when every
 // lane is culled (out.reason alone is then set).
 template <bool kOpacityRadius, bool kTightBox, bool kBaseline>
-bool project_vector(const Scene& scene, const Frame& frame, std::int64_t i, Lanes& out) {
+bool project_vector(const SceneArrays& scene, const Frame& frame, std::int64_t i, Lanes& out) {
   const FloatTag d;
   const IntTag di;
   const gm::CameraParams& cam = frame.camera;
@@ -298,7 +298,7 @@ bool project_vector(const Scene& scene, const Frame& frame, std::int64_t i, Lane
 // gm::sh_basis<DEGREE> for the lanes of Gaussians [i, i + lanes), the same expressions (and
 // sh_to_rgb's normalised direction). The sums over the coefficients follow per visible lane.
 template <int DEGREE>
-void sh_basis_vector(const Scene& scene, const Frame& frame, std::int64_t i, Lanes& out) {
+void sh_basis_vector(const SceneArrays& scene, const Frame& frame, std::int64_t i, Lanes& out) {
   if (DEGREE == 0) return;  // basis[0] is a constant
   const FloatTag d;
   FloatVec basis[16];
@@ -355,9 +355,9 @@ HWY_INLINE void sh_sums(const float* dc, const float* rest, const Lanes& v, std:
 
 // The visible lanes into Frame's arrays, as the scalar reference writes them.
 template <int DEGREE>
-void store_lanes(const Scene& scene, const float* dc, const float* rest, Frame& frame, std::int64_t i,
+void store_lanes(const SceneArrays& scene, Frame& frame, std::int64_t i,
                  std::size_t lanes, const Lanes& v) {
-  const int rest_n = scene.sh_rest_per_gaussian();
+  const int rest_n = scene.rest_n;
   for (std::size_t l = 0; l < lanes; ++l) {
     const std::int64_t id = i + static_cast<std::int64_t>(l);
     frame.cull[id] = static_cast<std::uint8_t>(v.reason[l]);
@@ -386,7 +386,7 @@ void store_lanes(const Scene& scene, const float* dc, const float* rest, Frame& 
     for (int k = 0; k < 4; ++k) g.whiten[k] = f.whiten[k];
     g.opacity = scene.opacities[id];
     HWY_ALIGN float rgb[4];
-    sh_sums<DEGREE>(dc + id * 3, DEGREE > 0 ? rest + id * rest_n : nullptr, v, l, rgb);
+    sh_sums<DEGREE>(scene.dc + id * 3, DEGREE > 0 ? scene.rest + id * rest_n : nullptr, v, l, rgb);
     for (int ch = 0; ch < 3; ++ch) g.rgb[ch] = rgb[ch];
     g.log2_opacity = frame.log2_opacity[id];
     g.q_cut = frame.q_cut[id];
@@ -395,48 +395,48 @@ void store_lanes(const Scene& scene, const float* dc, const float* rest, Frame& 
 }
 
 template <int DEGREE, bool kOpacityRadius, bool kTightBox, bool kBaseline>
-void project_vectors(const Scene& scene, const float* dc, const float* rest, Frame& frame, std::int64_t begin,
+void project_vectors(const SceneArrays& scene, Frame& frame, std::int64_t begin,
                      std::int64_t end) {
   const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(FloatTag()));
   Lanes v;
   for (std::int64_t i = begin; i < end; i += lanes) {
     if (project_vector<kOpacityRadius, kTightBox, kBaseline>(scene, frame, i, v))
       sh_basis_vector<DEGREE>(scene, frame, i, v);
-    store_lanes<DEGREE>(scene, dc, rest, frame, i, static_cast<std::size_t>(lanes), v);
+    store_lanes<DEGREE>(scene, frame, i, static_cast<std::size_t>(lanes), v);
   }
 }
 
 template <int DEGREE>
-void project_vectors_of_degree(const Scene& scene, const float* dc, const float* rest, Frame& frame,
+void project_vectors_of_degree(const SceneArrays& scene, Frame& frame,
                                std::int64_t begin, std::int64_t end) {
   // The geometry is the frame's: one specialisation per combination, no branch per lane.
   const gm::GeometryParams& geo = frame.geometry;
   const int which = (geo.opacity_radius ? 4 : 0) | (geo.tight_bbox ? 2 : 0) | (geo.baseline ? 1 : 0);
   switch (which) {
-    case 0: project_vectors<DEGREE, false, false, false>(scene, dc, rest, frame, begin, end); break;
-    case 1: project_vectors<DEGREE, false, false, true>(scene, dc, rest, frame, begin, end); break;
-    case 2: project_vectors<DEGREE, false, true, false>(scene, dc, rest, frame, begin, end); break;
-    case 3: project_vectors<DEGREE, false, true, true>(scene, dc, rest, frame, begin, end); break;
-    case 4: project_vectors<DEGREE, true, false, false>(scene, dc, rest, frame, begin, end); break;
-    case 5: project_vectors<DEGREE, true, false, true>(scene, dc, rest, frame, begin, end); break;
-    case 6: project_vectors<DEGREE, true, true, false>(scene, dc, rest, frame, begin, end); break;
-    default: project_vectors<DEGREE, true, true, true>(scene, dc, rest, frame, begin, end); break;
+    case 0: project_vectors<DEGREE, false, false, false>(scene, frame, begin, end); break;
+    case 1: project_vectors<DEGREE, false, false, true>(scene, frame, begin, end); break;
+    case 2: project_vectors<DEGREE, false, true, false>(scene, frame, begin, end); break;
+    case 3: project_vectors<DEGREE, false, true, true>(scene, frame, begin, end); break;
+    case 4: project_vectors<DEGREE, true, false, false>(scene, frame, begin, end); break;
+    case 5: project_vectors<DEGREE, true, false, true>(scene, frame, begin, end); break;
+    case 6: project_vectors<DEGREE, true, true, false>(scene, frame, begin, end); break;
+    default: project_vectors<DEGREE, true, true, true>(scene, frame, begin, end); break;
   }
 }
 
-void ProjectBlock(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
+void ProjectBlock(const SceneArrays& scene, int degree, Frame& frame,
                   std::int64_t begin, std::int64_t end) {
   const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(FloatTag()));
   // The scene's last Gaussian goes to the scalar code: sh_sums reads a float past its coefficients.
-  const std::int64_t vector_limit = std::min(end, static_cast<std::int64_t>(scene.size()) - 1);
+  const std::int64_t vector_limit = std::min(end, scene.count - 1);
   const std::int64_t vector_end = begin + std::max<std::int64_t>(0, vector_limit - begin) / lanes * lanes;
   switch (degree) {
-    case 0: project_vectors_of_degree<0>(scene, dc, rest, frame, begin, vector_end); break;
-    case 1: project_vectors_of_degree<1>(scene, dc, rest, frame, begin, vector_end); break;
-    case 2: project_vectors_of_degree<2>(scene, dc, rest, frame, begin, vector_end); break;
-    default: project_vectors_of_degree<3>(scene, dc, rest, frame, begin, vector_end); break;
+    case 0: project_vectors_of_degree<0>(scene, frame, begin, vector_end); break;
+    case 1: project_vectors_of_degree<1>(scene, frame, begin, vector_end); break;
+    case 2: project_vectors_of_degree<2>(scene, frame, begin, vector_end); break;
+    default: project_vectors_of_degree<3>(scene, frame, begin, vector_end); break;
   }
-  project_block_scalar(scene, dc, rest, degree, frame, vector_end, end);  // the tail: fewer than a vector
+  project_block_scalar(scene, degree, frame, vector_end, end);  // the tail: fewer than a vector
 }
 #endif  // HWY_TARGET == HWY_SCALAR
 
@@ -451,9 +451,9 @@ namespace cpu {
 
 HWY_EXPORT(ProjectBlock);
 
-void project_block_simd(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
+void project_block_simd(const SceneArrays& scene, int degree, Frame& frame,
                         std::int64_t begin, std::int64_t end) {
-  HWY_DYNAMIC_DISPATCH(ProjectBlock)(scene, dc, rest, degree, frame, begin, end);
+  HWY_DYNAMIC_DISPATCH(ProjectBlock)(scene, degree, frame, begin, end);
 }
 
 }  // namespace cpu
@@ -465,9 +465,9 @@ void project_block_simd(const Scene& scene, const float* dc, const float* rest, 
 namespace flashgs {
 namespace cpu {
 
-void project_block_simd(const Scene& scene, const float* dc, const float* rest, int degree, Frame& frame,
+void project_block_simd(const SceneArrays& scene, int degree, Frame& frame,
                         std::int64_t begin, std::int64_t end) {
-  project_block_scalar(scene, dc, rest, degree, frame, begin, end);
+  project_block_scalar(scene, degree, frame, begin, end);
 }
 
 }  // namespace cpu

@@ -42,6 +42,7 @@ class CpuRenderer final : public Renderer {
   void set_scene(std::shared_ptr<const Scene> scene) override {
     scene_ = std::move(scene);
     frame_.half_sh_of = nullptr;  // another scene may live at the old one's address
+    frame_.half_shape_of = nullptr;
     frame_.opacity_terms_of = nullptr;
   }
 

@@ -22,6 +22,7 @@ std::string RenderOptions::label() const {
     for (const RenderSwitch& s : kRenderSwitches)
       if (!(this->*(s.member))) label += std::string("-no_") + s.label;
   if (fp16_sh) label += "-fp16_sh";
+  if (fp16_shape) label += "-fp16_shape";
   return label;
 }
 
@@ -37,7 +38,7 @@ bool operator==(const RenderOptions& a, const RenderOptions& b) {
   for (const RenderSwitch& s : kRenderSwitches)
     if (a.*(s.member) != b.*(s.member)) return false;
   return a.algorithm == b.algorithm && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
-         a.fp16_sh == b.fp16_sh &&
+         a.fp16_sh == b.fp16_sh && a.fp16_shape == b.fp16_shape &&
          a.collect_tile_counts == b.collect_tile_counts && std::equal(a.background, a.background + 3, b.background);
 }
 
@@ -49,6 +50,14 @@ std::vector<RenderOptions> single_switch_configs() {
     out.push_back(o);
   }
   return out;
+}
+
+std::vector<RenderOptions> fp16_configs() {
+  RenderOptions sh, shape, both;
+  sh.fp16_sh = true;
+  shape.fp16_shape = true;
+  both.fp16_sh = both.fp16_shape = true;
+  return {sh, shape, both};
 }
 
 const char* algorithm_name(Algorithm a) { return a == Algorithm::baseline ? "baseline" : "flash"; }

@@ -39,6 +39,9 @@ struct RenderOptions {
   // are used as IEEE half values (gm::round_to_half), so that the CUDA backend can keep them in
   // half the bytes. Off by default; `flashgs report` shows its error against the fp64 reference.
   bool fp16_sh = false;
+  // The same for each Gaussian's rotation, scale and opacity: the CUDA backend keeps them in one
+  // 16-byte record instead of 32 bytes of floats. Positions stay floats.
+  bool fp16_shape = false;
   bool collect_tile_counts = false;  // fill FrameStats::tile_pair_counts
 
   // The options of the original 3DGS rasterizer (every switch off).
@@ -117,6 +120,9 @@ inline constexpr RenderSwitch kRenderSwitches[] = {
 // baseline, flash, then flash with each switch of kRenderSwitches off, in table order: the
 // configurations `flashgs bench` times and the CUDA tests compare.
 std::vector<RenderOptions> single_switch_configs();
+// flash with the precision options that store the scene in fewer bytes: fp16_sh, fp16_shape,
+// then both (the whole fp16 storage).
+std::vector<RenderOptions> fp16_configs();
 
 const char* algorithm_name(Algorithm a);
 const char* backend_name(Backend b);
