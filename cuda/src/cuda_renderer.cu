@@ -12,6 +12,7 @@
 #include "flashgs/cuda_renderer.h"
 #include "flashgs/error.h"
 #include "flashgs/frame_params.h"
+#include "host_parallel.h"
 #include "pipeline.h"
 #include "scene_upload.h"
 
@@ -377,28 +378,55 @@ class CudaRendererImpl final : public CudaRenderer {
 
   // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
   // distance to its centre plus its radius.
+  // The sphere around the centres' box and the largest opacity, over the host's threads (at
+  // 100M Gaussians one thread took 0.8-0.95 s). Minima and maxima: the same in any order.
   void compute_bounds(const Scene& scene) {
     const std::size_t n = scene.size();
+    const unsigned threads = cuda::host_threads_for(n, 1 << 16);
+    struct Partial {
+      double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+      double radius2 = 0;
+      float max_opacity = 1.0f;  // a sigmoid's; a scene built in code may hold more (NaN is never culled by chunk)
+    };
+    std::vector<Partial> partial(threads);
+    cuda::for_each_host_range(n, threads, [&](unsigned t, std::size_t begin, std::size_t end) {
+      Partial& p = partial[t];
+      for (std::size_t i = begin; i < end; ++i) {
+        for (int a = 0; a < 3; ++a) {
+          const double v = scene.positions[i * 3 + a];
+          p.lo[a] = std::min(p.lo[a], v);
+          p.hi[a] = std::max(p.hi[a], v);
+        }
+        p.max_opacity = std::max(p.max_opacity, scene.opacities[i]);
+      }
+    });
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (std::size_t i = 0; i < n; ++i)
-      for (int a = 0; a < 3; ++a) {
-        const double v = scene.positions[i * 3 + a];
-        lo[a] = i == 0 ? v : std::min(lo[a], v);
-        hi[a] = i == 0 ? v : std::max(hi[a], v);
+    max_opacity_ = 1.0f;
+    for (int a = 0; a < 3 && n > 0; ++a) {
+      lo[a] = INFINITY;
+      hi[a] = -INFINITY;
+      for (const Partial& p : partial) {
+        lo[a] = std::min(lo[a], p.lo[a]);
+        hi[a] = std::max(hi[a], p.hi[a]);
       }
-    double radius2 = 0;
-    for (int a = 0; a < 3; ++a) bounds_centre_[a] = 0.5 * (lo[a] + hi[a]);
-    for (std::size_t i = 0; i < n; ++i) {
-      double d2 = 0;
-      for (int a = 0; a < 3; ++a) {
-        const double d = scene.positions[i * 3 + a] - bounds_centre_[a];
-        d2 += d * d;
-      }
-      radius2 = std::max(radius2, d2);
     }
+    for (const Partial& p : partial) max_opacity_ = std::max(max_opacity_, p.max_opacity);
+    for (int a = 0; a < 3; ++a) bounds_centre_[a] = 0.5 * (lo[a] + hi[a]);
+    cuda::for_each_host_range(n, threads, [&](unsigned t, std::size_t begin, std::size_t end) {
+      double radius2 = 0;
+      for (std::size_t i = begin; i < end; ++i) {
+        double d2 = 0;
+        for (int a = 0; a < 3; ++a) {
+          const double d = scene.positions[i * 3 + a] - bounds_centre_[a];
+          d2 += d * d;
+        }
+        radius2 = std::max(radius2, d2);
+      }
+      partial[t].radius2 = radius2;
+    });
+    double radius2 = 0;
+    for (const Partial& p : partial) radius2 = std::max(radius2, p.radius2);
     bounds_radius_ = std::sqrt(radius2);
-    max_opacity_ = 1.0f;  // a sigmoid's; a scene built in code may hold more (NaN is never culled by chunk)
-    for (std::size_t i = 0; i < n; ++i) max_opacity_ = std::max(max_opacity_, scene.opacities[i]);
     // fp16_shape may round the largest opacity up (rounding keeps the order, so this is the max).
     max_opacity_ = std::max(max_opacity_, gm::round_to_half(max_opacity_));
   }

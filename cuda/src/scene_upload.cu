@@ -2,30 +2,21 @@
 #include "scene_upload.h"
 
 #include <algorithm>
-#include <thread>
-#include <vector>
 
+#include "host_parallel.h"
 #include "pipeline.h"
 
 namespace flashgs {
 namespace cuda {
 namespace {
 
-// pack(i) for i in [begin, end), split over the host's threads (packing is memory-bound;
-// one thread reaches a fraction of the host's bandwidth).
+// pack(i) for i in [begin, end), split over the host's threads.
 void pack_parallel(std::size_t begin, std::size_t end, std::size_t element_bytes, char* destination,
                    const SceneUploader::Pack& pack) {
   const std::size_t count = end - begin;
-  const unsigned threads = std::max(1u, std::min(std::thread::hardware_concurrency(),
-                                                 static_cast<unsigned>(count / 4096 + 1)));
-  auto run = [&](unsigned t) {
-    const std::size_t lo = begin + count * t / threads, hi = begin + count * (t + 1) / threads;
-    for (std::size_t i = lo; i < hi; ++i) pack(i, destination + (i - begin) * element_bytes);
-  };
-  std::vector<std::thread> workers;
-  for (unsigned t = 1; t < threads; ++t) workers.emplace_back(run, t);
-  run(0);
-  for (std::thread& w : workers) w.join();
+  for_each_host_range(count, host_threads_for(count, 4096), [&](unsigned, std::size_t lo, std::size_t hi) {
+    for (std::size_t i = begin + lo; i < begin + hi; ++i) pack(i, destination + (i - begin) * element_bytes);
+  });
 }
 
 }  // namespace
