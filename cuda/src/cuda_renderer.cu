@@ -376,10 +376,9 @@ class CudaRendererImpl final : public CudaRenderer {
             &deferred_footprints_, &deferred_records_, &deferred_hits_, &deferred_items_};
   }
 
-  // A sphere around every Gaussian centre: the farthest depth a frame can sort is the camera's
-  // distance to its centre plus its radius.
-  // The sphere around the centres' box and the largest opacity, over the host's threads (at
-  // 100M Gaussians one thread took 0.8-0.95 s). Minima and maxima: the same in any order.
+  // A sphere around every Gaussian centre (the farthest depth a frame can sort is the camera's
+  // distance to its centre plus its radius) and the largest opacity, on the host's threads (at
+  // 100M Gaussians one thread took 0.8-0.95 s). Minima and maxima are the same in any order.
   void compute_bounds(const Scene& scene) {
     const std::size_t n = scene.size();
     const unsigned threads = cuda::host_threads_for(n, 1 << 16);
