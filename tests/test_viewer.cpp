@@ -64,9 +64,12 @@ std::string out_dir() {
 // Returns the command prefix, or empty when neither exists.
 std::string display_prefix() {
   // ctest runs the tests in parallel: each process starts its search for a free display number
-  // at its own place, so that two xvfb-run calls rarely race for the same one.
+  // at its own place, so that two xvfb-run calls rarely race for the same one. The X authority
+  // file is ours (-f), so xvfb-run has no temporary folder to remove: its cleanup of one failed
+  // on a CI machine and replaced the viewer's exit status with its own 5.
   if (run("command -v xvfb-run").exit_code == 0)
-    return "xvfb-run -a -n " + std::to_string(100 + (getpid() * 37) % 800) + " -s \"-screen 0 1920x1080x24\" ";
+    return "xvfb-run -a -n " + std::to_string(100 + (getpid() * 37) % 800) + " -f '" + out_dir() + "/xauthority-" +
+           std::to_string(getpid()) + "' -s \"-screen 0 1920x1080x24\" ";
   if (std::getenv("DISPLAY")) return " ";
   return "";
 }
