@@ -210,6 +210,7 @@ struct BinSortArgs {
   std::uint32_t* keys;      // the pairs in bin order: values[1]
   std::uint32_t* values;    // values[0]
   std::uint32_t* scratch;   // keys[1] as 32-bit words: bin [s, e) may use [2s, 2e)
+  std::uint32_t* fill;      // the counting passes' per-bin counts, zeroed here for the next frame
   std::uint32_t* top_lists;     // tile_values[0]
   std::uint32_t* bottom_lists;  // tile_values[1]
   uint2* tile_lists;
@@ -452,6 +453,7 @@ __device__ void sort_in_global(PairSpan home, PairSpan scratch, unsigned n, Sort
 __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
   __shared__ SortShared sh;
   const unsigned bin = blockIdx.x;
+  if (threadIdx.x == 0) a.fill[bin] = 0;  // the scatter pass was its last user this frame
   const uint2 range = a.bin_ranges[bin];
   const unsigned n = range.y - range.x;
   const BinLists lists{a.top_lists, a.bottom_lists, range.x, n};
@@ -481,7 +483,8 @@ __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
 constexpr unsigned kScatterBlocks = 2048;
 constexpr unsigned kCountBlocks = 512;
 
-void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned shared_pairs, cudaStream_t stream) {
+void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned shared_pairs, bool fill_is_zero,
+                     cudaStream_t stream) {
   const unsigned bins = static_cast<unsigned>(b.bins.x) * static_cast<unsigned>(b.bins.y);
   if (bins == 0) return;
   if (bins > kBinSortMaxBins)
@@ -492,7 +495,7 @@ void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned s
   const std::size_t hist_bytes = bins * sizeof(unsigned);
   const std::uint32_t* keys = reinterpret_cast<const std::uint32_t*>(b.keys[0]);
   const int depth_bits = b.key_format.depth_bits;
-  check_cuda(cudaMemsetAsync(b.bin_fill, 0, bins * sizeof(std::uint32_t), stream), "bin count reset");
+  if (!fill_is_zero) check_cuda(cudaMemsetAsync(b.bin_fill, 0, bins * sizeof(std::uint32_t), stream), "bin count reset");
   bin_count_kernel<<<static_cast<unsigned>(std::min<std::uint64_t>(kCountBlocks, most_chunks)), kPassBlock, hist_bytes,
                      stream>>>(b.counters, b.pair_capacity, b.record_capacity, keys, depth_bits, bins, b.bin_fill,
                                b.tile_ranges);
@@ -509,6 +512,7 @@ void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned s
   args.keys = b.values[1];
   args.values = b.values[0];
   args.scratch = reinterpret_cast<std::uint32_t*>(b.keys[1]);
+  args.fill = b.bin_fill;
   args.top_lists = b.tile_values[0];
   args.bottom_lists = b.tile_values[1];
   args.tile_lists = b.tile_lists;

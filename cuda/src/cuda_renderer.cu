@@ -270,11 +270,13 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation");
     const Scene& sc = *scene;
     cuda::SceneUploader uploader(stream_);
+    // The position's fourth float: the DC red under fp16_shape (the opacity moves into the
+    // record of halves), the opacity otherwise.
+    uploader.upload(new_pos.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
+      const float* p = &sc.positions[i * 3];
+      *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], shape_half ? dc(i * 3) : sc.opacities[i]);
+    });
     if (shape_half) {
-      uploader.upload(new_pos.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
-        const float* p = &sc.positions[i * 3];
-        *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], dc(i * 3));
-      });
       uploader.upload(new_rot.as<void>(), sizeof(uint4), n, [&](std::size_t i, void* dst) {
         const float* q = &sc.rotations[i * 4];
         const float* sv = &sc.scales[i * 3];
@@ -286,10 +288,6 @@ class CudaRendererImpl final : public CudaRenderer {
                                                pair(sv[2], sc.opacities[i]));
       });
     } else {
-      uploader.upload(new_pos.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
-        const float* p = &sc.positions[i * 3];
-        *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], sc.opacities[i]);
-      });
       uploader.upload(new_rot.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
         const float* q = &sc.rotations[i * 4];
         *static_cast<float4*>(dst) = make_float4(q[0], q[1], q[2], q[3]);
@@ -576,6 +574,14 @@ class CudaRendererImpl final : public CudaRenderer {
            last_bin_pairs_ <= kBinSortMostPairsPerGaussian * last_records_;
   }
 
+  // Queues the read back of the frame's counters and the event the host waits for.
+  void read_back_counts(const cuda::FrameBuffers& b) {
+    check_cuda(cudaMemcpyAsync(&readback_->counters, b.counters, sizeof(cuda::FrameCounters), cudaMemcpyDeviceToHost,
+                               stream_),
+               "pair count read back");
+    check_cuda(cudaEventRecord(events_[event_set_][kCounted], stream_), "event record");
+  }
+
   // Stage times of the frame whose events are in `set` (its work must have finished).
   StageTimes stage_times(int set) const {
     auto elapsed = [this, set](Event a, Event b) {
@@ -585,7 +591,8 @@ class CudaRendererImpl final : public CudaRenderer {
     };
     StageTimes t;
     t.project_ms = elapsed(kBegin, kProjected);
-    t.emit_ms = elapsed(kProjected, kScanned) + elapsed(kEmitBegin, kEmitted);
+    // Fused emission is in the project stage: such frames record no emit events.
+    t.emit_ms = separate_emit_[set] ? elapsed(kProjected, kScanned) + elapsed(kEmitBegin, kEmitted) : 0.0;
     t.sort_ms = elapsed(kSortBegin, kSorted);
     t.ranges_ms = elapsed(kSorted, kRanged);
     t.blend_ms = elapsed(kRanged, kBlended);
@@ -639,9 +646,11 @@ class CudaRendererImpl final : public CudaRenderer {
       tile_places_.reserve(std::max<std::uint64_t>(f.bins, 1) * sizeof(std::uint32_t), "bin places");
     }
     const cuda::FrameBuffers b = frame_buffers();
-    check_cuda(cudaEventRecord(events[kEmitBegin], stream_), "event record");
-    if (!f.fused) cuda::launch_duplicate(device_scene_.count, b, cam, f.args->exact_tile_test, stream_);
-    check_cuda(cudaEventRecord(events[kEmitted], stream_), "event record");
+    if (!f.fused) {
+      check_cuda(cudaEventRecord(events[kEmitBegin], stream_), "event record");
+      cuda::launch_duplicate(device_scene_.count, b, cam, f.args->exact_tile_test, stream_);
+      check_cuda(cudaEventRecord(events[kEmitted], stream_), "event record");
+    }
 
     const int tile_bits = std::max(bits_for(f.bins), 1);
     int end_bit = 64;
@@ -650,8 +659,14 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
     // The bin sort writes the bin ranges and tile lists itself (its stage time includes them).
     int which = 0;
-    if (bin_sort_frame_) cuda::launch_bin_sort(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, stream_);
-    else which = cuda::launch_sort(pairs, end_bit, b, stream_);
+    if (bin_sort_frame_) {
+      const bool fill_is_zero = f.bins <= zeroed_fill_bins_;
+      zeroed_fill_bins_ = 0;  // until the bin blocks are queued
+      cuda::launch_bin_sort(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, fill_is_zero, stream_);
+      zeroed_fill_bins_ = f.bins;
+    } else {
+      which = cuda::launch_sort(pairs, end_bit, b, stream_);
+    }
     check_cuda(cudaEventRecord(events[kSorted], stream_), "event record");
     if (!bin_sort_frame_) {
       cuda::launch_ranges(pairs, f.bins, b, which, stream_);
@@ -745,7 +760,11 @@ class CudaRendererImpl final : public CudaRenderer {
 
     // The bin sort needs the depth bins of compact keys (depth_bits > 0) in 32-bit keys.
     bin_sort_frame_ = binned && key_format_.depth_bits > 0 && bin_sort_pays(bins);
-    if (bin_sort_frame_) bin_fill_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "bin fill");
+    if (bin_sort_frame_) {
+      const std::size_t fill_bytes = bin_fill_.bytes();
+      bin_fill_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "bin fill");
+      if (bin_fill_.bytes() != fill_bytes) zeroed_fill_bins_ = 0;
+    }
     ranges_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(uint2), "bin ranges");
     if (binned) {
       tile_lists_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile lists");
@@ -805,6 +824,12 @@ class CudaRendererImpl final : public CudaRenderer {
     // the rest of its work before the host waits for the count: the GPU then runs on instead
     // of idling while the host reads the count and launches the sort (8-16 us a frame, v14).
     const bool queue_before_count = bin_sort_frame_ && fused;
+    // Such a frame that goes to the host (whose end the host waits for anyway) reads its counts
+    // back at its end, after the blend: a copy between preprocess and sort kept the GPU idle
+    // for 15-25 us on the H200 machine (v22). A surface frame reads them back at once, so that
+    // the host can go on while the GPU blends.
+    const bool count_at_end = queue_before_count && out;
+    separate_emit_[event_set_] = !fused;
     const FramePlan frame{&camera, &cam, &options, &args, out, surface, tiles, bins, pixels, baseline, fused, binned,
                           previous_complete};
     std::uint64_t pairs = 0;
@@ -814,16 +839,16 @@ class CudaRendererImpl final : public CudaRenderer {
       check_cuda(cudaEventRecord(events[kBegin], stream_), "event record");
       cuda::launch_preprocess(device_scene_, b, args, fused, stream_);
       check_cuda(cudaEventRecord(events[kProjected], stream_), "event record");
-      if (!fused) cuda::launch_scan(n, b, stream_);
-      check_cuda(cudaEventRecord(events[kScanned], stream_), "event record");
-      check_cuda(cudaMemcpyAsync(&readback_->counters, b.counters, sizeof(cuda::FrameCounters),
-                                 cudaMemcpyDeviceToHost, stream_),
-                 "pair count read back");
-      check_cuda(cudaEventRecord(events[kCounted], stream_), "event record");
+      if (!fused) {
+        cuda::launch_scan(n, b, stream_);
+        check_cuda(cudaEventRecord(events[kScanned], stream_), "event record");
+      }
+      if (!count_at_end) read_back_counts(b);
       if (queue_before_count) {
         // The last frame's read backs (dense_order_pays) come before this frame's start.
         check_cuda(cudaEventSynchronize(events[kBegin]), "last frame");
         queue_after_count(frame, 0);
+        if (count_at_end) read_back_counts(b);
       }
       check_cuda(cudaEventSynchronize(events[kCounted]), "preprocess");
       pairs = readback_->counters.pairs;
@@ -895,6 +920,7 @@ class CudaRendererImpl final : public CudaRenderer {
   cudaEvent_t events_[2][kEventCount] = {};  // event_handles_'
   HostReadback* readback_ = nullptr;         // in pinned_
   int event_set_ = 0;
+  bool separate_emit_[2] = {false, false};  // per event set: its frame recorded the emit events
   bool last_frame_complete_ = false;  // the last frame recorded all its events
   bool list_chunks_ = false;          // this frame's preprocess walks a chunk list (FrameBuffers::chunk_list)
   bool compact_records_ = false;      // this frame keeps a blend record per projected Gaussian
@@ -924,6 +950,9 @@ class CudaRendererImpl final : public CudaRenderer {
   Mode dense_tiles_mode_ = kAuto;
   Mode bin_sort_ = kAuto;        // binned frames with compact keys sort per bin (launch_bin_sort)
   bool bin_sort_frame_ = false;  // this frame does
+  // bin_fill_'s first zeroed_fill_bins_ words are zero (the bin blocks zero them for the next
+  // frame; a new allocation has none).
+  std::uint64_t zeroed_fill_bins_ = 0;
   std::uint64_t last_bin_pairs_ = 0;  // the last frame's pairs if it was binned
   static constexpr std::uint64_t kBinSortMostPairsPerBin = 512;
   static constexpr std::uint64_t kBinSortAnyCoverageBins = 4096;     // 1080p-class frames

@@ -185,7 +185,8 @@ struct FrameBuffers {
   // keys[0] (as 32-bit words from pair_capacity), which leaves values[] free for the pairs in
   // bin order (launch_bin_sort).
   std::uint32_t* pair_values = nullptr;
-  // The bin sort's per-bin counts, then each bin's next free place.
+  // The bin sort's per-bin counts, then each bin's next free place; the bin blocks leave it
+  // zeroed for the next frame.
   std::uint32_t* bin_fill = nullptr;  // [bins]
   // Per bin: [start, end) of its pairs in the sorted list.
   uint2* tile_ranges = nullptr;  // [tile_capacity]
@@ -251,9 +252,12 @@ int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, c
 // each pair in its bin (unstable), then a block per bin sorts it by key (in shared memory up
 // to `shared_pairs` pairs, at most kBinSortSharedPairsMax; a larger bin in its place in
 // keys[1]), puts runs of equal keys in the exact order and writes its tiles' lists. Fills
-// tile_ranges (per bin), tile_lists and tile_values from keys[0] and pair_values. The pair count is read on the device, so the host may queue this before it
-// knows the count; a frame whose emission overflowed a capacity comes out empty.
-void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& buffers, unsigned shared_pairs,
+// tile_ranges (per bin), tile_lists and tile_values from keys[0] and pair_values. The pair
+// count is read on the device, so the host may queue this before it knows the count; a frame
+// whose emission overflowed a capacity comes out empty. `fill_is_zero`: bin_fill's first
+// `bins` words are zero (the last bin sort over as many bins or more left them so), and the
+// reset is skipped.
+void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& buffers, unsigned shared_pairs, bool fill_is_zero,
                      cudaStream_t stream);
 // Bins a frame may have for the bin sort: its passes count pairs per bin in shared memory (48
 // KB; a 4K frame has 8,160 bins).

@@ -4,7 +4,7 @@
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-ab bench-env bench
 #                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
 #                                       cpu-simd-tests build-prev bench-cpu-prev
-#                                       profile-blend profile-sass bench-variants kernel-times
+#                                       profile-blend profile-sass bench-variants kernel-times trace
 #                                       build-bg wait-build build-prev-bg bench-prev-cuda
 # tools/device/make_deps.sh fills .deps (52 MB; with the tree, just under a call's 64 MiB):
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
@@ -260,6 +260,20 @@ kernel_times() {  # ncu time of the kernels matching KERNEL_FILTER (default bin_
   done
 }
 
+trace() {  # the GPU timeline (tools/device/gpu_trace.cpp, built into .deps/libgputrace.so by prebuild.sh) of
+  # flash frames of TRACE_SCENES (default pc_biker pc_playbot) at TRACE_RES (default 1920x1080), camera 10, with
+  # the runtime calls: trace_SCENE.txt, and the frames' spans, idle time and gaps (trace_frames.py) in trace.txt
+  local scene cupti
+  cupti=$(ls -d /usr/local/cuda*/targets/x86_64-linux/lib 2>/dev/null | head -1)
+  [ -f "$ROOT/.deps/libgputrace.so" ] || { log "no .deps/libgputrace.so"; return; }
+  for scene in ${TRACE_SCENES:-pc_biker pc_playbot}; do
+    LD_LIBRARY_PATH=$LD_LIBRARY_PATH:$cupti CUDA_INJECTION64_PATH=$ROOT/.deps/libgputrace.so FLASHGS_TRACE_API=1 \
+      FLASHGS_TRACE_OUT=$OUT/trace_$scene.txt "$FLASHGS" bench "$SCENES/$scene/point_cloud.ply" --backend cuda \
+      -r "${TRACE_RES:-1920x1080}" --configs flash --camera-list 10 --warmup 3 --repeat 10 2>&1 | grep -E "^[0-9]+x.*flash +[0-9]"
+    python3 "$ROOT/tools/device/trace_frames.py" "$OUT/trace_$scene.txt" | tee -a "$OUT/trace.txt" | head -1
+  done
+}
+
 bench_scale() {  # pc_playbot copied SCALE_COPIES times in memory (default 20 60 200: 10M, 30M, 100M)
   for copies in ${SCALE_COPIES:-20 60 200}; do
     log "bench scale: $copies x pc_playbot"
@@ -356,6 +370,7 @@ for step in "$@"; do
     bench-scale) bench_scale ;;
     bench-variants) bench_variants ;;
     kernel-times) kernel_times ;;
+    trace) trace ;;
     report) report ;;
     profile) profile ;;
     profile-kernels) profile_kernels ;;

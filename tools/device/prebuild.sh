@@ -17,5 +17,8 @@ for t in "${targets[@]}"; do xz -T2 -6 -c "$build/$t" > "$root/.deps/bin/$(basen
 for t in "${targets[@]}"; do ldd "$build/$t"; done | awk '/=> \// {print $3}' | sort -u | while read -r lib; do
   case $(basename "$lib") in libc.so.*|libm.so.*|libpthread.so.*|libdl.so.*|librt.so.*) ;; *) cp -L "$lib" "$root/.deps/lib/" ;; esac
 done
+# The GPU timeline library of gpu_check.sh's trace step (CUPTI, which the device machine has).
+g++ -O2 -std=c++17 -shared -fPIC -I/usr/local/cuda/include "$root/tools/device/gpu_trace.cpp" -L/usr/local/cuda/lib64 \
+  -lcupti -o "$root/.deps/libgputrace.so"
 bash "$root/tools/device/source_stamp.sh" > "$root/.deps/bin/STAMP"
 du -sh "$root/.deps/bin" "$root/.deps/lib"

@@ -1,0 +1,45 @@
+#!/usr/bin/env python3
+"""Frames of a gpu_trace.cpp timeline: per flash frame (the counter reset to the blend's end) the
+span, the time in kernels, memsets and copies, and what is left (the GPU idle); then the last
+frame op by op with the gap after each. Usage: trace_frames.py TRACE..."""
+import re
+import statistics
+import sys
+
+
+def short(name):
+    match = re.search(r"\d+([a-z_]+_kernel)", name) or re.search(r"(Onesweep|Histogram|ExclusiveSum)\w*?Kernel", name)
+    return match.group(1) if match and match.lastindex else (match.group(0) if match else name[:40])
+
+
+def frames(path):
+    ops = []
+    for line in open(path):
+        kind, start, end, name = (line.rstrip("\n").split(None, 3) + [""])[:4]
+        if kind != "api":
+            ops.append((int(start), int(end), short(name) if kind == "kernel" else kind + " " + name))
+    ops.sort()
+    found, current = [], None
+    for op in ops:
+        if op[2] == "memset 216":  # FrameCounters reset: a frame's first operation
+            current = [op]
+        elif current is not None:
+            current.append(op)
+            if op[2].startswith("blend_"):
+                found.append(current)
+                current = None
+    return found
+
+
+for path in sys.argv[1:]:
+    flash = [f for f in frames(path) if any(op[2].startswith("blend_warp") for op in f)][-10:]
+    if not flash:
+        print(path, "no flash frames")
+        continue
+    span = statistics.median((f[-1][1] - f[0][0]) / 1000 for f in flash)
+    busy = statistics.median(sum(op[1] - op[0] for op in f) / 1000 for f in flash)
+    print(f"{path}: {len(flash)} frames, median span {span:.1f} us, busy {busy:.1f}, idle {span - busy:.1f}")
+    last = flash[-1]
+    for i, op in enumerate(last):
+        gap = (last[i + 1][0] - op[1]) / 1000 if i + 1 < len(last) else 0.0
+        print(f"  {op[2]:<30} {(op[1] - op[0]) / 1000:7.1f} us, then idle {gap:5.1f}")
