@@ -72,11 +72,15 @@ __device__ __forceinline__ std::uint64_t frame_pairs(const FrameCounters* counte
 }
 
 // The block of the counting pass that finishes last turns the counts into each bin's range
-// and first free place (all threads of every block call this once their counts are added).
+// and first free place, and with `order` lists the bins fullest class first for the blend
+// (classes by the bit length of the count, as launch_tile_order does for the other paths; the
+// order inside a class is immaterial). All threads of every block call this once their counts
+// are added.
 __device__ void finish_count(unsigned bins, std::uint32_t* fill, uint2* __restrict__ bin_ranges,
-                             FrameCounters* counters) {
+                             FrameCounters* counters, std::uint32_t* __restrict__ order) {
   __shared__ bool last;
   __shared__ unsigned warp_totals[kPassBlock / kWarp];
+  __shared__ unsigned class_next[kTileClasses];
   __syncthreads();
   if (threadIdx.x == 0) {
     __threadfence();  // cumulative: the block's counts (ordered by the barrier) before the ticket
@@ -85,6 +89,8 @@ __device__ void finish_count(unsigned bins, std::uint32_t* fill, uint2* __restri
   __syncthreads();
   if (!last) return;
   __threadfence();
+  for (unsigned c = threadIdx.x; c < kTileClasses; c += kPassBlock) class_next[c] = 0;
+  __syncthreads();
   constexpr int kScanItems = 8;
   unsigned running = 0;
   for (unsigned base = 0; base < bins; base += kPassBlock * kScanItems) {  // block-uniform
@@ -103,10 +109,26 @@ __device__ void finish_count(unsigned bins, std::uint32_t* fill, uint2* __restri
       if (b < bins) {
         bin_ranges[b] = make_uint2(start, start + count[k]);
         fill[b] = start;
+        if (order) atomicAdd(&class_next[__clz(count[k])], 1u);
       }
       start += count[k];
     }
     running += total;
+  }
+  if (!order) return;
+  __syncthreads();
+  if (threadIdx.x == 0) {  // each class's first place, fullest first
+    unsigned first = 0;
+    for (int c = 0; c < kTileClasses; ++c) {
+      const unsigned n = class_next[c];
+      class_next[c] = first;
+      first += n;
+    }
+  }
+  __syncthreads();  // and this block's bin_ranges writes are visible to all its threads
+  for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) {
+    const uint2 range = bin_ranges[b];
+    order[atomicAdd(&class_next[__clz(range.y - range.x)], 1u)] = b;
   }
 }
 
@@ -133,7 +155,8 @@ __global__ void __launch_bounds__(kPassBlock) bin_count_kernel(FrameCounters* co
                                                                std::uint32_t record_capacity,
                                                                const std::uint32_t* __restrict__ keys, int depth_bits,
                                                                unsigned bins, std::uint32_t* fill,
-                                                               uint2* __restrict__ bin_ranges) {
+                                                               uint2* __restrict__ bin_ranges,
+                                                               std::uint32_t* __restrict__ order) {
   extern __shared__ unsigned hist[];  // [bins]
   const std::uint64_t pairs = frame_pairs(counters, pair_capacity, record_capacity);
   const std::uint64_t chunks = (pairs + kChunkPairs - 1) / kChunkPairs;
@@ -152,7 +175,7 @@ __global__ void __launch_bounds__(kPassBlock) bin_count_kernel(FrameCounters* co
     for (unsigned b = threadIdx.x; b < bins; b += kPassBlock)
       if (hist[b] != 0) atomicAdd(&fill[b], hist[b]);
   }
-  finish_count(bins, fill, bin_ranges, counters);
+  finish_count(bins, fill, bin_ranges, counters, order);
 }
 
 // The scatter pass: each block takes chunks, counts a chunk's pairs per bin in shared memory,
@@ -484,7 +507,7 @@ constexpr unsigned kScatterBlocks = 2048;
 constexpr unsigned kCountBlocks = 512;
 
 void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned shared_pairs, bool fill_is_zero,
-                     cudaStream_t stream) {
+                     std::uint32_t* order, cudaStream_t stream) {
   const unsigned bins = static_cast<unsigned>(b.bins.x) * static_cast<unsigned>(b.bins.y);
   if (bins == 0) return;
   if (bins > kBinSortMaxBins)
@@ -498,7 +521,7 @@ void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned s
   if (!fill_is_zero) check_cuda(cudaMemsetAsync(b.bin_fill, 0, bins * sizeof(std::uint32_t), stream), "bin count reset");
   bin_count_kernel<<<static_cast<unsigned>(std::min<std::uint64_t>(kCountBlocks, most_chunks)), kPassBlock, hist_bytes,
                      stream>>>(b.counters, b.pair_capacity, b.record_capacity, keys, depth_bits, bins, b.bin_fill,
-                               b.tile_ranges);
+                               b.tile_ranges, order);
   check_cuda(cudaGetLastError(), "bin count kernel launch");
   bin_scatter_kernel<<<static_cast<unsigned>(std::min<std::uint64_t>(kScatterBlocks, most_chunks)), kPassBlock,
                        hist_bytes, stream>>>(b.counters, b.pair_capacity, b.record_capacity, keys, b.pair_values,

@@ -662,7 +662,8 @@ class CudaRendererImpl final : public CudaRenderer {
     if (bin_sort_frame_) {
       const bool fill_is_zero = f.bins <= zeroed_fill_bins_;
       zeroed_fill_bins_ = 0;  // until the bin blocks are queued
-      cuda::launch_bin_sort(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, fill_is_zero, stream_);
+      cuda::launch_bin_sort(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, fill_is_zero,
+                            dense_tiles_first ? b.tile_order : nullptr, stream_);
       zeroed_fill_bins_ = f.bins;
     } else {
       which = cuda::launch_sort(pairs, end_bit, b, stream_);
@@ -672,7 +673,7 @@ class CudaRendererImpl final : public CudaRenderer {
       cuda::launch_ranges(pairs, f.bins, b, which, stream_);
       if (f.binned) cuda::launch_tile_lists(pairs, cam.tiles_x, cam.tiles_y, b, which, stream_);
     }
-    if (dense_tiles_first) cuda::launch_tile_order(f.bins, b, stream_);
+    if (dense_tiles_first && !bin_sort_frame_) cuda::launch_tile_order(f.bins, b, stream_);  // the bin sort did
     check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
 
     cuda::BlendArgs blend{};

@@ -256,9 +256,10 @@ int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, c
 // count is read on the device, so the host may queue this before it knows the count; a frame
 // whose emission overflowed a capacity comes out empty. `fill_is_zero`: bin_fill's first
 // `bins` words are zero (the last bin sort over as many bins or more left them so), and the
-// reset is skipped.
+// reset is skipped. A non-null `order` gets the bins fullest first (what launch_tile_order
+// writes on the other paths, without its two launches).
 void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& buffers, unsigned shared_pairs, bool fill_is_zero,
-                     cudaStream_t stream);
+                     std::uint32_t* order, cudaStream_t stream);
 // Bins a frame may have for the bin sort: its passes count pairs per bin in shared memory (48
 // KB; a 4K frame has 8,160 bins).
 constexpr unsigned kBinSortMaxBins = 12000;
