@@ -4,7 +4,7 @@
 #   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-ab bench-env bench
 #                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
 #                                       cpu-simd-tests build-prev bench-cpu-prev
-#                                       profile-blend profile-sass bench-variants kernel-times trace
+#                                       profile-blend profile-sass bench-variants kernel-times trace launch-cost
 #                                       build-bg wait-build build-prev-bg bench-prev-cuda
 # tools/device/make_deps.sh fills .deps (52 MB; with the tree, just under a call's 64 MiB):
 # .deps holds include/ (glm, CLI, nlohmann), googletest/, scenes/NAME/{point_cloud.ply.xz,
@@ -274,6 +274,18 @@ trace() {  # the GPU timeline (tools/device/gpu_trace.cpp, built into .deps/libg
   done
 }
 
+launch_cost() {  # what a frame's first launches cost (tools/device/launch_cost.cu, in .deps), each mode under the
+  # GPU timeline: launch_cost.txt and trace_launch_MODE.txt
+  local mode cupti
+  cupti=$(ls -d /usr/local/cuda*/targets/x86_64-linux/lib 2>/dev/null | head -1)
+  [ -x "$ROOT/.deps/launch_cost" ] || { log "no .deps/launch_cost"; return; }
+  for mode in direct nomemset small graph; do
+    LD_LIBRARY_PATH=$LD_LIBRARY_PATH:$cupti CUDA_INJECTION64_PATH=$ROOT/.deps/libgputrace.so FLASHGS_TRACE_API=1 \
+      FLASHGS_TRACE_OUT=$OUT/trace_launch_$mode.txt "$ROOT/.deps/launch_cost" $mode | tee -a "$OUT/launch_cost.txt"
+    "$ROOT/.deps/launch_cost" $mode | sed 's/^/untraced /' | tee -a "$OUT/launch_cost.txt"
+  done
+}
+
 bench_scale() {  # pc_playbot copied SCALE_COPIES times in memory (default 20 60 200: 10M, 30M, 100M)
   for copies in ${SCALE_COPIES:-20 60 200}; do
     log "bench scale: $copies x pc_playbot"
@@ -371,6 +383,7 @@ for step in "$@"; do
     bench-variants) bench_variants ;;
     kernel-times) kernel_times ;;
     trace) trace ;;
+    launch-cost) launch_cost ;;
     report) report ;;
     profile) profile ;;
     profile-kernels) profile_kernels ;;

@@ -20,5 +20,7 @@ done
 # The GPU timeline library of gpu_check.sh's trace step (CUPTI, which the device machine has).
 g++ -O2 -std=c++17 -shared -fPIC -I/usr/local/cuda/include "$root/tools/device/gpu_trace.cpp" -L/usr/local/cuda/lib64 \
   -lcupti -o "$root/.deps/libgputrace.so" || echo "prebuild: no CUPTI here, so no trace step on the device" >&2
+# The launch-cost measurement of gpu_check.sh's launch-cost step.
+"${CUDACXX:-nvcc}" -O2 -std=c++17 -arch=sm_90 "$root/tools/device/launch_cost.cu" -o "$root/.deps/launch_cost"
 bash "$root/tools/device/source_stamp.sh" > "$root/.deps/bin/STAMP"
 du -sh "$root/.deps/bin" "$root/.deps/lib"
