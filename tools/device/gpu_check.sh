@@ -279,7 +279,7 @@ launch_cost() {  # what a frame's first launches cost (tools/device/launch_cost.
   local mode cupti
   cupti=$(ls -d /usr/local/cuda*/targets/x86_64-linux/lib 2>/dev/null | head -1)
   [ -x "$ROOT/.deps/launch_cost" ] || { log "no .deps/launch_cost"; return; }
-  for mode in direct nomemset small graph; do
+  for mode in direct nomemset small graph capture; do
     LD_LIBRARY_PATH=$LD_LIBRARY_PATH:$cupti CUDA_INJECTION64_PATH=$ROOT/.deps/libgputrace.so FLASHGS_TRACE_API=1 \
       FLASHGS_TRACE_OUT=$OUT/trace_launch_$mode.txt "$ROOT/.deps/launch_cost" $mode | tee -a "$OUT/launch_cost.txt"
     "$ROOT/.deps/launch_cost" $mode | sed 's/^/untraced /' | tee -a "$OUT/launch_cost.txt"
