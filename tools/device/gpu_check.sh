@@ -262,13 +262,14 @@ kernel_times() {  # ncu time of the kernels matching KERNEL_FILTER (default bin_
 
 trace() {  # the GPU timeline (tools/device/gpu_trace.cpp, built into .deps/libgputrace.so by prebuild.sh) of
   # flash frames of TRACE_SCENES (default pc_biker pc_playbot) at TRACE_RES (default 1920x1080), camera 10, with
-  # the runtime calls: trace_SCENE.txt, and the frames' spans, idle time and gaps (trace_frames.py) in trace.txt
-  local scene cupti
+  # the runtime calls: trace_SCENE.txt, and the frames' spans, idle time and gaps (trace_frames.py) in trace.txt;
+  # TRACE_BIN: another flashgs (default this tree's)
+  local scene cupti bin=${TRACE_BIN:-$FLASHGS}
   cupti=$(ls -d /usr/local/cuda*/targets/x86_64-linux/lib 2>/dev/null | head -1)
   [ -f "$ROOT/.deps/libgputrace.so" ] || { log "no .deps/libgputrace.so"; return; }
   for scene in ${TRACE_SCENES:-pc_biker pc_playbot}; do
     LD_LIBRARY_PATH=$LD_LIBRARY_PATH:$cupti CUDA_INJECTION64_PATH=$ROOT/.deps/libgputrace.so FLASHGS_TRACE_API=1 \
-      FLASHGS_TRACE_OUT=$OUT/trace_$scene.txt "$FLASHGS" bench "$SCENES/$scene/point_cloud.ply" --backend cuda \
+      FLASHGS_TRACE_OUT=$OUT/trace_$scene.txt "$bin" bench "$SCENES/$scene/point_cloud.ply" --backend cuda \
       -r "${TRACE_RES:-1920x1080}" --configs flash --camera-list 10 --warmup 3 --repeat 10 2>&1 | grep -E "^[0-9]+x.*flash +[0-9]"
     python3 "$ROOT/tools/device/trace_frames.py" "$OUT/trace_$scene.txt" | tee -a "$OUT/trace.txt" | head -1
   done
