@@ -20,9 +20,10 @@ def frames(path):
             ops.append((int(start), int(end), short(name) if kind == "kernel" else kind + " " + name))
     ops.sort()
     found, current = [], None
-    for op in ops:
-        if op[2] == "memset 216":  # FrameCounters reset: a frame's first operation
-            current = [op]
+    for i, op in enumerate(ops):
+        # A frame starts with the counters' reset, a memset right before its first kernel.
+        if op[2].startswith(("preprocess_kernel", "chunk_list_kernel")) and i > 0 and ops[i - 1][2].startswith("memset"):
+            current = [ops[i - 1], op]
         elif current is not None:
             current.append(op)
             if op[2].startswith("blend_"):
