@@ -260,29 +260,34 @@ kernel_times() {  # ncu time of the kernels matching KERNEL_FILTER (default bin_
   done
 }
 
-trace() {  # the GPU timeline (tools/device/gpu_trace.cpp, built into .deps/libgputrace.so by prebuild.sh) of
-  # flash frames of TRACE_SCENES (default pc_biker pc_playbot) at TRACE_RES (default 1920x1080), camera 10, with
-  # the runtime calls: trace_SCENE.txt, and the frames' spans, idle time and gaps (trace_frames.py) in trace.txt;
-  # TRACE_BIN: another flashgs (default this tree's)
-  local scene cupti bin=${TRACE_BIN:-$FLASHGS}
+traced() {  # OUTFILE COMMAND...: runs the command under the GPU timeline (tools/device/gpu_trace.cpp, built into
+  # .deps/libgputrace.so by prebuild.sh), runtime calls included, its lines written to OUTFILE
+  local cupti
   cupti=$(ls -d /usr/local/cuda*/targets/x86_64-linux/lib 2>/dev/null | head -1)
+  local out=$1
+  shift
+  LD_LIBRARY_PATH=$LD_LIBRARY_PATH:$cupti CUDA_INJECTION64_PATH=$ROOT/.deps/libgputrace.so FLASHGS_TRACE_API=1 \
+    FLASHGS_TRACE_OUT=$out "$@"
+}
+
+trace() {  # the GPU timeline of flash frames of TRACE_SCENES (default pc_biker pc_playbot) at TRACE_RES (default
+  # 1920x1080), camera 10: trace_SCENE.txt, and the frames' spans, idle time and gaps (trace_frames.py) in trace.txt;
+  # TRACE_BIN: another flashgs (default this tree's)
+  local scene bin=${TRACE_BIN:-$FLASHGS}
   [ -f "$ROOT/.deps/libgputrace.so" ] || { log "no .deps/libgputrace.so"; return; }
   for scene in ${TRACE_SCENES:-pc_biker pc_playbot}; do
-    LD_LIBRARY_PATH=$LD_LIBRARY_PATH:$cupti CUDA_INJECTION64_PATH=$ROOT/.deps/libgputrace.so FLASHGS_TRACE_API=1 \
-      FLASHGS_TRACE_OUT=$OUT/trace_$scene.txt "$bin" bench "$SCENES/$scene/point_cloud.ply" --backend cuda \
+    traced "$OUT/trace_$scene.txt" "$bin" bench "$SCENES/$scene/point_cloud.ply" --backend cuda \
       -r "${TRACE_RES:-1920x1080}" --configs flash --camera-list 10 --warmup 3 --repeat 10 2>&1 | grep -E "^[0-9]+x.*flash +[0-9]"
     python3 "$ROOT/tools/device/trace_frames.py" "$OUT/trace_$scene.txt" | tee -a "$OUT/trace.txt" | head -1
   done
 }
 
 launch_cost() {  # what a frame's first launches cost (tools/device/launch_cost.cu, in .deps), each mode under the
-  # GPU timeline: launch_cost.txt and trace_launch_MODE.txt
-  local mode cupti
-  cupti=$(ls -d /usr/local/cuda*/targets/x86_64-linux/lib 2>/dev/null | head -1)
-  [ -x "$ROOT/.deps/launch_cost" ] || { log "no .deps/launch_cost"; return; }
+  # GPU timeline and without: launch_cost.txt and trace_launch_MODE.txt
+  local mode
+  [ -x "$ROOT/.deps/launch_cost" ] && [ -f "$ROOT/.deps/libgputrace.so" ] || { log "no .deps/launch_cost or tracer"; return; }
   for mode in direct nomemset small graph capture; do
-    LD_LIBRARY_PATH=$LD_LIBRARY_PATH:$cupti CUDA_INJECTION64_PATH=$ROOT/.deps/libgputrace.so FLASHGS_TRACE_API=1 \
-      FLASHGS_TRACE_OUT=$OUT/trace_launch_$mode.txt "$ROOT/.deps/launch_cost" $mode | tee -a "$OUT/launch_cost.txt"
+    traced "$OUT/trace_launch_$mode.txt" "$ROOT/.deps/launch_cost" $mode | tee -a "$OUT/launch_cost.txt"
     "$ROOT/.deps/launch_cost" $mode | sed 's/^/untraced /' | tee -a "$OUT/launch_cost.txt"
   done
 }
