@@ -643,7 +643,8 @@ class CudaRendererImpl final : public CudaRenderer {
         !f.baseline && options.dense_tiles_first && dense_order_pays(f.tiles, f.previous_complete);
     if (dense_tiles_first) {
       tile_order_.reserve(std::max<std::uint64_t>(f.bins, 1) * sizeof(std::uint32_t), "bin order");
-      tile_places_.reserve(std::max<std::uint64_t>(f.bins, 1) * sizeof(std::uint32_t), "bin places");
+      if (!bin_sort_frame_)  // the bin sort's counting pass orders the bins without it
+        tile_places_.reserve(std::max<std::uint64_t>(f.bins, 1) * sizeof(std::uint32_t), "bin places");
     }
     const cuda::FrameBuffers b = frame_buffers();
     if (!f.fused) {
