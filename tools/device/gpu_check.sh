@@ -399,7 +399,12 @@ for step in "$@"; do
   esac
 done
 log "done"
-# At most 8 files come back: everything but the summary goes into one archive.
-# (written outside $OUT first: tar fails on an archive that grows inside the folder it reads)
-(cd "$OUT" && tar czf /tmp/flashgs_logs.tgz --exclude=summary.txt --exclude='*.ppm' . 2>/dev/null;
-  find . -maxdepth 1 -type f ! -name summary.txt -delete && mv /tmp/flashgs_logs.tgz logs.tgz)
+# At most 8 files come back: everything but the summary goes into one archive, logs.tgz, with a
+# folder per run of this script in the call (RUN_NAME, default the time), so that a later run's
+# files of the same name (trace_SCENE.txt) do not replace an earlier run's. The runs' files wait
+# in /tmp/flashgs_runs (outside $OUT: tar fails on an archive that grows inside the folder it reads).
+run_dir=/tmp/flashgs_runs/$(date +%H%M%S)${RUN_NAME:+_$RUN_NAME}
+mkdir -p "$run_dir"
+(cd "$OUT" && find . -maxdepth 1 -type f ! -name summary.txt ! -name logs.tgz ! -name '*.ppm' -exec mv {} "$run_dir"/ \;
+  find . -maxdepth 1 -type f -name '*.ppm' -delete
+  tar czf /tmp/flashgs_logs.tgz -C /tmp/flashgs_runs . 2>/dev/null && mv /tmp/flashgs_logs.tgz logs.tgz)
