@@ -47,9 +47,10 @@ def frames(ops):
 def frame_start_call(calls, frame):
     """The start of the host call that queued the frame's reset: the last capture begun before
     the reset ran, else the last memset call before it."""
-    before = calls[: bisect.bisect_left(calls, (frame[0][0], ""))]
+    end = bisect.bisect_left(calls, (frame[0][0], ""))
+    recent = calls[max(0, end - 64):end]  # the frame's own calls are the last few before its reset
     for prefix in FRAME_START_CALLS:
-        for start, name in reversed(before[-64:]):
+        for start, name in reversed(recent):
             if name.startswith(prefix):
                 return start
     return None
