@@ -217,10 +217,41 @@ TEST(OptionsTable, Fp16OptionsAreOffByDefaultAndNamedInTheLabel) {
   EXPECT_EQ(b.label(), "baseline-fp16_sh-fp16_shape");
 }
 
+// fp16_blend is a precision option of the CUDA blend only: off by default, named in the label,
+// part of equality, and what the CPU sees of it is off (it renders the exact image).
+TEST(OptionsTable, Fp16BlendIsACudaPrecisionOption) {
+  EXPECT_FALSE(RenderOptions{}.fp16_blend);
+  EXPECT_FALSE(RenderOptions::baseline().fp16_blend);
+  RenderOptions o;
+  o.fp16_blend = true;
+  EXPECT_EQ(o.label(), "flash-fp16_blend");
+  EXPECT_FALSE(o == RenderOptions{});
+  EXPECT_TRUE(o.seen_by(Backend::cuda).fp16_blend);
+  EXPECT_TRUE(o.seen_by(Backend::cpu) == RenderOptions{});
+  const std::vector<RenderOptions> configs = fp16_blend_configs();
+  ASSERT_EQ(configs.size(), 2u);
+  EXPECT_EQ(configs[0].label(), "flash-fp16_blend");
+  EXPECT_EQ(configs[1].label(), "flash-fp16_sh-fp16_shape-fp16_blend");
+}
+
+// The report sweeps the half blend alone and with the fp16 storage, on the GPU only.
+TEST(ReportSweep, Fp16BlendIsSweptOnTheGpu) {
+  std::map<std::string, RenderOptions> swept;
+  for (const cli::SweepConfig& c : cli::sweep_configs())
+    if (c.options.fp16_blend) {
+      EXPECT_EQ(c.group, "precision");
+      EXPECT_TRUE(c.gpu_only) << c.name;
+      swept[c.name] = c.options;
+    }
+  ASSERT_EQ(swept.size(), 2u);
+  EXPECT_EQ(swept["fp16-blend"], fp16_blend_configs()[0]);
+  EXPECT_EQ(swept["fp16-all-blend"], fp16_blend_configs()[1]);
+}
+
 TEST(ReportSweep, Fp16OptionsAreSweptOnEveryBackend) {
   std::map<std::string, RenderOptions> swept;
   for (const cli::SweepConfig& c : cli::sweep_configs()) {
-    if (!c.options.fp16_sh && !c.options.fp16_shape) continue;
+    if ((!c.options.fp16_sh && !c.options.fp16_shape) || c.options.fp16_blend) continue;
     EXPECT_EQ(c.group, "precision");
     EXPECT_FALSE(c.gpu_only);
     swept[c.name] = c.options;

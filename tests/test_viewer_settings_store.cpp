@@ -41,6 +41,7 @@ TEST(ViewerSettingsStore, ARoundTripKeepsEveryValue) {
   a.settings.options.background[1] = 0.5f;
   a.settings.options.fp16_sh = true;  // not the default: lost if the store left it out
   a.settings.options.fp16_shape = true;
+  a.settings.options.fp16_blend = true;
   a.settings.mode = fv::NavigationMode::orbit;
   a.settings.render_scale = 0.5f;
   a.settings.move_speed = 2.5f;

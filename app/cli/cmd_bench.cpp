@@ -44,11 +44,13 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 }
 
 // The configurations by name (their labels): baseline, flash, flash with one switch off, and
-// flash with the precision options that change the scene's bytes (fp16_sh, fp16_shape, both).
+// flash with the precision options: those that change the scene's bytes (fp16_sh, fp16_shape,
+// both), then the half blend alone and with them (fp16_blend; CUDA only).
 std::vector<std::pair<std::string, RenderOptions>> known_configs() {
   std::vector<std::pair<std::string, RenderOptions>> out;
   for (const RenderOptions& o : single_switch_configs()) out.emplace_back(o.label(), o);
   for (const RenderOptions& o : fp16_configs()) out.emplace_back(o.label(), o);
+  for (const RenderOptions& o : fp16_blend_configs()) out.emplace_back(o.label(), o);
   return out;
 }
 

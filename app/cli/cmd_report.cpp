@@ -210,7 +210,7 @@ void run(const ReportArgs& args) {
     // One column per switch (its label token): 1 where it is in effect.
     csv << "backend,config,group,algorithm,";
     for (const RenderSwitch& s : kRenderSwitches) csv << s.label << ',';
-    csv << "tau,fp16_sh,fp16_shape,median_ms,p95_ms,frames,kv_pairs,peak_memory_mb,psnr_vs_baseline_db,"
+    csv << "tau,fp16_sh,fp16_shape,fp16_blend,median_ms,p95_ms,frames,kv_pairs,peak_memory_mb,psnr_vs_baseline_db,"
            "max_abs_vs_baseline,frac_over_1_255_vs_baseline,psnr_vs_fp64_db,max_abs_vs_fp64,frac_over_1_255_vs_fp64,"
            "non_finite,pareto\n";
     for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
@@ -223,7 +223,7 @@ void run(const ReportArgs& args) {
         const RenderOptions& o = r.config.options;
         csv << r.backend << ',' << r.config.name << ',' << r.config.group << ',' << algorithm_name(o.algorithm) << ',';
         for (const RenderSwitch& s : kRenderSwitches) csv << (!o.is_baseline() && o.*(s.member)) << ',';
-        csv << fmt("%.6g", o.tau) << ',' << o.fp16_sh << ',' << o.fp16_shape << ',' << fmt("%.4f", r.median_ms) << ','
+        csv << fmt("%.6g", o.tau) << ',' << o.fp16_sh << ',' << o.fp16_shape << ',' << o.fp16_blend << ',' << fmt("%.4f", r.median_ms) << ','
             << fmt("%.4f", r.p95_ms) << ',' << r.frame_ms.size() << ',' << fmt("%.0f", r.kv_pairs) << ','
             << (r.peak_memory_mb >= 0 ? fmt("%.1f", r.peak_memory_mb) : "") << ','
             << psnr_csv(r.vs_baseline.psnr_db) << ',' << fmt("%.3e", r.vs_baseline.max_abs) << ','

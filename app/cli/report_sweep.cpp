@@ -43,6 +43,9 @@ std::vector<SweepConfig> sweep_configs() {
   // Not exact: the SH coefficients, the shapes or both as halves (fewer scene bytes on the GPU).
   for (const RenderOptions& o : fp16_configs())
     out.push_back({o.fp16_sh && o.fp16_shape ? "fp16-all" : o.fp16_sh ? "fp16-sh" : "fp16-shape", "precision", o, false});
+  // The half blend: a CUDA kernel (the CPU renders these exactly, so it skips their rows).
+  for (const RenderOptions& o : fp16_blend_configs())
+    out.push_back({o.fp16_sh ? "fp16-all-blend" : "fp16-blend", "precision", o, true});
   add_group(gpu_only, "gpu-only-", "gpu alone", "gpu left out", true);
   return out;
 }

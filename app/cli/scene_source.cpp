@@ -109,6 +109,8 @@ void RenderArgs::add_to(CLI::App* command) {
   command->add_flag("--fp16-sh", fp16_sh, "use the SH coefficients as half values (not exact; see flashgs report)");
   command->add_flag("--fp16-shape", fp16_shape,
                     "use each Gaussian's rotation, scale and opacity as half values (not exact; see flashgs report)");
+  command->add_flag("--fp16-blend", fp16_blend,
+                    "CUDA: blend in half arithmetic (not exact; see flashgs report; the CPU renders exactly)");
   command->add_option("--backend", backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
 }
 
@@ -120,6 +122,7 @@ RenderOptions RenderArgs::options() const {
   o.sh_degree_cap = sh_degree;
   o.fp16_sh = fp16_sh;
   o.fp16_shape = fp16_shape;
+  o.fp16_blend = fp16_blend;
   return o;
 }
 

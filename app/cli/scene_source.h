@@ -48,6 +48,7 @@ struct RenderArgs {
   int sh_degree = 3;
   bool fp16_sh = false;
   bool fp16_shape = false;
+  bool fp16_blend = false;
   std::string backend = "auto";
   void add_to(CLI::App* command);
   RenderOptions options() const;

@@ -76,6 +76,7 @@ bool apply_line(const std::string& key, const std::string& value, StoredSettings
   }
   if (key == "fp16_sh") return parse_bool(value, &o.fp16_sh);
   if (key == "fp16_shape") return parse_bool(value, &o.fp16_shape);
+  if (key == "fp16_blend") return parse_bool(value, &o.fp16_blend);
   if (key == "background") {
     std::stringstream ss(value);
     std::string part;
@@ -154,6 +155,7 @@ std::string write_settings_file(const std::string& path, const StoredSettings& s
   out << "sh_degree_cap = " << o.sh_degree_cap << "\n";
   out << "fp16_sh = " << o.fp16_sh << "\n";
   out << "fp16_shape = " << o.fp16_shape << "\n";
+  out << "fp16_blend = " << o.fp16_blend << "\n";
   out << "background = " << o.background[0] << "," << o.background[1] << "," << o.background[2] << "\n";
   out << "navigation = " << (s.mode == NavigationMode::fly ? "fly" : "orbit") << "\n";
   out << "render_scale = " << s.render_scale << "\n";

@@ -63,6 +63,7 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_option("--sh-degree", a->sh_degree, "use at most this many SH bands")->check(CLI::Range(0, kMaxShDegree));
   app.add_flag("--fp16-sh", a->fp16_sh, "use the SH coefficients as half values (not exact)");
   app.add_flag("--fp16-shape", a->fp16_shape, "use each Gaussian's rotation, scale and opacity as half values (not exact)");
+  app.add_flag("--fp16-blend", a->fp16_blend, "CUDA: blend in half arithmetic (not exact; the CPU renders exactly)");
   app.add_option("--background", a->background, "background colour r,g,b in [0, 1]")
       ->delimiter(',')
       ->expected(3)

@@ -27,6 +27,7 @@ struct ViewerArgs {
   int sh_degree = 3;
   bool fp16_sh = false;          // the SH coefficients as half values (RenderOptions::fp16_sh)
   bool fp16_shape = false;       // rotation, scale and opacity as half values (RenderOptions::fp16_shape)
+  bool fp16_blend = false;       // CUDA: the blend in half arithmetic (RenderOptions::fp16_blend)
   std::vector<float> background = {0, 0, 0};
   bool heatmap = false;
   bool orbit = false;            // start in orbit mode

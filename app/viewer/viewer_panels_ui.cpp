@@ -295,6 +295,15 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
       ImGui::Checkbox("fp16 shape", &o.fp16_shape);
       if (ImGui::IsItemHovered())
         ImGui::SetTooltip("rotation, scale and opacity as half values: 16 GPU bytes instead of 32, not exact");
+      // The half blend exists only as a CUDA kernel, and only for the exp2 loop.
+      const bool half_blend_runs = m.backend == Backend::cuda && !o.is_baseline() && o.exp2_alpha;
+      ImGui::BeginDisabled(!half_blend_runs);
+      ImGui::Checkbox("fp16 blend", &o.fp16_blend);
+      ImGui::EndDisabled();
+      if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+        ImGui::SetTooltip("%s", half_blend_runs ? "the blend in half arithmetic, two pixels per instruction: faster, not exact"
+                                                : "the blend in half arithmetic: a CUDA kernel of the flash path with exp2 "
+                                                  "alpha (greyed out: not in effect here)");
     }
     ImGui::EndTable();
   }

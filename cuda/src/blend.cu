@@ -1,6 +1,7 @@
 // Stage `blend`: front-to-back compositing of each tile's depth-sorted Gaussians, either the
 // 3DGS way (a thread per pixel, 256-Gaussian shared-memory batches) or the FlashGS way (warps
 // walking a tile's list with 32-Gaussian batches prefetched one ahead).
+#include <cuda_fp16.h>
 #include <math.h>
 
 #include <algorithm>
@@ -133,6 +134,61 @@ struct TileList {
 // background's weight, without a liveness test in the loop.
 __device__ __forceinline__ float finished_column() { return __int_as_float(0x7fffffff); }
 
+// A Gaussian as the HALF loop (RenderOptions::fp16_blend) reads it: the whitened rows at the
+// region's centre and their change per pixel, so that u = u0 + w0 lx + w1 ly and likewise v,
+// and log2 alpha = log2 opacity - u^2 - v^2, all in half2 arithmetic on a lane's two pixels.
+// Whitened coordinates stay small where alpha passes the cut (u^2 + v^2 <= 8), which suits
+// halves better than the polynomial's coefficients (RegionGaussian), whose terms cancel.
+struct alignas(16) HalfRegionGaussian {
+  __half2 uv0;         // (u, v) at the region's centre
+  __half2 w_y;         // (w1, w3): their change per pixel down
+  __half2 w_x;         // (w0, w2): per pixel across
+  __half2 lop_red;     // log2 opacity, red
+  __half2 green_blue;
+  unsigned pad[3];
+};
+
+__device__ __forceinline__ unsigned half2_bits(__half2 h) {
+  unsigned bits;
+  memcpy(&bits, &h, sizeof bits);
+  return bits;
+}
+
+__device__ __forceinline__ __half2 bits_half2(unsigned bits) {
+  __half2 h;
+  memcpy(&h, &bits, sizeof h);
+  return h;
+}
+
+// 2^x on both halves by the hardware unit (relative error 2^-9.9).
+__device__ __forceinline__ __half2 exp2_approx(__half2 x) {
+  unsigned y;
+  asm("ex2.approx.f16x2 %0, %1;" : "=r"(y) : "r"(half2_bits(x)));
+  return bits_half2(y);
+}
+
+// One staged Gaussian on a lane's two pixels in half2 arithmetic: alpha = exp2 of log2 alpha,
+// the 1/255 cut on the exponent (a column outside the image is NaN and fails it), the 0.99
+// clamp, and compositing with T and the colours as halves. No stop rule per Gaussian (its test
+// and selects would cost a third more): a pixel whose T fell below the minimum goes on until
+// every pixel of its warp has, adding less than that T (1e-4) in all. On Hopper the f16x2 exp2
+// is two MUFU.EX2.F16 and a PRMT: about 19 instructions per Gaussian and lane against the
+// float loop's 29-35 (SASS of session 22), with the exp2 unit then nearly as busy as the issue.
+__device__ __forceinline__ void blend_region_gaussian_half(const HalfRegionGaussian& g, __half2 lane_y,
+                                                           __half2 lane_x, __half2 cut, __half2 alpha_max,
+                                                           __half2& t, __half2& cr, __half2& cg, __half2& cb) {
+  const __half2 uv_row = __hfma2(g.w_y, lane_y, g.uv0);
+  const __half2 u = __hfma2(__low2half2(g.w_x), lane_x, __low2half2(uv_row));
+  const __half2 v = __hfma2(__high2half2(g.w_x), lane_x, __high2half2(uv_row));
+  const __half2 e = __hfma2(__hneg2(v), v, __hfma2(__hneg2(u), u, __low2half2(g.lop_red)));
+  const __half2 alpha = bits_half2(half2_bits(__hmin2(exp2_approx(e), alpha_max)) & __hge2_mask(e, cut));
+  const __half2 w = __hmul2(alpha, t);
+  t = __hsub2(t, w);
+  cr = __hfma2(__high2half2(g.lop_red), w, cr);
+  cg = __hfma2(__low2half2(g.green_blue), w, cg);
+  cb = __hfma2(__high2half2(g.green_blue), w, cb);
+}
+
 // One staged Gaussian on a lane's pixels (EXP2): alpha = exp2 of the polynomial, the 1/255 cut
 // on the exponent, and compositing. STOP_RULE applies the CPU's stop; without it (a Gaussian
 // that cannot take any of the warp's pixels below the minimum T, see the staging) the result
@@ -189,12 +245,16 @@ __device__ __forceinline__ void blend_region_gaussian(const RegionGaussian& g, f
 // Only the Gaussians that meet the region are staged, packed in list order, so the loop over
 // them is a counted one. Binned frames (BinGrid): the 4 blocks of a bin blend its tiles, each
 // from its own tile list (FrameBuffers::tile_lists).
-template <int REGION_W, bool PIPELINED, bool EXP2, bool SURFACE>
+// HALF (EXP2 only; RenderOptions::fp16_blend): the staged Gaussians as HalfRegionGaussian and
+// each lane's pixels as one half2, with no stop rule per Gaussian (see blend_region_gaussian_half).
+template <int REGION_W, bool PIPELINED, bool EXP2, bool HALF, bool SURFACE>
 __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
+  static_assert(EXP2 || !HALF, "the half blend is an exp2 blend");
+  static_assert(!HALF || kLanePixelsX == 2, "a lane's pixels are one half2");
   constexpr int kRegionH = 64 / REGION_W;
   constexpr int kLanesX = REGION_W / kLanePixelsX;
   constexpr int kRegionsX = kTile / REGION_W;
-  using Staged = std::conditional_t<EXP2, RegionGaussian, BlendGaussian>;
+  using Staged = std::conditional_t<HALF, HalfRegionGaussian, std::conditional_t<EXP2, RegionGaussian, BlendGaussian>>;
   __shared__ Staged batch[kWarpsPerBlock][kWarp];
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   // A block is one tile, its warps the tile's regions.
@@ -230,6 +290,10 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     lane_x[p] = !EXP2 || (live & (1u << p)) ? static_cast<float>(x0 + p) - region_mid_x : finished_column();
   }
   const unsigned inside = live;
+  // HALF: the lane's pixels as one half2 (a column outside the image NaN, as above).
+  const __half2 lane_x2 = __floats2half2_rn(lane_x[0], lane_x[1]), lane_y2 = __float2half2_rn(lane_y);
+  const __half2 half_cut = __float2half2_rn(kLog2AlphaMin), half_alpha_max = __float2half2_rn(gm::kAlphaMax);
+  __half2 t2 = __float2half2_rn(1.0f), cr2 = __float2half2_rn(0.0f), cg2 = cr2, cb2 = cr2;
   TileList list;
   if (shift > 0) {
     const uint2 range = a.tile_lists[static_cast<unsigned>(ty) * static_cast<unsigned>(a.tiles_x) + static_cast<unsigned>(tx)];
@@ -247,7 +311,10 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   unsigned ahead_record = 0, ahead_n = 0;
   if (PIPELINED) ahead_n = list.take(lane, ahead_record);
   while (n > 0) {
-    if constexpr (EXP2) {
+    if constexpr (HALF) {
+      live = inside & ((__low2float(t2) >= gm::kTransmittanceMin ? 1u : 0u) |
+                       (__high2float(t2) >= gm::kTransmittanceMin ? 2u : 0u));
+    } else if constexpr (EXP2) {
       live = 0;
 #pragma unroll
       for (int p = 0; p < kLanePixelsX; ++p) live |= isnan(lane_x[p]) ? 0u : 1u << p;
@@ -286,7 +353,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       for (int p = 0; p < kLanePixelsX; ++p) lowest_t = isnan(lane_x[p]) ? lowest_t : fminf(lowest_t, t[p]);
       // T > 0, so its bits order as the floats do.
       lowest_t = __uint_as_float(__reduce_min_sync(kFullMask, __float_as_uint(lowest_t)));
-      if (a.stop_bound && lowest_t >= kBoundWorthT) {
+      if (!HALF && a.stop_bound && lowest_t >= kBoundWorthT) {
         float kept = meets ? 1.0f - fminf(gm::kAlphaMax, exp2_approx(next.opacity - q_min + 1e-3f)) : 1.0f;
 #pragma unroll
         for (int offset = 1; offset < kWarp; offset <<= 1) {
@@ -300,7 +367,13 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
         // The whitened rows at the region's centre: (u0, v0), and log2 alpha there and around.
         const float ox = next.mean_x - region_mid_x, oy = next.mean_y - region_mid_y;
         const float u0 = -__fmaf_rn(next.w0, ox, next.w1 * oy), v0 = -__fmaf_rn(next.w2, ox, next.w3 * oy);
-        batch[warp][__popc(relevant & ((1u << lane) - 1u))] = RegionGaussian{
+        Staged& slot = batch[warp][__popc(relevant & ((1u << lane) - 1u))];
+        if constexpr (HALF)
+          slot = HalfRegionGaussian{__floats2half2_rn(u0, v0), __floats2half2_rn(next.w1, next.w3),
+                                    __floats2half2_rn(next.w0, next.w2), __floats2half2_rn(next.opacity, next.red),
+                                    __floats2half2_rn(next.green, next.blue), {0u, 0u, 0u}};
+        else
+          slot = RegionGaussian{
             __fmaf_rn(-u0, u0, __fmaf_rn(-v0, v0, next.opacity)),
             -2.0f * __fmaf_rn(next.w1, u0, next.w3 * v0),
             -conic_c,
@@ -324,7 +397,11 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
       next_n = list.take(lane, next_record);
     }
     // Unrolled: more independent work between the loads and the transmittance chain.
-    if constexpr (EXP2) {
+    if constexpr (HALF) {
+#pragma unroll kBlendUnroll
+      for (unsigned j = 0; j < staged; ++j)
+        blend_region_gaussian_half(batch[warp][j], lane_y2, lane_x2, half_cut, half_alpha_max, t2, cr2, cg2, cb2);
+    } else if constexpr (EXP2) {
 #pragma unroll kBlendUnroll
       for (unsigned j = 0; j < unstoppable; ++j)
         blend_region_gaussian<false>(batch[warp][j], lane_y, lane_x, t, cr, cg, cb);
@@ -363,6 +440,12 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     n = next_n;
     record = next_record;
   }
+  if constexpr (HALF) {
+    const float2 t_out = __half22float2(t2), r_out = __half22float2(cr2), g_out = __half22float2(cg2),
+                 b_out = __half22float2(cb2);
+    t[0] = t_out.x, t[1] = t_out.y, cr[0] = r_out.x, cr[1] = r_out.y;
+    cg[0] = g_out.x, cg[1] = g_out.y, cb[0] = b_out.x, cb[1] = b_out.y;
+  }
 #pragma unroll
   for (int p = 0; p < kLanePixelsX; ++p)
     if (inside & (1u << p))
@@ -376,14 +459,19 @@ void launch_warp_tile(const BlendArgs& a, cudaStream_t stream) {
   const unsigned blocks = static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y) << (2 * a.bins.shift);
   const unsigned threads = kWarpsPerBlock * kWarp;
   const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
-  if (pipelined && a.exp2_alpha)
-    blend_warp_tile_kernel<REGION_W, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  const bool half = a.exp2_alpha && a.half_blend;
+  if (pipelined && half)
+    blend_warp_tile_kernel<REGION_W, true, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else if (pipelined && a.exp2_alpha)
+    blend_warp_tile_kernel<REGION_W, true, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
   else if (pipelined)
-    blend_warp_tile_kernel<REGION_W, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+    blend_warp_tile_kernel<REGION_W, true, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  else if (half)
+    blend_warp_tile_kernel<REGION_W, false, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
   else if (a.exp2_alpha)
-    blend_warp_tile_kernel<REGION_W, false, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
+    blend_warp_tile_kernel<REGION_W, false, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
   else
-    blend_warp_tile_kernel<REGION_W, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+    blend_warp_tile_kernel<REGION_W, false, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
 }
 
 
@@ -404,7 +492,7 @@ std::uint64_t blend_resident_blocks() {
   int device = 0, sms = 0, per_sm = 0;
   check_cuda(cudaGetDevice(&device), "device query");
   check_cuda(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "device query");
-  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false>,
+  check_cuda(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&per_sm, blend_warp_tile_kernel<8, true, true, false, false>,
                                                            kWarpsPerBlock * kWarp, 0),
              "occupancy query");
   return static_cast<std::uint64_t>(std::max(1, sms * per_sm));

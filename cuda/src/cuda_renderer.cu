@@ -687,6 +687,7 @@ class CudaRendererImpl final : public CudaRenderer {
                               : (options.pipelined_blend ? cuda::BlendKernel::warp_tile_pipelined
                                                          : cuda::BlendKernel::warp_tile);
     blend.exp2_alpha = f.args->exp2_alpha;
+    blend.half_blend = options.fp16_blend;
     blend.region_width = region_width_;
     blend.stop_bound = stop_bound_;
     blend.bins = bins_;

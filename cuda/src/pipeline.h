@@ -287,6 +287,7 @@ struct BlendArgs {
   float background[3];
   BlendKernel kernel;
   bool exp2_alpha;
+  bool half_blend;               // warp blend (exp2): RenderOptions::fp16_blend
   int region_width;              // warp blend: a warp's region, 16 x 4 or 8 x 8 pixels
   bool stop_bound;               // warp blend (exp2): no stop rule where no pixel can stop
   const std::uint32_t* values;   // sorted pair values (blend records; tile bits when binned)

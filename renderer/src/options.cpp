@@ -23,6 +23,7 @@ std::string RenderOptions::label() const {
       if (!(this->*(s.member))) label += std::string("-no_") + s.label;
   if (fp16_sh) label += "-fp16_sh";
   if (fp16_shape) label += "-fp16_shape";
+  if (fp16_blend) label += "-fp16_blend";
   return label;
 }
 
@@ -31,6 +32,7 @@ RenderOptions RenderOptions::seen_by(Backend backend) const {
   const RenderOptions defaults = is_baseline() ? RenderOptions::baseline() : RenderOptions{};
   for (const RenderSwitch& s : kRenderSwitches)
     if (!s.honoured_by(backend)) seen.*(s.member) = defaults.*(s.member);
+  if (backend == Backend::cpu) seen.fp16_blend = false;
   return seen;
 }
 
@@ -39,6 +41,7 @@ bool operator==(const RenderOptions& a, const RenderOptions& b) {
     if (a.*(s.member) != b.*(s.member)) return false;
   return a.algorithm == b.algorithm && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
          a.fp16_sh == b.fp16_sh && a.fp16_shape == b.fp16_shape &&
+         a.fp16_blend == b.fp16_blend &&
          a.collect_tile_counts == b.collect_tile_counts && std::equal(a.background, a.background + 3, b.background);
 }
 
@@ -58,6 +61,13 @@ std::vector<RenderOptions> fp16_configs() {
   shape.fp16_shape = true;
   both.fp16_sh = both.fp16_shape = true;
   return {sh, shape, both};
+}
+
+std::vector<RenderOptions> fp16_blend_configs() {
+  RenderOptions blend, all;
+  blend.fp16_blend = true;
+  all.fp16_sh = all.fp16_shape = all.fp16_blend = true;
+  return {blend, all};
 }
 
 const char* algorithm_name(Algorithm a) { return a == Algorithm::baseline ? "baseline" : "flash"; }

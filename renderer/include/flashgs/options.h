@@ -42,6 +42,10 @@ struct RenderOptions {
   // The same for each Gaussian's rotation, scale and opacity: the CUDA backend keeps them in one
   // 16-byte record instead of 32 bytes of floats. Positions stay floats.
   bool fp16_shape = false;
+  // The CUDA flash blend in half2 arithmetic: each Gaussian staged as 20 bytes of halves and
+  // each pixel's alpha, transmittance and colour as halves, two pixels per instruction. Only
+  // with exp2_alpha (the float expf loop has no half form); the CPU renders the exact image.
+  bool fp16_blend = false;
   bool collect_tile_counts = false;  // fill FrameStats::tile_pair_counts
 
   // The options of the original 3DGS rasterizer (every switch off).
@@ -123,6 +127,8 @@ std::vector<RenderOptions> single_switch_configs();
 // flash with the precision options that store the scene in fewer bytes: fp16_sh, fp16_shape,
 // then both (the whole fp16 storage).
 std::vector<RenderOptions> fp16_configs();
+// flash with the half blend (fp16_blend), alone and with the whole fp16 storage: CUDA only.
+std::vector<RenderOptions> fp16_blend_configs();
 
 const char* algorithm_name(Algorithm a);
 const char* backend_name(Backend b);
