@@ -267,11 +267,16 @@ TEST(CliReport, Fp16OptionsAreSweptWithTheirErrorAgainstTheReference) {
     EXPECT_GT(fp16_psnr, 40.0) << name << " " << by_name[name][psnr];
     EXPECT_NE(by_name[name][psnr], by_name["flash"][psnr]) << name << " must change the image";
   }
+  // The half blend is a CUDA kernel: the CPU's report has its column, 0 on every row, and no row of it.
+  const std::size_t fp16_blend = column("fp16_blend");
+  for (const auto& [name, row] : by_name) EXPECT_EQ(row[fp16_blend], "0") << name;
+  EXPECT_FALSE(by_name.count("fp16-blend"));
 
   const CliResult bench = run_cli("bench --backend cpu -r 32x18 --camera-list 0 --warmup 0 --repeat 1 --configs "
-                                  "flash-fp16_sh,flash-fp16_shape,flash-fp16_sh-fp16_shape --json " + dir + "/b.json");
+                                  "flash-fp16_sh,flash-fp16_shape,flash-fp16_sh-fp16_shape,flash-fp16_blend --json " +
+                                  dir + "/b.json");
   ASSERT_EQ(bench.exit_code, 0) << bench.output;
-  for (const char* label : {"flash-fp16_sh", "flash-fp16_shape", "flash-fp16_sh-fp16_shape"})
+  for (const char* label : {"flash-fp16_sh", "flash-fp16_shape", "flash-fp16_sh-fp16_shape", "flash-fp16_blend"})
     EXPECT_NE(bench.output.find(std::string("\n32x18      ") + label + " "), std::string::npos) << label << "\n"
                                                                                                << bench.output;
 }
