@@ -610,14 +610,14 @@ TEST(CudaEdgeCases, EmptyFrameAndEmptyScene) {
   EXPECT_EQ(r.image.rgb[1], 0.5f);
 }
 
-// render_to_surface writes the same pixels, as RGBA8, as render() gives as floats.
-TEST(CudaSurface, MatchesTheFloatImage) {
-  FLASHGS_REQUIRE_CUDA();
+// render_to_surface writes the same pixels, as RGBA8, as render() gives as floats (exact, and
+// with the half blend, whose surface kernel is a template instance of its own).
+void check_surface_matches_float_image(const RenderOptions& options) {
   const auto scene = test::load_demo_scene();
   const Camera camera = test::load_demo_cameras()[1].resized(333, 187);
   auto gpu = make_cuda_renderer();
   gpu->set_scene(scene);
-  const Result f = render(*gpu, camera, RenderOptions{});
+  const Result f = render(*gpu, camera, options);
   cudaChannelFormatDesc desc = cudaCreateChannelDesc(8, 8, 8, 8, cudaChannelFormatKindUnsigned);
   cudaArray_t array = nullptr;
   ASSERT_EQ(cudaMallocArray(&array, &desc, camera.width, camera.height, cudaArraySurfaceLoadStore), cudaSuccess);
@@ -627,7 +627,7 @@ TEST(CudaSurface, MatchesTheFloatImage) {
   cudaSurfaceObject_t surface = 0;
   ASSERT_EQ(cudaCreateSurfaceObject(&surface, &res), cudaSuccess);
   FrameStats stats;
-  gpu->render_to_surface(camera, RenderOptions{}, surface, &stats);
+  gpu->render_to_surface(camera, options, surface, &stats);
   ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(gpu->stream())), cudaSuccess);
   std::vector<unsigned char> rgba(std::size_t(camera.width) * camera.height * 4);
   ASSERT_EQ(cudaMemcpy2DFromArray(rgba.data(), camera.width * 4, array, 0, 0, camera.width * 4, camera.height,
@@ -643,9 +643,17 @@ TEST(CudaSurface, MatchesTheFloatImage) {
     }
     EXPECT_EQ(rgba[p * 4 + 3], 255);
   }
-  EXPECT_LE(worst, 0);
+  EXPECT_LE(worst, 0) << options.label();
   cudaDestroySurfaceObject(surface);
   cudaFreeArray(array);
+}
+
+TEST(CudaSurface, MatchesTheFloatImage) {
+  FLASHGS_REQUIRE_CUDA();
+  check_surface_matches_float_image(RenderOptions{});
+  RenderOptions half;
+  half.fp16_blend = true;
+  check_surface_matches_float_image(half);
 }
 
 // A surface smaller than the frame (or not RGBA8) is refused before anything is written.

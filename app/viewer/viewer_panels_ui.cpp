@@ -292,9 +292,11 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
       ImGui::Checkbox("fp16 SH", &o.fp16_sh);
       if (ImGui::IsItemHovered())
         ImGui::SetTooltip("the SH coefficients as half values: half the GPU bytes of the SH bands, not exact");
-      ImGui::Checkbox("fp16 shape", &o.fp16_shape);
+      // On the SH box's line, so that the panel is no taller than the GPU column beside it.
+      ImGui::SameLine();
+      ImGui::Checkbox("shape##fp16 shape", &o.fp16_shape);
       if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("rotation, scale and opacity as half values: 16 GPU bytes instead of 32, not exact");
+        ImGui::SetTooltip("fp16 shape: rotation, scale and opacity as half values: 16 GPU bytes instead of 32, not exact");
       // The half blend exists only as a CUDA kernel, and only for the exp2 loop.
       const bool half_blend_runs = m.backend == Backend::cuda && !o.is_baseline() && o.exp2_alpha;
       ImGui::BeginDisabled(!half_blend_runs);
