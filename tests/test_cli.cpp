@@ -281,6 +281,23 @@ TEST(CliReport, Fp16OptionsAreSweptWithTheirErrorAgainstTheReference) {
                                                                                                << bench.output;
 }
 
+// `bench --configs all` on the CPU leaves out the rows that would repeat another: the GPU
+// switches (each would be "flash") and the half blend (alone "flash", with the fp16 storage
+// "flash-fp16_sh-fp16_shape").
+TEST(CliBench, AllConfigsOnTheCpuRepeatNoRow) {
+  const std::string dir = scratch_dir("bench_all_cpu");
+  const CliResult r = run_cli("bench --backend cpu -r 32x18 --camera-list 0 --warmup 0 --repeat 1 --configs all --json " +
+                              dir + "/b.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto has_row = [&](const std::string& label) {
+    return r.output.find("\n32x18      " + label + " ") != std::string::npos;
+  };
+  for (const char* label : {"baseline", "flash", "flash-no_tight_bbox", "flash-fp16_sh", "flash-fp16_sh-fp16_shape"})
+    EXPECT_TRUE(has_row(label)) << label << "\n" << r.output;
+  for (const char* label : {"flash-no_warp_emit", "flash-fp16_blend", "flash-fp16_sh-fp16_shape-fp16_blend"})
+    EXPECT_FALSE(has_row(label)) << label << "\n" << r.output;
+}
+
 TEST(CliGenerate, RefusesToOverwriteAScene) {
   const std::string dir = scratch_dir("overwrite");
   ASSERT_EQ(run_cli("generate demo --count 300 -o " + dir).exit_code, 0);

@@ -67,9 +67,12 @@ std::vector<std::pair<std::string, RenderOptions>> select_configs(const std::vec
   for (const std::string& w : wanted) {
     if (w == "all") {
       for (const auto& c : known) {
-        // A switch the CPU does not honour: its row would repeat "flash".
-        const bool repeats_flash = c.first != "flash" && c.second.seen_by(Backend::cpu) == RenderOptions{};
-        if (!(cpu && repeats_flash)) out.push_back(c);
+        // An option the CPU does not honour: its row would repeat an earlier one ("flash" for a
+        // GPU switch, flash-fp16_sh-fp16_shape for the fp16 storage with the half blend).
+        const bool repeats = std::any_of(known.begin(), known.end(), [&](const auto& earlier) {
+          return &earlier < &c && earlier.second.seen_by(Backend::cpu) == c.second.seen_by(Backend::cpu);
+        });
+        if (!(cpu && repeats)) out.push_back(c);
       }
       continue;
     }
