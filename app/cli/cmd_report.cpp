@@ -223,8 +223,9 @@ void run(const ReportArgs& args) {
         const RenderOptions& o = r.config.options;
         csv << r.backend << ',' << r.config.name << ',' << r.config.group << ',' << algorithm_name(o.algorithm) << ',';
         for (const RenderSwitch& s : kRenderSwitches) csv << (!o.is_baseline() && o.*(s.member)) << ',';
-        csv << fmt("%.6g", o.tau) << ',' << o.fp16_sh << ',' << o.fp16_shape << ',' << o.fp16_blend << ',' << fmt("%.4f", r.median_ms) << ','
-            << fmt("%.4f", r.p95_ms) << ',' << r.frame_ms.size() << ',' << fmt("%.0f", r.kv_pairs) << ','
+        csv << fmt("%.6g", o.tau) << ',' << o.fp16_sh << ',' << o.fp16_shape << ',' << o.fp16_blend << ','
+            << fmt("%.4f", r.median_ms) << ',' << fmt("%.4f", r.p95_ms) << ',' << r.frame_ms.size() << ','
+            << fmt("%.0f", r.kv_pairs) << ','
             << (r.peak_memory_mb >= 0 ? fmt("%.1f", r.peak_memory_mb) : "") << ','
             << psnr_csv(r.vs_baseline.psnr_db) << ',' << fmt("%.3e", r.vs_baseline.max_abs) << ','
             << fmt("%.3e", r.vs_baseline.fraction_over) << ',' << psnr_csv(r.vs_reference.psnr_db) << ','

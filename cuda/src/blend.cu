@@ -139,6 +139,7 @@ __device__ __forceinline__ float finished_column() { return __int_as_float(0x7ff
 // and log2 alpha = log2 opacity - u^2 - v^2, all in half2 arithmetic on a lane's two pixels.
 // Whitened coordinates stay small where alpha passes the cut (u^2 + v^2 <= 8), which suits
 // halves better than the polynomial's coefficients (RegionGaussian), whose terms cancel.
+// 20 bytes of halves in a 32-byte slot, read back as one 16-byte and one 4-byte broadcast.
 struct alignas(16) HalfRegionGaussian {
   __half2 uv0;         // (u, v) at the region's centre
   __half2 w_y;         // (w1, w3): their change per pixel down
