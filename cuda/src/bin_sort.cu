@@ -181,14 +181,15 @@ __global__ void __launch_bounds__(kPassBlock) bin_count_kernel(FrameCounters* co
 // The scatter pass: each block takes chunks, counts a chunk's pairs per bin in shared memory,
 // reserves its places in each bin with one global atomic and hands them out with shared
 // atomics. The order within a bin is whatever the atomics give; the bin sort makes it exact.
+// A pair's key and value go out as one 8-byte word: a chunk's pairs land one or two per bin,
+// so each store is a memory request of its own, and one per pair halves them.
 __global__ void __launch_bounds__(kPassBlock) bin_scatter_kernel(const FrameCounters* counters,
                                                                  std::uint64_t pair_capacity,
                                                                  std::uint32_t record_capacity,
                                                                  const std::uint32_t* __restrict__ keys,
                                                                  const std::uint32_t* __restrict__ values,
                                                                  int depth_bits, unsigned bins, std::uint32_t* fill,
-                                                                 std::uint32_t* __restrict__ bin_keys,
-                                                                 std::uint32_t* __restrict__ bin_values) {
+                                                                 uint2* __restrict__ bin_pairs) {
   extern __shared__ unsigned hist[];  // [bins]
   const std::uint64_t pairs = frame_pairs(counters, pair_capacity, record_capacity);
   const std::uint64_t chunks = (pairs + kChunkPairs - 1) / kChunkPairs;
@@ -211,9 +212,7 @@ __global__ void __launch_bounds__(kPassBlock) bin_scatter_kernel(const FrameCoun
 #pragma unroll
     for (int k = 0; k < kChunkItems; ++k)
       if (bin[k] != kNoBin) {
-        const unsigned place = atomicAdd(&hist[bin[k]], 1u);
-        bin_keys[place] = key[k];
-        bin_values[place] = value[k];
+        bin_pairs[atomicAdd(&hist[bin[k]], 1u)] = make_uint2(key[k], value[k]);
       }
     __syncthreads();  // hist is cleared for the next chunk
   }
@@ -225,18 +224,22 @@ struct PairSpan {
   std::uint32_t* values;
 };
 
-// What the bin sort reads and writes (FrameBuffers' fields; see launch_bin_sort).
+// What the bin blocks read and write (FrameBuffers' fields; see launch_bin_blocks).
 struct BinSortArgs {
   BinGrid bins;
   int tiles_x, tiles_y;
   const uint2* bin_ranges;
-  std::uint32_t* keys;      // the pairs in bin order: values[1]
-  std::uint32_t* values;    // values[0]
-  std::uint32_t* scratch;   // keys[1] as 32-bit words: bin [s, e) may use [2s, 2e)
+  const uint2* pairs;       // the scatter pass's (key, value) in bin order: keys[1]
+  std::uint32_t* keys;      // a bin sorted in global memory: its keys, values[1]
+  std::uint32_t* values;    // and values, values[0]
+  std::uint32_t* scratch;   // keys[1] as 32-bit words: bin [s, e) may use [2s, 2e) once read
   std::uint32_t* fill;      // the counting passes' per-bin counts, zeroed here for the next frame
   std::uint32_t* top_lists;     // tile_values[0]
   std::uint32_t* bottom_lists;  // tile_values[1]
   uint2* tile_lists;
+  const std::uint32_t* order;  // block b sorts bin order[b] (null: bin b)
+  std::uint32_t* ready;        // ready[bin] = frame_tag once the bin's lists are written (or null)
+  std::uint32_t frame_tag;
   Records records;
   unsigned shared_pairs;  // bins of more pairs sort in global memory
 };
@@ -367,6 +370,26 @@ __device__ void copy_pairs(PairSpan from, PairSpan to, unsigned n, std::uint32_t
   }
 }
 
+// Splits n scattered (key, value) pairs into a span (kBatch loads per thread in flight).
+__device__ void split_pairs(const uint2* from, PairSpan to, unsigned n) {
+  for (unsigned base = 0; base < n; base += kBatch * kSortBlock) {
+    uint2 pair[kBatch];
+#pragma unroll
+    for (int j = 0; j < kBatch; ++j) {
+      const unsigned i = base + j * kSortBlock + threadIdx.x;
+      pair[j] = i < n ? from[i] : make_uint2(0u, 0u);
+    }
+#pragma unroll
+    for (int j = 0; j < kBatch; ++j) {
+      const unsigned i = base + j * kSortBlock + threadIdx.x;
+      if (i < n) {
+        to.keys[i] = pair[j].x;
+        to.values[i] = pair[j].y;
+      }
+    }
+  }
+}
+
 // The smallest and largest key of a span in global memory.
 __device__ void span_key_bounds(PairSpan span, unsigned n, std::uint32_t& low, std::uint32_t& high) {
   low = 0xffffffffu;
@@ -421,14 +444,15 @@ __device__ void write_tile_lists(const BinSortArgs& a, unsigned bin, const std::
 // immaterial (ties are put in the exact order afterwards); so that padding sorts last, it gets
 // a key one bit above every real one.
 template <typename BlockSort, int ITEMS>
-__device__ void sort_in_shared(PairSpan home, unsigned n, BlockSort sorter, SortShared& sh) {
+__device__ void sort_in_shared(const uint2* pairs, unsigned n, BlockSort sorter, SortShared& sh) {
   std::uint32_t key[ITEMS], value[ITEMS];
   std::uint32_t low = 0xffffffffu, high = 0;
 #pragma unroll
   for (int j = 0; j < ITEMS; ++j) {
     const unsigned i = j * kSortBlock + threadIdx.x;
-    key[j] = i < n ? home.keys[i] : 0u;
-    value[j] = i < n ? home.values[i] : 0u;
+    const uint2 pair = i < n ? pairs[i] : make_uint2(0u, 0u);
+    key[j] = pair.x;
+    value[j] = pair.y;
     if (i < n) {
       low = min(low, key[j]);
       high = max(high, key[j]);
@@ -471,11 +495,25 @@ __device__ void sort_in_global(PairSpan home, PairSpan scratch, unsigned n, Sort
   }
 }
 
+// Tells a blend block waiting on `bin` that its lists are written (every thread calls, after
+// its last write of them).
+__device__ __forceinline__ void publish_bin(const BinSortArgs& a, unsigned bin) {
+  if (!a.ready) return;
+  __threadfence();
+  __syncthreads();
+  if (threadIdx.x == 0) store_release(a.ready + bin, a.frame_tag);
+}
+
 // A block per bin: sort by key (the bin's keys differ only in their depth bins, and only the
 // bits in which the bin's keys differ are sorted), order the ties, write the lists.
 __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
+#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
+  // The blend may be scheduled once every bin block has started: a blend block then waits only
+  // for a bin block that is running, so the wait always ends.
+  asm volatile("griddepcontrol.launch_dependents;");
+#endif
   __shared__ SortShared sh;
-  const unsigned bin = blockIdx.x;
+  const unsigned bin = a.order ? a.order[blockIdx.x] : blockIdx.x;
   if (threadIdx.x == 0) a.fill[bin] = 0;  // the scatter pass was its last user this frame
   const uint2 range = a.bin_ranges[bin];
   const unsigned n = range.y - range.x;
@@ -483,19 +521,24 @@ __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
   if (n == 0) {  // whole block
     const unsigned none[4] = {0, 0, 0, 0};
     record_tile_list(a.bins, a.tiles_x, a.tiles_y, a.tile_lists, bin, lists, none, threadIdx.x);
+    publish_bin(a, bin);
     return;
   }
+  const uint2* pairs = a.pairs + range.x;
   const PairSpan home{a.keys + range.x, a.values + range.x};
   PairSpan sorted = home;
   if (n <= a.shared_pairs) {
     sorted = PairSpan{sh.bin.sorted.keys, sh.bin.sorted.values};
-    if (n <= kSortBlock * kSmallItems) sort_in_shared<SmallBinSort, kSmallItems>(home, n, SmallBinSort(sh.bin.small), sh);
-    else sort_in_shared<LargeBinSort, kLargeItems>(home, n, LargeBinSort(sh.bin.large), sh);
+    if (n <= kSortBlock * kSmallItems) sort_in_shared<SmallBinSort, kSmallItems>(pairs, n, SmallBinSort(sh.bin.small), sh);
+    else sort_in_shared<LargeBinSort, kLargeItems>(pairs, n, LargeBinSort(sh.bin.large), sh);
   } else {
+    split_pairs(pairs, home, n);
+    __syncthreads();  // the pairs' words become the radix passes' scratch
     sort_in_global(home, PairSpan{a.scratch + 2ull * range.x, a.scratch + 2ull * range.x + n}, n, sh);
   }
   order_ties(sorted, n, a.records);
   write_tile_lists(a, bin, sorted.values, lists, sh);
+  publish_bin(a, bin);
 }
 
 }  // namespace
@@ -506,14 +549,12 @@ __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
 constexpr unsigned kScatterBlocks = 2048;
 constexpr unsigned kCountBlocks = 512;
 
-void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned shared_pairs, bool fill_is_zero,
-                     std::uint32_t* order, cudaStream_t stream) {
+void launch_bin_pairs(const FrameBuffers& b, bool fill_is_zero, std::uint32_t* order, cudaStream_t stream) {
   const unsigned bins = static_cast<unsigned>(b.bins.x) * static_cast<unsigned>(b.bins.y);
   if (bins == 0) return;
   if (bins > kBinSortMaxBins)
     throw Error("cuda renderer: internal error, a bin sort of " + std::to_string(bins) + " bins (at most " +
                 std::to_string(kBinSortMaxBins) + ")");
-  shared_pairs = std::min(shared_pairs, kBinSortSharedPairsMax);
   const std::uint64_t most_chunks = std::max<std::uint64_t>(1, (b.pair_capacity + kChunkPairs - 1) / kChunkPairs);
   const std::size_t hist_bytes = bins * sizeof(unsigned);
   const std::uint32_t* keys = reinterpret_cast<const std::uint32_t*>(b.keys[0]);
@@ -525,13 +566,20 @@ void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned s
   check_cuda(cudaGetLastError(), "bin count kernel launch");
   bin_scatter_kernel<<<static_cast<unsigned>(std::min<std::uint64_t>(kScatterBlocks, most_chunks)), kPassBlock,
                        hist_bytes, stream>>>(b.counters, b.pair_capacity, b.record_capacity, keys, b.pair_values,
-                                             depth_bits, bins, b.bin_fill, b.values[1], b.values[0]);
+                                             depth_bits, bins, b.bin_fill, reinterpret_cast<uint2*>(b.keys[1]));
   check_cuda(cudaGetLastError(), "bin scatter kernel launch");
+}
+
+void launch_bin_blocks(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned shared_pairs,
+                       const std::uint32_t* order, std::uint32_t* ready, std::uint32_t frame_tag, cudaStream_t stream) {
+  const unsigned bins = static_cast<unsigned>(b.bins.x) * static_cast<unsigned>(b.bins.y);
+  if (bins == 0) return;
   BinSortArgs args{};
   args.bins = b.bins;
   args.tiles_x = tiles_x;
   args.tiles_y = tiles_y;
   args.bin_ranges = b.tile_ranges;
+  args.pairs = reinterpret_cast<const uint2*>(b.keys[1]);
   args.keys = b.values[1];
   args.values = b.values[0];
   args.scratch = reinterpret_cast<std::uint32_t*>(b.keys[1]);
@@ -539,8 +587,11 @@ void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned s
   args.top_lists = b.tile_values[0];
   args.bottom_lists = b.tile_values[1];
   args.tile_lists = b.tile_lists;
+  args.order = order;
+  args.ready = ready;
+  args.frame_tag = frame_tag;
   args.records = Records{b.blend, b.record_ids, kRecordMask};
-  args.shared_pairs = shared_pairs;
+  args.shared_pairs = std::min(shared_pairs, kBinSortSharedPairsMax);
   bin_sort_kernel<<<bins, kSortBlock, 0, stream>>>(args);
   check_cuda(cudaGetLastError(), "bin sort kernel launch");
 }

@@ -268,6 +268,11 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const int tx = static_cast<int>(bin % a.bins.x) * (1 << shift) + static_cast<int>(tile_in_bin & ((1u << shift) - 1u));
   const int ty = static_cast<int>(bin / a.bins.x) * (1 << shift) + static_cast<int>(tile_in_bin >> shift);
   if (tx >= a.tiles_x || ty >= a.tiles_y) return;  // a bin over the image's edge: whole block
+  if (a.bins_ready) {  // launched beside the bin blocks: wait for this bin's lists
+    if (threadIdx.x == 0)
+      while (load_acquire(a.bins_ready + bin) != a.frame_tag) __nanosleep(200);
+    __syncthreads();
+  }
   const int region_in_tile = static_cast<int>(warp);
   // The region's pixel-centre rectangle, clipped to the image, and this lane's pixels.
   const float region_x0 = static_cast<float>(tx * kTile + (region_in_tile % kRegionsX) * REGION_W);
@@ -454,25 +459,36 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
                            cb[p] + t[p] * a.background[2]);
 }
 
+// A block per tile of each bin (tiles of bins over the image's edge return at once). With
+// bins_ready, the launch may start before the bin blocks before it in the stream have ended
+// (programmatic dependent launch): each block waits for its own bin's lists instead.
+template <int REGION_W, bool PIPELINED, bool EXP2, bool HALF, bool SURFACE>
+void launch_warp_tile_kernel(const BlendArgs& a, cudaStream_t stream) {
+  cudaLaunchConfig_t config{};
+  config.gridDim = dim3(static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y) << (2 * a.bins.shift));
+  config.blockDim = dim3(kWarpsPerBlock * kWarp);
+  config.stream = stream;
+  cudaLaunchAttribute early{};
+  early.id = cudaLaunchAttributeProgrammaticStreamSerialization;
+  early.val.programmaticStreamSerializationAllowed = 1;
+  if (a.bins_ready) {
+    config.attrs = &early;
+    config.numAttrs = 1;
+  }
+  check_cuda(cudaLaunchKernelEx(&config, blend_warp_tile_kernel<REGION_W, PIPELINED, EXP2, HALF, SURFACE>, a),
+             "blend kernel launch");
+}
+
 template <int REGION_W, bool SURFACE>
 void launch_warp_tile(const BlendArgs& a, cudaStream_t stream) {
-  // A block per tile of each bin (tiles of bins over the image's edge return at once).
-  const unsigned blocks = static_cast<unsigned>(a.bins.x) * static_cast<unsigned>(a.bins.y) << (2 * a.bins.shift);
-  const unsigned threads = kWarpsPerBlock * kWarp;
   const bool pipelined = a.kernel == BlendKernel::warp_tile_pipelined;
   const bool half = a.exp2_alpha && a.half_blend;
-  if (pipelined && half)
-    blend_warp_tile_kernel<REGION_W, true, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (pipelined && a.exp2_alpha)
-    blend_warp_tile_kernel<REGION_W, true, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (pipelined)
-    blend_warp_tile_kernel<REGION_W, true, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (half)
-    blend_warp_tile_kernel<REGION_W, false, true, true, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else if (a.exp2_alpha)
-    blend_warp_tile_kernel<REGION_W, false, true, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
-  else
-    blend_warp_tile_kernel<REGION_W, false, false, false, SURFACE><<<blocks, threads, 0, stream>>>(a);
+  if (pipelined && half) launch_warp_tile_kernel<REGION_W, true, true, true, SURFACE>(a, stream);
+  else if (pipelined && a.exp2_alpha) launch_warp_tile_kernel<REGION_W, true, true, false, SURFACE>(a, stream);
+  else if (pipelined) launch_warp_tile_kernel<REGION_W, true, false, false, SURFACE>(a, stream);
+  else if (half) launch_warp_tile_kernel<REGION_W, false, true, true, SURFACE>(a, stream);
+  else if (a.exp2_alpha) launch_warp_tile_kernel<REGION_W, false, true, false, SURFACE>(a, stream);
+  else launch_warp_tile_kernel<REGION_W, false, false, false, SURFACE>(a, stream);
 }
 
 

@@ -210,6 +210,13 @@ class CudaRendererImpl final : public CudaRenderer {
     if (const char* shared = std::getenv("FLASHGS_BIN_SORT_SHARED_PAIRS"))
       bin_sort_shared_pairs_ = static_cast<unsigned>(
           std::max(0, std::min(static_cast<int>(cuda::kBinSortSharedPairsMax), std::atoi(shared))));
+    // The blend starts beside the bin blocks where the device can launch a kernel early (sm_90
+    // and later); FLASHGS_BIN_OVERLAP=0 runs it after them.
+    int device = 0, major = 0;
+    check_cuda(cudaGetDevice(&device), "device query");
+    check_cuda(cudaDeviceGetAttribute(&major, cudaDevAttrComputeCapabilityMajor, device), "device query");
+    bin_overlap_ = major >= 9;
+    if (const char* overlap = std::getenv("FLASHGS_BIN_OVERLAP")) bin_overlap_ = bin_overlap_ && std::atoi(overlap) != 0;
     // FLASHGS_INITIAL_RECORDS: the blend records a first frame starts with (tests of growth).
     if (const char* records = std::getenv("FLASHGS_INITIAL_RECORDS"))
       initial_records_ = std::max<long long>(1, std::atoll(records));
@@ -370,7 +377,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &record_ids_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &tile_lists_, &bin_fill_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
+            &values_[1], &ranges_, &tile_lists_, &bin_fill_, &bin_ready_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
             &deferred_footprints_, &deferred_records_, &deferred_hits_, &deferred_items_};
   }
 
@@ -555,7 +562,7 @@ class CudaRendererImpl final : public CudaRenderer {
     return fullest * blend_resident_blocks_ > last_pairs;
   }
 
-  // Whether sorting per bin (launch_bin_sort) pays over CUB's radix sort of the whole frame.
+  // Whether sorting per bin (launch_bin_pairs, launch_bin_blocks) pays over CUB's radix sort of the whole frame.
   // Measured on an H200 (docs/PERFORMANCE.md, v16 and v19): sort + ranges 18-41 us shorter at
   // 1080p on pc_biker and pc_playbot (2,040 bins of 200-400 pairs); at 4K (8,160 bins), since
   // the bin blocks write their tile lists without idle groups, 7-31 us shorter on five real
@@ -659,12 +666,23 @@ class CudaRendererImpl final : public CudaRenderer {
     else if (f.baseline || options.minimal_sort_bits) end_bit = std::min(64, 32 + tile_bits);
     check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
     // The bin sort writes the bin ranges and tile lists itself (its stage time includes them).
+    // Where its bin blocks overlap the blend, nothing may come between them in the stream: the
+    // sort stage is then the counting and scatter passes, and the bin blocks' time is in the
+    // blend's (the two run together and cannot be timed apart).
     int which = 0;
+    const std::uint32_t* order = dense_tiles_first ? b.tile_order : nullptr;
+    const bool overlap = bin_sort_frame_ && bin_overlap_ && !f.baseline;
+    std::uint32_t* ready = nullptr;
+    if (overlap) {
+      ready = bin_ready_.as<std::uint32_t>();
+      if (++bin_frame_tag_ == 0) ++bin_frame_tag_;  // 0 is a fresh buffer's
+    }
     if (bin_sort_frame_) {
       const bool fill_is_zero = f.bins <= zeroed_fill_bins_;
       zeroed_fill_bins_ = 0;  // until the bin blocks are queued
-      cuda::launch_bin_sort(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, fill_is_zero,
-                            dense_tiles_first ? b.tile_order : nullptr, stream_);
+      cuda::launch_bin_pairs(b, fill_is_zero, dense_tiles_first ? b.tile_order : nullptr, stream_);
+      if (!overlap)
+        cuda::launch_bin_blocks(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, order, nullptr, 0, stream_);
       zeroed_fill_bins_ = f.bins;
     } else {
       which = cuda::launch_sort(pairs, end_bit, b, stream_);
@@ -676,6 +694,8 @@ class CudaRendererImpl final : public CudaRenderer {
     }
     if (dense_tiles_first && !bin_sort_frame_) cuda::launch_tile_order(f.bins, b, stream_);  // the bin sort did
     check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
+    if (overlap)
+      cuda::launch_bin_blocks(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, order, ready, bin_frame_tag_, stream_);
 
     cuda::BlendArgs blend{};
     blend.width = cam.width;
@@ -695,7 +715,9 @@ class CudaRendererImpl final : public CudaRenderer {
     blend.tile_ranges = b.tile_ranges;
     blend.tile_lists = b.tile_lists;
     for (int k = 0; k < 2; ++k) blend.tile_values[k] = b.tile_values[k];
-    blend.tile_order = dense_tiles_first ? b.tile_order : nullptr;
+    blend.tile_order = order;
+    blend.bins_ready = ready;
+    blend.frame_tag = bin_frame_tag_;
     blend.gaussians = b.blend;
     blend.image_rgb = f.out ? b.image_rgb : nullptr;
     blend.surface = f.surface;
@@ -767,6 +789,12 @@ class CudaRendererImpl final : public CudaRenderer {
       const std::size_t fill_bytes = bin_fill_.bytes();
       bin_fill_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "bin fill");
       if (bin_fill_.bytes() != fill_bytes) zeroed_fill_bins_ = 0;
+      if (bin_overlap_) {  // flags of earlier frames' tags: a new buffer starts with none
+        const std::size_t ready_bytes = bin_ready_.bytes();
+        bin_ready_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "bin ready flags");
+        if (bin_ready_.bytes() != ready_bytes)
+          check_cuda(cudaMemsetAsync(bin_ready_.as<void>(), 0, bin_ready_.bytes(), stream_), "bin flag reset");
+      }
     }
     ranges_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(uint2), "bin ranges");
     if (binned) {
@@ -860,7 +888,7 @@ class CudaRendererImpl final : public CudaRenderer {
                     " Gaussian-tile pairs, more than the 2^31 the sort can take");
       const std::uint64_t records = readback_->counters.records;
       if (pairs <= pair_capacity_ && (!compact_records_ || records <= record_capacity())) break;
-      // (A frame queued before its count blended nothing: launch_bin_sort saw the overflow.)
+      // (A frame queued before its count blended nothing: its bin sort saw the overflow.)
       grow_pairs(pairs);
       if (compact_records_) grow_records(records, true);
       if (!fused) break;  // nothing was written yet
@@ -951,8 +979,10 @@ class CudaRendererImpl final : public CudaRenderer {
   enum Mode { kAuto, kAlways, kNever };
   Mode chunk_cull_ = kAuto;
   Mode dense_tiles_mode_ = kAuto;
-  Mode bin_sort_ = kAuto;        // binned frames with compact keys sort per bin (launch_bin_sort)
+  Mode bin_sort_ = kAuto;        // binned frames with compact keys sort per bin (launch_bin_pairs, launch_bin_blocks)
   bool bin_sort_frame_ = false;  // this frame does
+  bool bin_overlap_ = false;     // bin-sort frames blend beside the bin blocks (launch_bin_blocks)
+  std::uint32_t bin_frame_tag_ = 0;  // the last such frame's tag in bin_ready_
   // bin_fill_'s first zeroed_fill_bins_ words are zero (the bin blocks zero them for the next
   // frame; a new allocation has none).
   std::uint64_t zeroed_fill_bins_ = 0;
@@ -972,7 +1002,7 @@ class CudaRendererImpl final : public CudaRenderer {
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
   // Working memory.
   DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_, bin_fill_,
-      dense_bins_, tile_order_, tile_places_, chunk_list_, image_,
+      bin_ready_, dense_bins_, tile_order_, tile_places_, chunk_list_, image_,
       cub_temp_, deferred_footprints_, deferred_records_, deferred_hits_, deferred_items_;
 };
 

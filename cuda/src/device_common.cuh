@@ -23,6 +23,17 @@ __device__ __forceinline__ unsigned warp_inclusive_sum(unsigned v) {
   return v;
 }
 
+// A flag between blocks of kernels that run at once (the bin blocks and the blend): the
+// release makes the block's earlier writes visible to whoever acquires the value.
+__device__ __forceinline__ void store_release(std::uint32_t* flag, std::uint32_t value) {
+  asm volatile("st.release.gpu.global.u32 [%0], %1;" ::"l"(flag), "r"(value) : "memory");
+}
+__device__ __forceinline__ std::uint32_t load_acquire(const std::uint32_t* flag) {
+  std::uint32_t value;
+  asm volatile("ld.acquire.gpu.global.u32 %0, [%1];" : "=r"(value) : "l"(flag) : "memory");
+  return value;
+}
+
 // Words a lane loads at once when a warp walks an array (all in flight before any is used).
 constexpr int kWarpLoads = 8;
 constexpr unsigned kWarpRun = kWarp * kWarpLoads;

@@ -141,7 +141,7 @@ struct FrameCounters {
   unsigned int tiles_by_class[kTileClasses];  // tiles per pair-count class (launch_tile_order)
   unsigned int records;            // blend records wanted (compact records: may exceed capacity)
   unsigned int dense_bins;         // bins listed in FrameBuffers::dense_bins (launch_tile_lists)
-  unsigned int bin_count_blocks;   // blocks of the bin sort's counting pass done (launch_bin_sort)
+  unsigned int bin_count_blocks;   // blocks of the bin sort's counting pass done (launch_bin_pairs)
 };
 
 // Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
@@ -182,8 +182,8 @@ struct FrameBuffers {
   std::uint32_t* values[2] = {nullptr, nullptr};  // [pair_capacity]
   std::uint64_t pair_capacity = 0;
   // Where emission writes the pair values: values[0], or for the bin sort the upper half of
-  // keys[0] (as 32-bit words from pair_capacity), which leaves values[] free for the pairs in
-  // bin order (launch_bin_sort).
+  // keys[0] (as 32-bit words from pair_capacity), which leaves keys[1] and values[] free for
+  // the pairs in bin order (launch_bin_pairs).
   std::uint32_t* pair_values = nullptr;
   // The bin sort's per-bin counts, then each bin's next free place; the bin blocks leave it
   // zeroed for the next frame.
@@ -248,22 +248,29 @@ void launch_scan(std::size_t gaussians, const FrameBuffers& buffers, cudaStream_
 // buffer (0/1) holds the result.
 int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, cudaStream_t stream);
 // The sort of binned frames with compact keys, and what the ranges pass and the tile lists do
-// for the others: a counting pass turns the pairs per bin into bin ranges, a scatter pass puts
-// each pair in its bin (unstable), then a block per bin sorts it by key (in shared memory up
-// to `shared_pairs` pairs, at most kBinSortSharedPairsMax; a larger bin in its place in
-// keys[1]), puts runs of equal keys in the exact order and writes its tiles' lists. Fills
-// tile_ranges (per bin), tile_lists and tile_values from keys[0] and pair_values. The pair
-// count is read on the device, so the host may queue this before it knows the count; a frame
-// whose emission overflowed a capacity comes out empty. `fill_is_zero`: bin_fill's first
-// `bins` words are zero (the last bin sort over as many bins or more left them so), and the
-// reset is skipped. A non-null `order` gets the bins fullest first (what launch_tile_order
-// writes on the other paths, without its two launches).
-void launch_bin_sort(int tiles_x, int tiles_y, const FrameBuffers& buffers, unsigned shared_pairs, bool fill_is_zero,
-                     std::uint32_t* order, cudaStream_t stream);
+// for the others. launch_bin_pairs queues a counting pass, which turns the pairs per bin into
+// bin ranges (and with a non-null `order` lists the bins fullest first, what launch_tile_order
+// writes on the other paths), and a scatter pass, which puts each pair in its bin (unstable;
+// key and value side by side in keys[1]). launch_bin_blocks then queues a block per bin: it
+// sorts the bin by key (in shared memory up to `shared_pairs` pairs, at most
+// kBinSortSharedPairsMax; a larger bin in its place in values[], through keys[1]), puts runs of
+// equal keys in the exact order and writes its tiles' lists. Block b takes bin order[b] (the
+// blend's order) or, with a null `order`, bin b. Fills tile_ranges (per bin), tile_lists and
+// tile_values from keys[0] and pair_values. The pair count is read on the device, so the host
+// may queue this before it knows the count; a frame whose emission overflowed a capacity comes
+// out empty. `fill_is_zero`: bin_fill's first `bins` words are zero (the last bin sort over as
+// many bins or more left them so), and the reset is skipped.
+// With `ready`, each bin block stores `frame_tag` in ready[bin] once its lists are written and
+// lets the next kernel start early (programmatic dependent launch, sm_90): a blend launched
+// with BlendArgs::bins_ready then runs beside the bin blocks, each of its blocks waiting for
+// its own bin, instead of after the last of them.
+void launch_bin_pairs(const FrameBuffers& buffers, bool fill_is_zero, std::uint32_t* order, cudaStream_t stream);
+void launch_bin_blocks(int tiles_x, int tiles_y, const FrameBuffers& buffers, unsigned shared_pairs,
+                       const std::uint32_t* order, std::uint32_t* ready, std::uint32_t frame_tag, cudaStream_t stream);
 // Bins a frame may have for the bin sort: its passes count pairs per bin in shared memory (48
 // KB; a 4K frame has 8,160 bins).
 constexpr unsigned kBinSortMaxBins = 12000;
-// Pairs a bin may hold to be sorted in shared memory (the default of launch_bin_sort's shared_pairs).
+// Pairs a bin may hold to be sorted in shared memory (the default of launch_bin_blocks' shared_pairs).
 constexpr unsigned kBinSortSharedPairsMax = 2048;
 // The ranges of the `bins` bins from the sorted keys in buffer `which`, and runs of equal keys
 // put in (depth, Gaussian id) order.
@@ -296,6 +303,10 @@ struct BlendArgs {
   const uint2* tile_lists;                 // binned: each tile's list (FrameBuffers::tile_lists)
   const std::uint32_t* tile_values[2];     // binned: the lists' records
   const std::uint32_t* tile_order;  // warp blend: blocks blend bin tile_order[b] (null: bin b), a tile each
+  // Warp blend of a bin-sort frame: launched early beside the bin blocks (launch_bin_blocks),
+  // a block waits until bins_ready[its bin] holds frame_tag (null: the lists are all written).
+  const std::uint32_t* bins_ready;
+  std::uint32_t frame_tag;
   const BlendGaussian* gaussians;
   float* image_rgb;              // float output, or
   unsigned long long surface;    // RGBA8 surface (when image_rgb is null)

@@ -227,7 +227,8 @@ bench_variants() {  # flash rows of several builds in one call, for an A/B that 
   # VARIANTS: "tree" (this tree's flashgs) and NAMEs of .deps/variants/NAME.xz (flashgs of other trees, e.g. from
   # `ninja app/flashgs` in the prebuild folder, xz-compressed); VARIANT_ROWS: scene[:extra bench args] items (default
   # pc_biker pc_playbot pc_playbot:--tile=7); VARIANT_RES (default 1920x1080,3840x2160); environment such as
-  # FLASHGS_BIN_SORT=1 applies to every row. Prints "== variant scene args" and the bench rows.
+  # FLASHGS_BIN_SORT=1 applies to every row; VARIANT_CONFIGS: the bench configs (default flash). Prints "== variant
+  # scene args" and the bench rows.
   local v bin row scene extra
   mkdir -p /tmp/variants
   for v in ${VARIANTS:-tree}; do
@@ -242,8 +243,8 @@ bench_variants() {  # flash rows of several builds in one call, for an A/B that 
       [ "$row" != "$scene" ] && extra=${row#*:}
       echo "== $v $scene ${extra//=/ }"
       "$bin" bench "$SCENES/$scene/point_cloud.ply" --backend cuda -r "${VARIANT_RES:-1920x1080,3840x2160}" \
-        --configs flash --warmup 2 --repeat 5 ${extra//=/ } -o /tmp/variant.json 2>&1 |
-        grep -E "^[0-9]+x[0-9]+ +flash +[0-9]|rror"
+        --configs "${VARIANT_CONFIGS:-flash}" --warmup 2 --repeat 5 ${extra//=/ } -o /tmp/variant.json 2>&1 |
+        grep -E "^[0-9]+x[0-9]+ +flash[-a-z0-9_]* +[0-9]|rror"
     done
   done
 }
