@@ -19,6 +19,7 @@ std::string format_stats(const FrameStats& s) {
                 static_cast<unsigned long long>(s.culled_degenerate), s.times.project_ms, s.times.emit_ms,
                 s.times.sort_ms, s.times.ranges_ms, s.times.blend_ms, s.times.total_ms);
   std::string out = text;
+  if (*blend_time_note(s.times)) out += std::string("            ") + blend_time_note(s.times) + "\n";
   if (s.device_peak_bytes) {
     std::snprintf(text, sizeof text, "device mem: %.1f MB now, %.1f MB peak (above the scene); scene %.1f MB\n",
                   s.device_memory_bytes / 1e6, s.device_peak_bytes / 1e6, s.scene_device_bytes / 1e6);

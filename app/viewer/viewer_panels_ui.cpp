@@ -456,7 +456,9 @@ void stats_window(const UiModel& m) {
     if (st->device_peak_bytes > 0)
       ImGui::Text("device memory %.1f MB (peak %.1f MB)", st->device_memory_bytes / 1e6, st->device_peak_bytes / 1e6);
     ImGui::Text("project %.1f  emit %.1f  sort %.1f ms", st->times.project_ms, st->times.emit_ms, st->times.sort_ms);
-    ImGui::Text("ranges %.1f  blend %.1f ms", st->times.ranges_ms, st->times.blend_ms);
+    ImGui::Text("ranges %.1f  blend %.1f ms%s", st->times.ranges_ms, st->times.blend_ms,
+                st->times.sort_in_blend ? " (+ bin sort)" : "");
+    if (st->times.sort_in_blend && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", blend_time_note(st->times));
   }
   if (const StatsHistory* h = m.history) {
     if (ImGui::CollapsingHeader("mean and max over recent frames")) {

@@ -603,6 +603,7 @@ class CudaRendererImpl final : public CudaRenderer {
     t.sort_ms = elapsed(kSortBegin, kSorted);
     t.ranges_ms = elapsed(kSorted, kRanged);
     t.blend_ms = elapsed(kRanged, kBlended);
+    t.sort_in_blend = sort_in_blend_[set];
     t.total_ms = t.project_ms + t.emit_ms + t.sort_ms + t.ranges_ms + t.blend_ms;
     return t;
   }
@@ -673,6 +674,7 @@ class CudaRendererImpl final : public CudaRenderer {
     const std::uint32_t* order = dense_tiles_first ? b.tile_order : nullptr;
     const bool overlap = bin_sort_frame_ && bin_overlap_ && !f.baseline;
     std::uint32_t* ready = nullptr;
+    sort_in_blend_[event_set_] = overlap;
     if (overlap) {
       ready = bin_ready_.as<std::uint32_t>();
       if (++bin_frame_tag_ == 0) ++bin_frame_tag_;  // 0 is a fresh buffer's
@@ -983,6 +985,7 @@ class CudaRendererImpl final : public CudaRenderer {
   bool bin_sort_frame_ = false;  // this frame does
   bool bin_overlap_ = false;     // bin-sort frames blend beside the bin blocks (launch_bin_blocks)
   std::uint32_t bin_frame_tag_ = 0;  // the last such frame's tag in bin_ready_
+  bool sort_in_blend_[2] = {false, false};  // per event set: the bin blocks ran beside the blend
   // bin_fill_'s first zeroed_fill_bins_ words are zero (the bin blocks zero them for the next
   // frame; a new allocation has none).
   std::uint64_t zeroed_fill_bins_ = 0;

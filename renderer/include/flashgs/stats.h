@@ -14,7 +14,15 @@ struct StageTimes {
   double ranges_ms = 0;   // per-tile start/end in the sorted list
   double blend_ms = 0;    // front-to-back compositing
   double total_ms = 0;
+  // CUDA bin-sort frames whose blend ran beside the sort's per-bin blocks: those blocks' time
+  // is in blend_ms (the two cannot be timed apart), sort_ms is the counting and scatter passes.
+  bool sort_in_blend = false;
 };
+
+// What blend_ms holds beside the blend, to print next to it ("" when nothing).
+inline const char* blend_time_note(const StageTimes& t) {
+  return t.sort_in_blend ? "blend includes the bin sort's per-bin blocks, which ran beside it" : "";
+}
 
 struct FrameStats {
   std::uint64_t kv_pairs = 0;  // Gaussian-tile pairs emitted this frame
