@@ -671,7 +671,7 @@ class CudaRendererImpl final : public CudaRenderer {
     // sort stage is then the counting and scatter passes, and the bin blocks' time is in the
     // blend's (the two run together and cannot be timed apart).
     int which = 0;
-    const std::uint32_t* order = dense_tiles_first ? b.tile_order : nullptr;
+    std::uint32_t* order = dense_tiles_first ? b.tile_order : nullptr;
     const bool overlap = bin_sort_frame_ && bin_overlap_ && !f.baseline;
     std::uint32_t* ready = nullptr;
     sort_in_blend_[event_set_] = overlap;
@@ -682,7 +682,7 @@ class CudaRendererImpl final : public CudaRenderer {
     if (bin_sort_frame_) {
       const bool fill_is_zero = f.bins <= zeroed_fill_bins_;
       zeroed_fill_bins_ = 0;  // until the bin blocks are queued
-      cuda::launch_bin_pairs(b, fill_is_zero, dense_tiles_first ? b.tile_order : nullptr, stream_);
+      cuda::launch_bin_pairs(b, fill_is_zero, order, stream_);
       if (!overlap)
         cuda::launch_bin_blocks(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, order, nullptr, 0, stream_);
       zeroed_fill_bins_ = f.bins;
@@ -719,7 +719,7 @@ class CudaRendererImpl final : public CudaRenderer {
     for (int k = 0; k < 2; ++k) blend.tile_values[k] = b.tile_values[k];
     blend.tile_order = order;
     blend.bins_ready = ready;
-    blend.frame_tag = bin_frame_tag_;
+    blend.frame_tag = overlap ? bin_frame_tag_ : 0u;
     blend.gaussians = b.blend;
     blend.image_rgb = f.out ? b.image_rgb : nullptr;
     blend.surface = f.surface;
