@@ -190,10 +190,18 @@ struct alignas(16) SmallBox {
   int box_w;                  // bins per box row
   unsigned start, row_magic, record, depth_bits;  // row_magic: ceil(2^16 / box_w), t / box_w = (t row_magic) >> 16
 };
+// A box in the scratch, 80 bytes apart: lanes read their owners' boxes 16 bytes at a time, and
+// at a 64-byte stride every second box fell on the same banks (a quarter-warp of distinct
+// owners took up to four passes); at 20 words, eight consecutive boxes take distinct banks.
+struct alignas(16) BankSpreadBox {
+  SmallBox box;
+  unsigned pad[4];
+};
+static_assert(sizeof(BankSpreadBox) == 80, "a box 20 banks from the next");
 constexpr int kSmallTilesPerWarp = kWarp * kWarp;
 
 struct SmallBoxScratch {
-  SmallBox boxes[kWarp];
+  BankSpreadBox boxes[kWarp];
   unsigned char owner[kSmallTilesPerWarp];  // concatenated bin -> the lane whose box holds it
   unsigned char tiles[kSmallTilesPerWarp];  // concatenated bin -> the tiles it touches (bin_tiles)
 };
@@ -220,7 +228,7 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
   const int shift = buf.bins.shift;
   if (my_box > 0) {
     const int box_w = BinBox(f, shift).width();
-    s.boxes[lane] = SmallBox{make_float4(f.whiten[0], f.whiten[1], f.whiten[2], f.whiten[3]),
+    s.boxes[lane].box = SmallBox{make_float4(f.whiten[0], f.whiten[1], f.whiten[2], f.whiten[3]),
                              f.edge_slope_x, f.edge_slope_y, f.threshold, f.mean_x, f.mean_y,
                              static_cast<unsigned>(f.tile_x0) | static_cast<unsigned>(f.tile_x1) << 16,
                              static_cast<unsigned>(f.tile_y0) | static_cast<unsigned>(f.tile_y1) << 16,
@@ -236,7 +244,7 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
     const unsigned g = c * kWarp + lane;
     bool pass = false;
     if (g < total_tiles) {
-      const SmallBox& b = s.boxes[s.owner[g]];
+      const SmallBox& b = s.boxes[s.owner[g]].box;
       int bx, by;
       small_box_bin(b, shift, g - b.start, bx, by);
       const float w[4] = {b.whiten.x, b.whiten.y, b.whiten.z, b.whiten.w};
@@ -283,7 +291,7 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
     const unsigned long long step_base = __shfl_sync(kFullMask, base, c);
     if (ballot & (1u << lane)) {
       const unsigned g = c * kWarp + lane;
-      const SmallBox& b = s.boxes[s.owner[g]];
+      const SmallBox& b = s.boxes[s.owner[g]].box;
       int bx, by;
       small_box_bin(b, shift, g - b.start, bx, by);
       store_pair(buf, step_base + __popc(ballot & lanes_below),
