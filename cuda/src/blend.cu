@@ -106,15 +106,17 @@ __device__ __forceinline__ float exp2_approx(float x) {
 }
 
 // A Gaussian as the EXP2 loop reads it from shared memory: its log2 alpha as a polynomial
-// in the pixel's offset (lx, ly) from the region's centre, prepared once by the lane that
-// loaded it, so that a lane evaluates it for its row once (c0 = a0 + a1 ly + a2 ly^2,
-// c1 = b0 + b1 ly: three FMAs) and for each of its pixels with two (c0 + c1 lx + c2 lx^2).
+// in the pixel's offset (lx, ly) from the region's centre, c0 + c1 lx + c2 lx^2 with
+// c0 = a0 + a1 ly + a2 ly^2 and c1 = b0 + b1 ly, the row's (c0, c1) prepared for each of the
+// region's ROWS rows by the lane that loaded it (24 FMAs at 8 rows, once per region), so that a
+// lane reads its row's pair and evaluates each of its pixels with two FMAs (the same roundings
+// as evaluating the row in the loop, so the same image).
 // Expanded about the centre, no term exceeds the exponent's range over the 8-pixel region
 // (the 0.3 px^2 dilation bounds the conic), so fp32 keeps it to ~1e-5 in log2 alpha.
+template <int ROWS>
 struct alignas(16) RegionGaussian {
-  float a0, a1, a2, b0;
-  float b1, c2, red, green;
-  float blue, pad0, pad1, pad2;
+  float c2, red, green, blue;
+  float2 row[ROWS];  // (c0, c1) at row r, ly = r - (ROWS - 1) / 2
 };
 
 // A tile's blend records in list order, up to 32 at a time (lane j gets the j-th).
@@ -194,13 +196,13 @@ __device__ __forceinline__ void blend_region_gaussian_half(const HalfRegionGauss
 // on the exponent, and compositing. STOP_RULE applies the CPU's stop; without it (a Gaussian
 // that cannot take any of the warp's pixels below the minimum T, see the staging) the result
 // is the same with three operations fewer per pixel.
-template <bool STOP_RULE>
-__device__ __forceinline__ void blend_region_gaussian(const RegionGaussian& g, float lane_y,
+template <bool STOP_RULE, int ROWS>
+__device__ __forceinline__ void blend_region_gaussian(const RegionGaussian<ROWS>& g, unsigned lane_row,
                                                       float (&lane_x)[kLanePixelsX], float (&t)[kLanePixelsX],
                                                       float (&cr)[kLanePixelsX], float (&cg)[kLanePixelsX],
                                                       float (&cb)[kLanePixelsX]) {
-  const float c0 = __fmaf_rn(__fmaf_rn(g.a2, lane_y, g.a1), lane_y, g.a0);
-  const float c1 = __fmaf_rn(g.b1, lane_y, g.b0), c2 = g.c2;
+  const float2 row = g.row[lane_row];
+  const float c0 = row.x, c1 = row.y, c2 = g.c2;
   const float red = g.red, green = g.green, blue = g.blue;
 #pragma unroll
   for (int p = 0; p < kLanePixelsX; ++p) {
@@ -222,6 +224,27 @@ __device__ __forceinline__ void blend_region_gaussian(const RegionGaussian& g, f
     t[p] = kept_t;
     if constexpr (STOP_RULE) lane_x[p] = stop ? finished_column() : lane_x[p];
   }
+}
+
+// The staged form of a Gaussian met by a region of ROWS rows: (u0, v0) are its whitened rows at
+// the region's centre and (conic_a, conic_b, conic_c) its conic, all in the exp2 scaling.
+template <int ROWS>
+__device__ __forceinline__ RegionGaussian<ROWS> region_gaussian(const BlendGaussian& g, float u0, float v0,
+                                                                float conic_a, float conic_b, float conic_c) {
+  const float a0 = __fmaf_rn(-u0, u0, __fmaf_rn(-v0, v0, g.opacity));
+  const float a1 = -2.0f * __fmaf_rn(g.w1, u0, g.w3 * v0), a2 = -conic_c;
+  const float b0 = -2.0f * __fmaf_rn(g.w0, u0, g.w2 * v0), b1 = -2.0f * conic_b;
+  RegionGaussian<ROWS> r;
+  r.c2 = -conic_a;
+  r.red = g.red;
+  r.green = g.green;
+  r.blue = g.blue;
+#pragma unroll
+  for (int row = 0; row < ROWS; ++row) {
+    const float ly = static_cast<float>(row) - 0.5f * (ROWS - 1);  // exactly the lane's y - the centre's
+    r.row[row] = make_float2(__fmaf_rn(__fmaf_rn(a2, ly, a1), ly, a0), __fmaf_rn(b1, ly, b0));
+  }
+  return r;
 }
 
 // FlashGS render kernel, a warp per 64-pixel region of a tile: REGION_W x (64 / REGION_W)
@@ -255,7 +278,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   constexpr int kRegionH = 64 / REGION_W;
   constexpr int kLanesX = REGION_W / kLanePixelsX;
   constexpr int kRegionsX = kTile / REGION_W;
-  using Staged = std::conditional_t<HALF, HalfRegionGaussian, std::conditional_t<EXP2, RegionGaussian, BlendGaussian>>;
+  using Staged = std::conditional_t<HALF, HalfRegionGaussian, std::conditional_t<EXP2, RegionGaussian<kRegionH>, BlendGaussian>>;
   __shared__ Staged batch[kWarpsPerBlock][kWarp];
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   // A block is one tile, its warps the tile's regions.
@@ -286,6 +309,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const float region_mid_x = region_x0 + 0.5f * (REGION_W - 1);
   float lane_x[kLanePixelsX];
   const float lane_y = static_cast<float>(y) - region_mid_y;
+  const unsigned lane_row = lane / kLanesX;  // EXP2: the row of RegionGaussian::row
   float t[kLanePixelsX], cr[kLanePixelsX], cg[kLanePixelsX], cb[kLanePixelsX];
   unsigned live = 0;  // bit p: pixel p still blending
 #pragma unroll
@@ -379,14 +403,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
                                     __floats2half2_rn(next.w0, next.w2), __floats2half2_rn(next.opacity, next.red),
                                     __floats2half2_rn(next.green, next.blue), {0u, 0u, 0u}};
         else
-          slot = RegionGaussian{
-            __fmaf_rn(-u0, u0, __fmaf_rn(-v0, v0, next.opacity)),
-            -2.0f * __fmaf_rn(next.w1, u0, next.w3 * v0),
-            -conic_c,
-            -2.0f * __fmaf_rn(next.w0, u0, next.w2 * v0),
-            -2.0f * conic_b,
-            -conic_a,
-            next.red, next.green, next.blue, 0.0f, 0.0f, 0.0f};
+          slot = region_gaussian<kRegionH>(next, u0, v0, conic_a, conic_b, conic_c);
       }
       staged = __popc(relevant);
     } else {
@@ -410,10 +427,10 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     } else if constexpr (EXP2) {
 #pragma unroll kBlendUnroll
       for (unsigned j = 0; j < unstoppable; ++j)
-        blend_region_gaussian<false>(batch[warp][j], lane_y, lane_x, t, cr, cg, cb);
+        blend_region_gaussian<false>(batch[warp][j], lane_row, lane_x, t, cr, cg, cb);
 #pragma unroll kBlendUnroll
       for (unsigned j = unstoppable; j < staged; ++j)
-        blend_region_gaussian<true>(batch[warp][j], lane_y, lane_x, t, cr, cg, cb);
+        blend_region_gaussian<true>(batch[warp][j], lane_row, lane_x, t, cr, cg, cb);
     } else {
 #pragma unroll kBlendUnroll
       for (unsigned j = 0; j < staged && live; ++j) {
