@@ -25,12 +25,14 @@ constexpr int kPassBlock = 256;
 constexpr unsigned kNoBin = 0xffffffffu;
 
 // The per-bin sort: a block of 4 warps. A bin that fits sorts in registers and shared memory
-// (CUB's block radix sort, 4 or 16 pairs per thread); a larger one sorts in global memory,
-// radix digits of 8 bits.
+// (CUB's block radix sort, 4 or 8 pairs per thread); a larger one sorts in global memory,
+// radix digits of 8 bits. At most 8 pairs per thread keep the kernel at 56 registers, so that
+// its blocks displace fewer of the blend's beside them (16 took 80 registers and made the
+// frame 10-18 us longer at 4K on the H200, docs/PERFORMANCE.md v27).
 constexpr int kSortWarps = 4;
 constexpr int kSortBlock = kSortWarps * kWarp;
 constexpr int kSmallItems = 4;
-constexpr int kLargeItems = 16;
+constexpr int kLargeItems = 8;
 static_assert(kSortBlock * kLargeItems == static_cast<int>(kBinSortSharedPairsMax), "the largest bin in shared memory");
 using SmallBinSort = cub::BlockRadixSort<std::uint32_t, kSortBlock, kSmallItems, std::uint32_t>;
 using LargeBinSort = cub::BlockRadixSort<std::uint32_t, kSortBlock, kLargeItems, std::uint32_t>;

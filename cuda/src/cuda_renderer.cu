@@ -568,8 +568,9 @@ class CudaRendererImpl final : public CudaRenderer {
   // the bin blocks write their tile lists without idle groups, 7-31 us shorter on five real
   // scenes (v19), with no wait for the host between emission and sort, but not for frames of
   // frame-covering Gaussians (below, v20); 0.1 ms longer on 7 x pc_playbot at 1080p (about 700
-  // pairs per bin; bins of more than 2,048 sort in global memory). Judged on the last frame's
-  // bin pairs and blend records: the emission that this decides comes before this frame's count.
+  // pairs per bin; bins of more than 2,048, since v27 1,024, sort in global memory). Judged on
+  // the last frame's bin pairs and blend records: the emission that this decides comes before
+  // this frame's count.
   bool bin_sort_pays(std::uint64_t bins) const {
     if (bins > cuda::kBinSortMaxBins) return false;  // beyond the scatter pass's shared histogram
     if (bin_sort_ != kAuto) return bin_sort_ == kAlways;

@@ -271,7 +271,7 @@ void launch_bin_blocks(int tiles_x, int tiles_y, const FrameBuffers& buffers, un
 // KB; a 4K frame has 8,160 bins).
 constexpr unsigned kBinSortMaxBins = 12000;
 // Pairs a bin may hold to be sorted in shared memory (the default of launch_bin_blocks' shared_pairs).
-constexpr unsigned kBinSortSharedPairsMax = 2048;
+constexpr unsigned kBinSortSharedPairsMax = 1024;
 // The ranges of the `bins` bins from the sorted keys in buffer `which`, and runs of equal keys
 // put in (depth, Gaussian id) order.
 void launch_ranges(std::uint64_t pairs, std::uint64_t bins, const FrameBuffers& buffers, int which,
