@@ -278,7 +278,8 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   constexpr int kRegionH = 64 / REGION_W;
   constexpr int kLanesX = REGION_W / kLanePixelsX;
   constexpr int kRegionsX = kTile / REGION_W;
-  using Staged = std::conditional_t<HALF, HalfRegionGaussian, std::conditional_t<EXP2, RegionGaussian<kRegionH>, BlendGaussian>>;
+  using Staged =
+      std::conditional_t<HALF, HalfRegionGaussian, std::conditional_t<EXP2, RegionGaussian<kRegionH>, BlendGaussian>>;
   __shared__ Staged batch[kWarpsPerBlock][kWarp];
   const unsigned warp = threadIdx.x / kWarp, lane = lane_id();
   // A block is one tile, its warps the tile's regions.
