@@ -596,6 +596,34 @@ TEST(CudaStats, TileCountsMatchTheCpu) {
   }
 }
 
+// Stage times from the stage events, on both sort paths: stages that meet with nothing queued
+// between them share an event (a bin-sort frame has no ranges stage of its own), and every
+// stage read must come from events that were recorded (an elapsed time of an unrecorded event
+// throws).
+TEST(CudaStats, StageTimesAddUpOnBothSortPaths) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = test::load_demo_scene();
+  const Camera camera = test::load_demo_cameras()[3].resized(800, 450);
+  for (const char* bin_sort : {"1", "0"}) {
+    setenv("FLASHGS_BIN_SORT", bin_sort, 1);
+    auto gpu = make_cuda_renderer();  // reads the variable once
+    unsetenv("FLASHGS_BIN_SORT");
+    gpu->set_scene(scene);
+    for (int frame = 0; frame < 3; ++frame) {  // both event sets, and a frame after each
+      const StageTimes t = render(*gpu, camera, RenderOptions{}).stats.times;
+      const std::string what = std::string("bin sort ") + bin_sort + ", frame " + std::to_string(frame);
+      EXPECT_GT(t.project_ms, 0.0) << what;
+      EXPECT_GT(t.sort_ms, 0.0) << what;
+      EXPECT_GT(t.blend_ms, 0.0) << what;
+      EXPECT_GE(t.ranges_ms, 0.0) << what;
+      if (*bin_sort == '1') {
+        EXPECT_EQ(t.ranges_ms, 0.0) << what;
+      }
+      EXPECT_DOUBLE_EQ(t.total_ms, t.project_ms + t.emit_ms + t.sort_ms + t.ranges_ms + t.blend_ms) << what;
+    }
+  }
+}
+
 // An empty frame (camera looking away) is the background, with no pairs.
 TEST(CudaEdgeCases, EmptyFrameAndEmptyScene) {
   FLASHGS_REQUIRE_CUDA();

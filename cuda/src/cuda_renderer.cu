@@ -601,9 +601,11 @@ class CudaRendererImpl final : public CudaRenderer {
     t.project_ms = elapsed(kBegin, kProjected);
     // Fused emission is in the project stage: such frames record no emit events.
     t.emit_ms = separate_emit_[set] ? elapsed(kProjected, kScanned) + elapsed(kEmitBegin, kEmitted) : 0.0;
-    t.sort_ms = elapsed(kSortBegin, kSorted);
-    t.ranges_ms = elapsed(kSorted, kRanged);
-    t.blend_ms = elapsed(kRanged, kBlended);
+    const Event sort_begin = sort_follows_project_[set] ? kProjected : kSortBegin;
+    const Event ranged = ranges_in_sort_[set] ? kSorted : kRanged;
+    t.sort_ms = elapsed(sort_begin, kSorted);
+    t.ranges_ms = ranges_in_sort_[set] ? 0.0 : elapsed(kSorted, kRanged);
+    t.blend_ms = elapsed(ranged, kBlended);
     t.sort_in_blend = sort_in_blend_[set];
     t.total_ms = t.project_ms + t.emit_ms + t.sort_ms + t.ranges_ms + t.blend_ms;
     return t;
@@ -639,6 +641,7 @@ class CudaRendererImpl final : public CudaRenderer {
     std::uint64_t tiles, bins, pixels;
     bool baseline, fused, binned;
     bool previous_complete;  // the last frame recorded all its events
+    bool sort_follows_project;  // nothing is queued between the project and sort stages
   };
 
   // Queues the frame's work after preprocess: separate emission, sort, ranges, blend, the
@@ -666,7 +669,10 @@ class CudaRendererImpl final : public CudaRenderer {
     int end_bit = 64;
     if (key_format_.depth_bits > 0) end_bit = tile_bits + key_format_.depth_bits;
     else if (f.baseline || options.minimal_sort_bits) end_bit = std::min(64, 32 + tile_bits);
-    check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
+    // An event costs the GPU about a microsecond between kernels (v28): stages that meet with
+    // nothing between them share one.
+    sort_follows_project_[event_set_] = f.sort_follows_project;
+    if (!sort_follows_project_[event_set_]) check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
     // The bin sort writes the bin ranges and tile lists itself (its stage time includes them).
     // Where its bin blocks overlap the blend, nothing may come between them in the stream: the
     // sort stage is then the counting and scatter passes, and the bin blocks' time is in the
@@ -696,7 +702,8 @@ class CudaRendererImpl final : public CudaRenderer {
       if (f.binned) cuda::launch_tile_lists(pairs, cam.tiles_x, cam.tiles_y, b, which, stream_);
     }
     if (dense_tiles_first && !bin_sort_frame_) cuda::launch_tile_order(f.bins, b, stream_);  // the bin sort did
-    check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
+    ranges_in_sort_[event_set_] = bin_sort_frame_;  // the bin sort writes the ranges and lists itself
+    if (!ranges_in_sort_[event_set_]) check_cuda(cudaEventRecord(events[kRanged], stream_), "event record");
     if (overlap)
       cuda::launch_bin_blocks(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, order, ready, bin_frame_tag_, stream_);
 
@@ -865,7 +872,7 @@ class CudaRendererImpl final : public CudaRenderer {
     const bool count_at_end = queue_before_count && out;
     separate_emit_[event_set_] = !fused;
     const FramePlan frame{&camera, &cam, &options, &args, out, surface, tiles, bins, pixels, baseline, fused, binned,
-                          previous_complete};
+                          previous_complete, count_at_end};
     std::uint64_t pairs = 0;
     for (int attempt = 0;; ++attempt) {
       const cuda::FrameBuffers b = frame_buffers();
@@ -987,6 +994,8 @@ class CudaRendererImpl final : public CudaRenderer {
   bool bin_overlap_ = false;     // bin-sort frames blend beside the bin blocks (launch_bin_blocks)
   std::uint32_t bin_frame_tag_ = 0;  // the last such frame's tag in bin_ready_
   bool sort_in_blend_[2] = {false, false};  // per event set: the bin blocks ran beside the blend
+  bool sort_follows_project_[2] = {false, false};  // per event set: no kSortBegin, the sort began at kProjected
+  bool ranges_in_sort_[2] = {false, false};        // per event set: no kRanged, no ranges stage
   // bin_fill_'s first zeroed_fill_bins_ words are zero (the bin blocks zero them for the next
   // frame; a new allocation has none).
   std::uint64_t zeroed_fill_bins_ = 0;

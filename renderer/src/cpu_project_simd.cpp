@@ -158,10 +158,8 @@ bool project_vector(const SceneArrays& scene, const Frame& frame, std::int64_t i
   const FloatVec fx = hn::Set(d, cam.fx), fy = hn::Set(d, cam.fy);
   const FloatVec mean_x = hn::Add(hn::Mul(hn::Mul(fx, v0), inv_z), hn::Set(d, cam.cx));
   const FloatVec mean_y = hn::Add(hn::Mul(hn::Mul(fy, v1), inv_z), hn::Set(d, cam.cy));
-  float limits[4];
-  gm::frustum_limits(cam, limits);
-  const FloatVec tx = clamp(hn::Mul(v0, inv_z), hn::Set(d, limits[0]), hn::Set(d, limits[1]));
-  const FloatVec ty = clamp(hn::Mul(v1, inv_z), hn::Set(d, limits[2]), hn::Set(d, limits[3]));
+  const FloatVec tx = clamp(hn::Mul(v0, inv_z), hn::Set(d, cam.frustum[0]), hn::Set(d, cam.frustum[1]));
+  const FloatVec ty = clamp(hn::Mul(v1, inv_z), hn::Set(d, cam.frustum[2]), hn::Set(d, cam.frustum[3]));
   const FloatVec j00 = hn::Mul(fx, inv_z), j02 = hn::Mul(hn::Mul(hn::Set(d, -cam.fx), tx), inv_z);
   const FloatVec j11 = hn::Mul(fy, inv_z), j12 = hn::Mul(hn::Mul(hn::Set(d, -cam.fy), ty), inv_z);
   FloatVec t0[3], t1[3];

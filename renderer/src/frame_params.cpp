@@ -15,6 +15,7 @@ gm::CameraParams make_camera_params(const Camera& camera) {
   p.height = camera.height;
   p.tiles_x = (camera.width + gm::kTileSize - 1) / gm::kTileSize;
   p.tiles_y = (camera.height + gm::kTileSize - 1) / gm::kTileSize;
+  gm::frustum_limits(p, p.frustum);
   return p;
 }
 

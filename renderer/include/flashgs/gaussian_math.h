@@ -39,6 +39,7 @@ struct CameraParams {
   float fx, fy, cx, cy;
   int width, height;
   int tiles_x, tiles_y;
+  float frustum[4];   // frustum_limits(): per camera, not per Gaussian (four divisions)
 };
 
 // Which geometry a frame uses; derived from RenderOptions.
@@ -148,7 +149,7 @@ FLASHGS_HD void to_view(const CameraParams& cam, const float p[3], float v[3]) {
 // x/z and y/z clamped to the view frustum widened by 30% of its half-size on each side:
 // 3DGS's limit 1.3 tan(fov / 2), written for any principal point (identical to it when the
 // principal point is the image centre; the image spans pixel edges -0.5 .. width - 0.5).
-// The limits as {x_lo, x_hi, y_lo, y_hi}: per camera, so the CPU's SIMD project computes them once.
+// The limits as {x_lo, x_hi, y_lo, y_hi}: per camera (CameraParams::frustum).
 FLASHGS_HD void frustum_limits(const CameraParams& cam, float limits[4]) {
   const float margin_x = static_cast<float>(model::kFrustumMargin) * static_cast<float>(cam.width);
   const float margin_y = static_cast<float>(model::kFrustumMargin) * static_cast<float>(cam.height);
@@ -158,12 +159,11 @@ FLASHGS_HD void frustum_limits(const CameraParams& cam, float limits[4]) {
   limits[3] = (static_cast<float>(cam.height) - 0.5f - cam.cy + margin_y) / cam.fy;
 }
 
+// With cam.frustum as frustum_limits() set it (make_camera_params).
 FLASHGS_HD void frustum_clamped_direction(const CameraParams& cam, float x_over_z, float y_over_z,
                                           float& tx, float& ty) {
-  float limits[4];
-  frustum_limits(cam, limits);
-  tx = clampf(x_over_z, limits[0], limits[1]);
-  ty = clampf(y_over_z, limits[2], limits[3]);
+  tx = clampf(x_over_z, cam.frustum[0], cam.frustum[1]);
+  ty = clampf(y_over_z, cam.frustum[2], cam.frustum[3]);
 }
 
 // The culls that need only the view-space centre and the opacity, in project()'s order
