@@ -17,6 +17,7 @@ namespace {
 
 constexpr int kTile = gm::kTileSize;
 constexpr float kLog2AlphaMin = -7.99435344f;  // log2(1/255)
+constexpr float kLog2AlphaMax = -0.0144995697f;  // log2(0.99)
 
 // Writes one finished pixel: float RGB, or RGBA8 through the surface.
 template <bool SURFACE>
@@ -96,6 +97,16 @@ constexpr int kLanePixelsX = 2;      // pixels per lane, side by side in a row
 constexpr int kRegionsPerTile = 4;   // 64-pixel regions, a warp each
 constexpr int kBlendUnroll = 4;      // staged Gaussians per step of the loop
 constexpr float kBoundWorthT = 32.0f * gm::kTransmittanceMin;  // see the staging's stop bound
+// Resident blocks per SM the blend kernel is compiled for: 56 registers without spills. Left to
+// itself the compiler takes 64 for the colour steps, which leaves 8 blocks and measured slower.
+constexpr int kBlendBlocksPerSm = 9;
+
+// 1/x by the hardware unit alone, for a positive normal x (no range checks, as __fdividef has).
+__device__ __forceinline__ float reciprocal_approx(float x) {
+  float y;
+  asm("rcp.approx.ftz.f32 %0, %1;" : "=f"(y) : "f"(x));
+  return y;
+}
 
 // 2^x by the hardware unit alone: x >= log2(1/255) here, so no denormal handling is needed
 // (exp2f adds a range check and two scalings around the same instruction).
@@ -113,11 +124,71 @@ __device__ __forceinline__ float exp2_approx(float x) {
 // as evaluating the row in the loop, so the same image).
 // Expanded about the centre, no term exceeds the exponent's range over the 8-pixel region
 // (the 0.3 px^2 dilation bounds the conic), so fp32 keeps it to ~1e-5 in log2 alpha.
+// Its colour is stored as the change from the Gaussian staged before it (ColourSteps).
 template <int ROWS>
 struct alignas(16) RegionGaussian {
-  float c2, red, green, blue;
+  float c2, red_step, green_step, blue_step;
   float2 row[ROWS];  // (c0, c1) at row r, ly = r - (ROWS - 1) / 2
 };
+
+// The column a finished pixel moves to: NaN, so every later Gaussian's exponent there is NaN,
+// fails the 1/255 cut and gives alpha 0, and the pixel keeps its transmittance, the
+// background's weight, without a liveness test in the loop.
+__device__ __forceinline__ float finished_column() { return __int_as_float(0x7fffffff); }
+
+// Summation by parts for the EXP2 loop. A pixel's colour is sum_i c_i (T_i - T_i+1) over the
+// Gaussians its warp visits, T_i its transmittance before the i-th; that equals
+// sum_i T_i (c_i - c_i-1) - c_last T_end (c_-1 = 0). So each visit adds (c_i - c_i-1) T_i, which
+// needs neither alpha nor the new T: three FMAs off the exp2's chain and no weight to form, and a
+// visit that changes no T adds terms that cancel. The region's staged Gaussians are one sequence
+// across its batches; `last` is the colour of the latest one staged, to be taken off at the end.
+// Against sum_i c_i w_i this moves each pixel by a few float roundings of its colour per visit
+// (~1e-7 each), well inside the parity bound with the CPU; T and so every stop are unchanged.
+struct ColourSteps {
+  float last_red = 0.0f, last_green = 0.0f, last_blue = 0.0f;
+
+  // For the lane whose record is staged (`relevant` the warp's staged lanes): its colour minus
+  // that of the staged Gaussian before it. Then `last` moves to the batch's last staged colour.
+  // Every lane of the warp calls this (shuffles).
+  __device__ float3 step(unsigned relevant, unsigned lane, float red, float green, float blue) {
+    const unsigned before = relevant & ((1u << lane) - 1u);
+    const int from = before ? 31 - __clz(before) : 0;
+    float3 previous = make_float3(__shfl_sync(kFullMask, red, from), __shfl_sync(kFullMask, green, from),
+                                  __shfl_sync(kFullMask, blue, from));
+    if (!before) previous = make_float3(last_red, last_green, last_blue);
+    if (relevant) {
+      const int final_lane = 31 - __clz(relevant);
+      last_red = __shfl_sync(kFullMask, red, final_lane);
+      last_green = __shfl_sync(kFullMask, green, final_lane);
+      last_blue = __shfl_sync(kFullMask, blue, final_lane);
+    }
+    return make_float3(red - previous.x, green - previous.y, blue - previous.z);
+  }
+};
+
+// t = (e >= the 1/255 cut) ? t - alpha t : t as one predicated FMA (a select would be one
+// instruction more per pixel). A NaN exponent (a finished or outside column) fails the cut.
+__device__ __forceinline__ float transmittance_after(float t, float alpha, float e) {
+  asm("{\n\t.reg .pred visible;\n\tsetp.ge.f32 visible, %1, %2;\n\t@visible fma.rn.f32 %0, %3, %0, %0;\n\t}"
+      : "+f"(t)
+      : "f"(e), "f"(kLog2AlphaMin), "f"(-alpha));
+  return t;
+}
+
+// The same with the CPU's stop rule: a visible Gaussian that would take T below the minimum
+// adds nothing, T stays (the background's weight), and the pixel's column becomes NaN, so that
+// no later Gaussian passes its cut. One compare gives both outcomes ("keep" and "stop"), and
+// each moves one register: selects would cost one instruction more per pixel.
+__device__ __forceinline__ void transmittance_or_stop(float& t, float& column, float alpha, float e) {
+  asm("{\n\t.reg .pred visible, keep, stop;\n\t.reg .f32 next;\n\t"
+      "setp.ge.f32 visible, %2, %3;\n\t"
+      "fma.rn.f32 next, %4, %0, %0;\n\t"
+      "setp.ge.and.f32 keep|stop, next, %5, visible;\n\t"
+      "@keep mov.f32 %0, next;\n\t"
+      "@stop mov.f32 %1, %6;\n\t}"
+      : "+f"(t), "+f"(column)
+      : "f"(e), "f"(kLog2AlphaMin), "f"(-alpha), "f"(gm::kTransmittanceMin), "f"(finished_column()));
+}
 
 // A tile's blend records in list order, up to 32 at a time (lane j gets the j-th).
 struct TileList {
@@ -130,11 +201,6 @@ struct TileList {
     return n;
   }
 };
-
-// The column a finished pixel moves to: NaN, so every later Gaussian's exponent there is NaN,
-// fails the 1/255 cut and gives alpha 0, and the pixel keeps its transmittance, the
-// background's weight, without a liveness test in the loop.
-__device__ __forceinline__ float finished_column() { return __int_as_float(0x7fffffff); }
 
 // A Gaussian as the HALF loop (RenderOptions::fp16_blend) reads it: the whitened rows at the
 // region's centre and their change per pixel, so that u = u0 + w0 lx + w1 ly and likewise v,
@@ -193,52 +259,61 @@ __device__ __forceinline__ void blend_region_gaussian_half(const HalfRegionGauss
 }
 
 // One staged Gaussian on a lane's pixels (EXP2): alpha = exp2 of the polynomial, the 1/255 cut
-// on the exponent, and compositing. STOP_RULE applies the CPU's stop; without it (a Gaussian
-// that cannot take any of the warp's pixels below the minimum T, see the staging) the result
-// is the same with three operations fewer per pixel.
-template <bool STOP_RULE, int ROWS>
+// on the exponent, and compositing by colour steps (ColourSteps). STOP_RULE applies the CPU's
+// stop; without it (a Gaussian that cannot take any of the warp's pixels below the minimum T,
+// see the staging) the result is the same with three operations fewer per pixel. Likewise
+// CLAMP, the 0.99 clamp, which only a Gaussian whose alpha can reach 0.99 in the region needs.
+template <bool STOP_RULE, bool CLAMP, int ROWS>
 __device__ __forceinline__ void blend_region_gaussian(const RegionGaussian<ROWS>& g, unsigned lane_row,
                                                       float (&lane_x)[kLanePixelsX], float (&t)[kLanePixelsX],
                                                       float (&cr)[kLanePixelsX], float (&cg)[kLanePixelsX],
                                                       float (&cb)[kLanePixelsX]) {
   const float2 row = g.row[lane_row];
   const float c0 = row.x, c1 = row.y, c2 = g.c2;
-  const float red = g.red, green = g.green, blue = g.blue;
 #pragma unroll
   for (int p = 0; p < kLanePixelsX; ++p) {
     const float e = __fmaf_rn(__fmaf_rn(c2, lane_x[p], c1), lane_x[p], c0);  // log2 alpha
+    cr[p] = __fmaf_rn(g.red_step, t[p], cr[p]);
+    cg[p] = __fmaf_rn(g.green_step, t[p], cg[p]);
+    cb[p] = __fmaf_rn(g.blue_step, t[p], cb[p]);
     // The clamp after exp2 keeps alpha = 0.99f exactly for opaque Gaussians, and the FMA gives
     // T (1 - alpha) with one rounding: with 1 - alpha exact (alpha >= 1/2), the CPU's T, so the
     // stop rule's decisions on stacked opaque layers are its own.
-    const float alpha = e >= kLog2AlphaMin ? fminf(gm::kAlphaMax, exp2_approx(e)) : 0.0f;
-    const float next_t = __fmaf_rn(-alpha, t[p], t[p]);
-    // The CPU stops before a Gaussian that would take T below the minimum: it adds nothing,
-    // and T stays the background's weight. The weight is what T loses, alpha T to within T's
-    // last bit (exactly alpha T's rounding for alpha <= 1/2), and 0 then.
-    const bool stop = STOP_RULE && next_t < gm::kTransmittanceMin;
-    const float kept_t = stop ? t[p] : next_t;
-    const float w = t[p] - kept_t;
-    cr[p] = __fmaf_rn(red, w, cr[p]);
-    cg[p] = __fmaf_rn(green, w, cg[p]);
-    cb[p] = __fmaf_rn(blue, w, cb[p]);
-    t[p] = kept_t;
-    if constexpr (STOP_RULE) lane_x[p] = stop ? finished_column() : lane_x[p];
+    const float alpha = CLAMP ? fminf(gm::kAlphaMax, exp2_approx(e)) : exp2_approx(e);
+    if constexpr (STOP_RULE) transmittance_or_stop(t[p], lane_x[p], alpha, e);
+    else t[p] = transmittance_after(t[p], alpha, e);
   }
+}
+
+// A warp's staged Gaussians [0, staged) on its pixels, the first `unstoppable` without the stop
+// rule. Unrolled: more independent work between the shared loads and the transmittance chain.
+template <bool CLAMP, int ROWS>
+__device__ __forceinline__ void blend_staged(const RegionGaussian<ROWS>* batch, unsigned unstoppable, unsigned staged,
+                                             unsigned lane_row, float (&lane_x)[kLanePixelsX],
+                                             float (&t)[kLanePixelsX], float (&cr)[kLanePixelsX],
+                                             float (&cg)[kLanePixelsX], float (&cb)[kLanePixelsX]) {
+#pragma unroll kBlendUnroll
+  for (unsigned j = 0; j < unstoppable; ++j)
+    blend_region_gaussian<false, CLAMP>(batch[j], lane_row, lane_x, t, cr, cg, cb);
+#pragma unroll kBlendUnroll
+  for (unsigned j = unstoppable; j < staged; ++j)
+    blend_region_gaussian<true, CLAMP>(batch[j], lane_row, lane_x, t, cr, cg, cb);
 }
 
 // The staged form of a Gaussian met by a region of ROWS rows: (u0, v0) are its whitened rows at
 // the region's centre and (conic_a, conic_b, conic_c) its conic, all in the exp2 scaling.
 template <int ROWS>
-__device__ __forceinline__ RegionGaussian<ROWS> region_gaussian(const BlendGaussian& g, float u0, float v0,
-                                                                float conic_a, float conic_b, float conic_c) {
+__device__ __forceinline__ RegionGaussian<ROWS> region_gaussian(const BlendGaussian& g, float3 colour_step, float u0,
+                                                                float v0, float conic_a, float conic_b,
+                                                                float conic_c) {
   const float a0 = __fmaf_rn(-u0, u0, __fmaf_rn(-v0, v0, g.opacity));
   const float a1 = -2.0f * __fmaf_rn(g.w1, u0, g.w3 * v0), a2 = -conic_c;
   const float b0 = -2.0f * __fmaf_rn(g.w0, u0, g.w2 * v0), b1 = -2.0f * conic_b;
   RegionGaussian<ROWS> r;
   r.c2 = -conic_a;
-  r.red = g.red;
-  r.green = g.green;
-  r.blue = g.blue;
+  r.red_step = colour_step.x;
+  r.green_step = colour_step.y;
+  r.blue_step = colour_step.z;
 #pragma unroll
   for (int row = 0; row < ROWS; ++row) {
     const float ly = static_cast<float>(row) - 0.5f * (ROWS - 1);  // exactly the lane's y - the centre's
@@ -262,17 +337,18 @@ __device__ __forceinline__ RegionGaussian<ROWS> region_gaussian(const BlendGauss
 // pixel's offset (RegionGaussian), the 1/255 cut made on the exponent, FMAs throughout, no
 // branch per pixel (at least one lane of the warp passes the cut on almost every visit, so a
 // branch skipped nothing and cost its own instructions); a finished pixel's column becomes
-// NaN, so later Gaussians add exactly nothing to it. The stop rule's test and selects run only
-// from the first staged Gaussian that might take a live pixel's T below the minimum (bounded
-// per batch from each Gaussian's largest alpha over the region). Otherwise the arithmetic is
-// the CPU's: the same alpha to ~1e-5, and its cut, clamp and stop rule.
+// NaN, so later Gaussians change nothing there. The colour is summed by parts (ColourSteps).
+// The stop rule's test runs only from the first staged Gaussian that might take a live pixel's
+// T below the minimum, and the 0.99 clamp only in batches with a Gaussian that might reach it
+// (both bounded per batch from each Gaussian's largest alpha over the region). Otherwise the
+// arithmetic is the CPU's: the same alpha to ~1e-5, and its cut, clamp and stop rule.
 // Only the Gaussians that meet the region are staged, packed in list order, so the loop over
 // them is a counted one. Binned frames (BinGrid): the 4 blocks of a bin blend its tiles, each
 // from its own tile list (FrameBuffers::tile_lists).
 // HALF (EXP2 only; RenderOptions::fp16_blend): the staged Gaussians as HalfRegionGaussian and
 // each lane's pixels as one half2, with no stop rule per Gaussian (see blend_region_gaussian_half).
 template <int REGION_W, bool PIPELINED, bool EXP2, bool HALF, bool SURFACE>
-__global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel(BlendArgs a) {
+__global__ void __launch_bounds__(kWarpsPerBlock * kWarp, kBlendBlocksPerSm) blend_warp_tile_kernel(BlendArgs a) {
   static_assert(EXP2 || !HALF, "the half blend is an exp2 blend");
   static_assert(!HALF || kLanePixelsX == 2, "a lane's pixels are one half2");
   constexpr int kRegionH = 64 / REGION_W;
@@ -325,6 +401,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
   const __half2 lane_x2 = __floats2half2_rn(lane_x[0], lane_x[1]), lane_y2 = __float2half2_rn(lane_y);
   const __half2 half_cut = __float2half2_rn(kLog2AlphaMin), half_alpha_max = __float2half2_rn(gm::kAlphaMax);
   __half2 t2 = __float2half2_rn(1.0f), cr2 = __float2half2_rn(0.0f), cg2 = cr2, cb2 = cr2;
+  ColourSteps steps;  // EXP2, not HALF: cr, cg, cb sum colour steps
   TileList list;
   if (shift > 0) {
     const uint2 range = a.tile_lists[static_cast<unsigned>(ty) * static_cast<unsigned>(a.tiles_x) + static_cast<unsigned>(tx)];
@@ -355,23 +432,32 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     __syncwarp();
     unsigned staged = n;  // Gaussians in batch[warp], in list order
     unsigned unstoppable = 0;  // EXP2: how many of them cannot stop a pixel
+    bool clamp = true;         // EXP2: whether any of them needs the 0.99 clamp
     if constexpr (EXP2) {
       bool meets = false;
-      const float cut = (next.opacity - kLog2AlphaMin) * 1.00001f + 1e-4f;  // q' of alpha = 1/255
+      const float cut = __fmaf_rn(next.opacity - kLog2AlphaMin, 1.00001f, 1e-4f);  // q' of alpha = 1/255
       const float conic_a = __fmaf_rn(next.w0, next.w0, next.w2 * next.w2);
       const float conic_b = __fmaf_rn(next.w0, next.w1, next.w2 * next.w3);
       const float conic_c = __fmaf_rn(next.w1, next.w1, next.w3 * next.w3);
       float q_min = 0.0f;
       if (lane < n && cut > 0.0f) {
         const float w[4] = {next.w0, next.w1, next.w2, next.w3};
-        // Fast divisions: the cut's margin covers their error (it moves the edge minimiser
-        // along a flat valley, changing q to second order only).
-        q_min = gm::whitened_q_min_on_rect(w, __fdividef(-conic_b, conic_c), __fdividef(-conic_b, conic_a),
+        // Approximate divisions and fused arithmetic: the cut's margin covers their error (a
+        // division's moves the edge minimiser along a flat valley, changing q to second order).
+        q_min = gm::whitened_q_min_on_rect<true>(w, -conic_b * reciprocal_approx(conic_c),
+                                                 -conic_b * reciprocal_approx(conic_a),
                                            region_x0 - next.mean_x, region_x1 - next.mean_x,
                                            region_y0 - next.mean_y, region_y1 - next.mean_y);
         meets = q_min <= cut;
       }
       const unsigned relevant = __ballot_sync(kFullMask, meets);
+      float3 colour_step{};
+      if constexpr (!HALF) {
+        colour_step = steps.step(relevant, lane, next.red, next.green, next.blue);
+        // Alpha is at most 2^(opacity - q_min) over the region (with a margin over the loop's
+        // rounding): below 0.99, the clamp cannot act.
+        clamp = __any_sync(kFullMask, meets && next.opacity - q_min + 1e-3f > kLog2AlphaMax);
+      }
       // The stop rule can only act where T may fall below its minimum. At most, a staged
       // Gaussian leaves 1 - (its alpha at the region's nearest point) of a pixel's T (log2
       // alpha = opacity - q_min, with a margin over the loop's rounding), so the staged
@@ -404,7 +490,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
                                     __floats2half2_rn(next.w0, next.w2), __floats2half2_rn(next.opacity, next.red),
                                     __floats2half2_rn(next.green, next.blue), {0u, 0u, 0u}};
         else
-          slot = region_gaussian<kRegionH>(next, u0, v0, conic_a, conic_b, conic_c);
+          slot = region_gaussian<kRegionH>(next, colour_step, u0, v0, conic_a, conic_b, conic_c);
       }
       staged = __popc(relevant);
     } else {
@@ -420,18 +506,13 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     } else {
       next_n = list.take(lane, next_record);
     }
-    // Unrolled: more independent work between the loads and the transmittance chain.
     if constexpr (HALF) {
 #pragma unroll kBlendUnroll
       for (unsigned j = 0; j < staged; ++j)
         blend_region_gaussian_half(batch[warp][j], lane_y2, lane_x2, half_cut, half_alpha_max, t2, cr2, cg2, cb2);
     } else if constexpr (EXP2) {
-#pragma unroll kBlendUnroll
-      for (unsigned j = 0; j < unstoppable; ++j)
-        blend_region_gaussian<false>(batch[warp][j], lane_row, lane_x, t, cr, cg, cb);
-#pragma unroll kBlendUnroll
-      for (unsigned j = unstoppable; j < staged; ++j)
-        blend_region_gaussian<true>(batch[warp][j], lane_row, lane_x, t, cr, cg, cb);
+      if (clamp) blend_staged<true>(batch[warp], unstoppable, staged, lane_row, lane_x, t, cr, cg, cb);
+      else blend_staged<false>(batch[warp], unstoppable, staged, lane_row, lane_x, t, cr, cg, cb);
     } else {
 #pragma unroll kBlendUnroll
       for (unsigned j = 0; j < staged && live; ++j) {
@@ -470,11 +551,14 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp) blend_warp_tile_kernel
     t[0] = t_out.x, t[1] = t_out.y, cr[0] = r_out.x, cr[1] = r_out.y;
     cg[0] = g_out.x, cg[1] = g_out.y, cb[0] = b_out.x, cb[1] = b_out.y;
   }
+  // The background takes what T is left; with colour steps, so does the last staged colour's removal.
+  const float background[3] = {a.background[0] - steps.last_red, a.background[1] - steps.last_green,
+                               a.background[2] - steps.last_blue};
 #pragma unroll
   for (int p = 0; p < kLanePixelsX; ++p)
     if (inside & (1u << p))
-      write_pixel<SURFACE>(a, x0 + p, y, cr[p] + t[p] * a.background[0], cg[p] + t[p] * a.background[1],
-                           cb[p] + t[p] * a.background[2]);
+      write_pixel<SURFACE>(a, x0 + p, y, cr[p] + t[p] * background[0], cg[p] + t[p] * background[1],
+                           cb[p] + t[p] * background[2]);
 }
 
 // A block per tile of each bin (tiles of bins over the image's edge return at once). With
