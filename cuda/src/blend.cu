@@ -96,7 +96,7 @@ constexpr int kWarpsPerBlock = 4;
 constexpr int kLanePixelsX = 2;      // pixels per lane, side by side in a row
 constexpr int kRegionsPerTile = 4;   // 64-pixel regions, a warp each
 constexpr int kBlendUnroll = 4;      // staged Gaussians per step of the loop
-constexpr float kBoundWorthT = 32.0f * gm::kTransmittanceMin;  // see the staging's stop bound
+constexpr float kBoundWorthT = 8.0f * gm::kTransmittanceMin;  // see the staging's stop bound
 // Resident blocks per SM the blend kernel is compiled for: 56 registers without spills. Left to
 // itself the compiler takes 64 for the colour steps, which leaves 8 blocks and measured slower.
 constexpr int kBlendBlocksPerSm = 9;
@@ -462,7 +462,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp, kBlendBlocksPerSm) ble
       // Gaussian leaves 1 - (its alpha at the region's nearest point) of a pixel's T (log2
       // alpha = opacity - q_min, with a margin over the loop's rounding), so the staged
       // Gaussians whose running product of these, times the lowest T of the warp's live
-      // pixels, stays above twice the minimum cannot stop a pixel: a prefix of the batch,
+      // pixels, stays above 1.1 x the minimum (a margin over roundings of ~1e-7 each) cannot stop a pixel: a prefix of the batch,
       // cut to whole groups of the loop's unrolling. Near the minimum, where almost any
       // Gaussian might stop a pixel, the bound is not worth its scan.
       float lowest_t = INFINITY;
@@ -477,7 +477,7 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp, kBlendBlocksPerSm) ble
           const float before = __shfl_up_sync(kFullMask, kept, offset);
           if (lane >= static_cast<unsigned>(offset)) kept *= before;
         }
-        unstoppable = __popc(__ballot_sync(kFullMask, meets && lowest_t * kept >= 2.0f * gm::kTransmittanceMin));
+        unstoppable = __popc(__ballot_sync(kFullMask, meets && lowest_t * kept >= 1.1f * gm::kTransmittanceMin));
         unstoppable &= ~static_cast<unsigned>(kBlendUnroll - 1);
       }
       if (meets) {
