@@ -462,9 +462,9 @@ __global__ void __launch_bounds__(kWarpsPerBlock * kWarp, kBlendBlocksPerSm) ble
       // Gaussian leaves 1 - (its alpha at the region's nearest point) of a pixel's T (log2
       // alpha = opacity - q_min, with a margin over the loop's rounding), so the staged
       // Gaussians whose running product of these, times the lowest T of the warp's live
-      // pixels, stays above 1.1 x the minimum (a margin over roundings of ~1e-7 each) cannot stop a pixel: a prefix of the batch,
-      // cut to whole groups of the loop's unrolling. Near the minimum, where almost any
-      // Gaussian might stop a pixel, the bound is not worth its scan.
+      // pixels, stays above 1.1 x the minimum (a margin over roundings of ~1e-7 each) cannot
+      // stop a pixel: a prefix of the batch, cut to whole groups of the loop's unrolling. Near
+      // the minimum, where almost any Gaussian might stop a pixel, the bound is not worth its scan.
       float lowest_t = INFINITY;
 #pragma unroll
       for (int p = 0; p < kLanePixelsX; ++p) lowest_t = isnan(lane_x[p]) ? lowest_t : fminf(lowest_t, t[p]);
