@@ -222,6 +222,22 @@ TEST(CliBench, TiledSceneIsBenchedAndTooManyCopiesAreRefused) {
   EXPECT_FALSE(fs::exists(dir + "/c.json"));
 }
 
+// `bench --frames`: frames queued back to back (the default) need a backend with a queue; the
+// CPU backend's frames are waited for whatever is asked, and the header and the JSON say so. An
+// unknown mode is one line naming the option.
+TEST(CliBench, FrameModeIsReportedAndChecked) {
+  const std::string dir = scratch_dir("bench_frames");
+  const std::string quick = " --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 --json ";
+  const CliResult r = run_cli("bench --frames queued" + quick + dir + "/b.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("timed frames each, each downloaded and waited for;"), std::string::npos) << r.output;
+  std::ifstream json(dir + "/b.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"frames\": \"waited\""), std::string::npos) << text.substr(0, 400);
+  expect_one_line_error(run_cli("bench --frames sometimes" + quick + dir + "/c.json"), "--frames", "--frames sometimes");
+  EXPECT_FALSE(fs::exists(dir + "/c.json"));
+}
+
 // The fp16 options in the sweeps: `report` has their rows (group "precision", columns fp16_sh
 // and fp16_shape set, an error against the fp64 reference) beside flash's, and `bench` theirs.
 std::vector<std::vector<std::string>> read_csv(const std::string& path) {

@@ -726,6 +726,44 @@ TEST(CudaSurface, TooSmallOrWrongFormatIsAnError) {
   EXPECT_GT(render(*gpu, camera, RenderOptions{}).stats.kv_pairs, 0u);
 }
 
+// Frames queued without waiting (render_queued, as `flashgs bench` times them) do the work of
+// waited ones: queued frames of one view and then of a larger one (whose buffers grow while a
+// frame is in flight) count the pairs of a fresh renderer's frames and report stage times that
+// add up, and waited frames after them give a fresh renderer's bytes.
+TEST(CudaQueued, FramesQueuedBackToBackLeaveTheSameFrames) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = test::load_demo_scene();
+  const Camera small = test::load_demo_cameras()[1].resized(333, 187);
+  const Camera large = test::load_demo_cameras()[3].resized(1001, 563);
+  for (const RenderOptions& o : {RenderOptions{}, RenderOptions::baseline()}) {
+    auto fresh = make_cuda_renderer();
+    fresh->set_scene(scene);
+    const Result want_small = render(*fresh, small, o);
+    const Result want_large = render(*fresh, large, o);
+    auto gpu = make_cuda_renderer();
+    gpu->set_scene(scene);
+    const std::pair<const Camera*, const Result*> frames[] = {
+        {&small, &want_small}, {&small, &want_small}, {&small, &want_small}, {&large, &want_large}, {&large, &want_large}};
+    for (const auto& [camera, want] : frames) {
+      FrameStats stats;
+      gpu->render_queued(*camera, o, &stats);
+      EXPECT_EQ(stats.sorted_pairs, want->stats.sorted_pairs) << o.label() << " " << camera->width;
+      EXPECT_EQ(stats.visible, want->stats.visible) << o.label() << " " << camera->width;
+      const StageTimes& t = stats.times;
+      EXPECT_GT(t.project_ms, 0.0) << o.label();
+      EXPECT_GT(t.blend_ms, 0.0) << o.label();
+      EXPECT_DOUBLE_EQ(t.total_ms, t.project_ms + t.emit_ms + t.sort_ms + t.ranges_ms + t.blend_ms) << o.label();
+    }
+    const Result got_large = render(*gpu, large, o);
+    EXPECT_EQ(got_large.image.rgb, want_large.image.rgb) << o.label();
+    EXPECT_EQ(got_large.stats.kv_pairs, want_large.stats.kv_pairs) << o.label();
+    FrameStats stats;
+    gpu->render_queued(small, o, &stats);
+    const Result got_small = render(*gpu, small, o);
+    EXPECT_EQ(got_small.image.rgb, want_small.image.rgb) << o.label();
+  }
+}
+
 // A scene that cannot fit in GPU memory is a flashgs::Error, not a crash, and the old scene
 // stays usable. The GPU is first filled with ballast so that a 2M-Gaussian scene cannot fit.
 TEST(CudaEdgeCases, SceneTooLargeIsAnError) {

@@ -25,4 +25,25 @@ std::unique_ptr<Renderer> create_backend(const std::string& which, int cpu_threa
   return make_cpu_renderer(cpu_threads, cpu_blend);
 }
 
+bool can_queue_frames(Renderer& renderer) {
+#ifdef FLASHGS_HAVE_CUDA
+  return dynamic_cast<CudaRenderer*>(&renderer) != nullptr;
+#else
+  (void)renderer;
+  return false;
+#endif
+}
+
+void render_queued(Renderer& renderer, const Camera& camera, const RenderOptions& options, FrameStats* stats) {
+#ifdef FLASHGS_HAVE_CUDA
+  if (auto* cuda = dynamic_cast<CudaRenderer*>(&renderer)) {
+    cuda->render_queued(camera, options, stats);
+    return;
+  }
+#else
+  (void)camera, (void)options, (void)stats;
+#endif
+  throw Error("internal error: the " + renderer.name() + " backend cannot queue frames");
+}
+
 }  // namespace flashgs::cli

@@ -14,4 +14,12 @@ namespace flashgs::cli {
 std::unique_ptr<Renderer> create_backend(const std::string& which, int cpu_threads = 0,
                                          CpuBlend cpu_blend = CpuBlend::simd);
 
+// Whether `renderer` can queue frames behind each other without the host waiting for each (the
+// CUDA backend: CudaRenderer::render_queued).
+bool can_queue_frames(Renderer& renderer);
+
+// Queues a frame behind the last one without waiting for it, as the viewer renders; `stats`
+// gets this frame's counts and the previous frame's stage times. Only where can_queue_frames.
+void render_queued(Renderer& renderer, const Camera& camera, const RenderOptions& options, FrameStats* stats);
+
 }  // namespace flashgs::cli

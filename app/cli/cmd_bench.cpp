@@ -35,6 +35,10 @@ struct BenchArgs {
   std::string cpu_blend = "simd";  // CPU backend: simd or scalar (the reference kernel)
   int warmup = 3;
   int repeat = 10;
+  // queued: frames queued back to back as the viewer renders them (GPU backends), the host's
+  // launches for one overlapping the GPU's work on the last; waited: each frame downloaded and
+  // waited for, as `flashgs render` does.
+  std::string frames = "queued";
   int copies = 1;  // --tile: the scene copied on a grid in memory (scale benchmarks)
   std::string json_path = "bench.json";
 };
@@ -109,6 +113,7 @@ struct ConfigRun {
   std::uint64_t memory_max = 0, peak_max = 0;
   std::uint64_t scene_device_bytes = 0;  // the scene as the backend holds it (0 on the CPU)
   double upload_ms = 0, first_frame_ms = -1;  // wall clock: set_scene, and the first render
+  std::vector<double> wall_ms;  // per camera, queued frames: wall clock per timed frame
   std::string blend_note;  // blend_time_note of a timed frame whose blend time held more than the blend
   nlohmann::json per_camera = nlohmann::json::array();
 };
@@ -145,6 +150,7 @@ void run(const BenchArgs& args) {
                      "--resolutions");
   const bool cpu = probe->name().rfind("cpu", 0) == 0;
   const std::string backend_name = probe->name();
+  const bool queued = args.frames == "queued" && can_queue_frames(*probe);
   probe.reset();
   const auto configs = select_configs(args.configs, cpu);
 
@@ -157,6 +163,7 @@ void run(const BenchArgs& args) {
   out["backend"] = backend_name;
   out["timing"] = cpu ? "wall clock per stage (CPU)" : "GPU time per stage from CUDA events; total = sum of stages";
   out["cameras"] = camera_ids;
+  out["frames"] = queued ? "queued" : "waited";
   out["warmup"] = args.warmup;
   out["repeat"] = args.repeat;
   out["results"] = nlohmann::json::array();
@@ -164,8 +171,9 @@ void run(const BenchArgs& args) {
   std::printf("%s: %zu Gaussians (SH degree %d) on %s; cameras", scene_path.c_str(), scene->size(), scene->sh_degree,
               backend_name.c_str());
   for (int id : camera_ids) std::printf(" %d", id);
-  std::printf("; %d warm-up + %d timed frames each; per-camera medians, then median (p95) over cameras\n",
-              args.warmup, args.repeat);
+  std::printf("; %d warm-up + %d timed frames each, %s; per-camera medians, then median (p95) over cameras\n",
+              args.warmup, args.repeat,
+              queued ? "queued back to back as the viewer renders them" : "each downloaded and waited for");
 
   std::string table, uploads;
   for (std::size_t k = 0; k < resolutions.size(); ++k) {
@@ -194,11 +202,25 @@ void run(const BenchArgs& args) {
           r.renderer->render(camera, r.options, image, &stats);
           r.first_frame_ms = ms_since(first_start);
         }
-        for (int w = 0; w < args.warmup; ++w) r.renderer->render(camera, r.options, image, &stats);
+        const int repeat = std::max(1, args.repeat);
         std::vector<double> samples[6];
-        for (int k = 0; k < std::max(1, args.repeat); ++k) {
+        if (queued) {
+          // A queued frame reports the previous frame's stage times: one frame more than timed,
+          // then a waited frame, which finishes the queue and gives the image and its counts.
+          for (int w = 0; w <= args.warmup; ++w) render_queued(*r.renderer, camera, r.options, &stats);
+          const auto timed_start = std::chrono::steady_clock::now();
+          for (int k = 0; k < repeat; ++k) {
+            render_queued(*r.renderer, camera, r.options, &stats);
+            for (int s = 0; s < 6; ++s) samples[s].push_back(stage_ms(stats.times, s));
+          }
+          r.wall_ms.push_back(ms_since(timed_start) / repeat);
           r.renderer->render(camera, r.options, image, &stats);
-          for (int s = 0; s < 6; ++s) samples[s].push_back(stage_ms(stats.times, s));
+        } else {
+          for (int w = 0; w < args.warmup; ++w) r.renderer->render(camera, r.options, image, &stats);
+          for (int k = 0; k < repeat; ++k) {
+            r.renderer->render(camera, r.options, image, &stats);
+            for (int s = 0; s < 6; ++s) samples[s].push_back(stage_ms(stats.times, s));
+          }
         }
         nlohmann::json cam;
         cam["camera"] = id;
@@ -246,6 +268,7 @@ void run(const BenchArgs& args) {
       j["memory_bytes"] = {{"working_max", r.memory_max}, {"peak", r.peak_max}, {"scene_device", r.scene_device_bytes}};
       j["sort_in_blend"] = !r.blend_note.empty();
       j["upload_ms"] = r.upload_ms;
+      if (!r.wall_ms.empty()) j["wall_ms_per_frame_median"] = median(r.wall_ms);
       j["first_frame_ms"] = r.first_frame_ms;
       char upload_line[320];
       const std::string scene_bytes =
@@ -253,6 +276,12 @@ void run(const BenchArgs& args) {
       std::snprintf(upload_line, sizeof upload_line, "%-10s %-28s scene upload %.1f ms, first frame %.1f ms (wall clock)%s\n",
                     resolution.c_str(), r.name.c_str(), r.upload_ms, r.first_frame_ms, scene_bytes.c_str());
       uploads += upload_line;
+      if (!r.wall_ms.empty()) {
+        std::snprintf(upload_line, sizeof upload_line,
+                      "%-10s %-28s queued frames: %.3f ms apart (wall clock, median over cameras)\n",
+                      resolution.c_str(), r.name.c_str(), median(r.wall_ms));
+        uploads += upload_line;
+      }
       if (!r.blend_note.empty()) {
         std::snprintf(upload_line, sizeof upload_line, "%-10s %-28s %s\n", resolution.c_str(), r.name.c_str(),
                       r.blend_note.c_str());
@@ -300,6 +329,10 @@ void register_bench(CLI::App& app) {
       ->check(CLI::IsMember({"simd", "scalar"}));
   sub->add_option("--warmup", args->warmup, "untimed frames per camera and config")->check(CLI::NonNegativeNumber);
   sub->add_option("--repeat", args->repeat, "timed frames per camera and config")->check(CLI::PositiveNumber);
+  sub->add_option("--frames", args->frames,
+                  "queued (default: frames back to back, as the viewer renders them; GPU backends) or waited "
+                  "(each frame downloaded and waited for, as render does)")
+      ->check(CLI::IsMember({"queued", "waited"}));
   sub->add_option("--tile", args->copies, "render this many copies of the scene on a grid (scale runs)")
       ->check(CLI::Range(1, 4096));
   sub->add_option("--json,-o", args->json_path, "JSON output file");

@@ -77,8 +77,7 @@ using PinnedHandle = CudaHandle<void*, cudaFreeHost>;
 // What each frame reads back into pinned host memory.
 struct HostReadback {
   cuda::FrameCounters counters;    // after the preprocess: pairs and culls of this frame
-  std::uint32_t tile_max[2] = {};  // FrameCounters::max_tile_pairs, per event set
-  unsigned long long tile_pairs[2] = {};  // FrameCounters::tile_pairs, per event set
+  cuda::TileTotals tile_totals[2] = {};  // FrameCounters::tile_totals, per event set
 };
 
 // One device allocation; grows (discarding its content) but never shrinks. The owner's byte
@@ -182,6 +181,7 @@ class CudaRendererImpl final : public CudaRenderer {
     device_name_ = prop.name;
     check_cuda(cudaStreamCreateWithFlags(stream_handle_.out(), cudaStreamNonBlocking), "stream creation");
     stream_ = stream_handle_.get();
+    check_cuda(cudaStreamCreateWithFlags(copy_stream_handle_.out(), cudaStreamNonBlocking), "stream creation");
     // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
     if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
     // FLASHGS_BLEND_STOP_BOUND=0 runs the blend's stop rule on every staged Gaussian: the same
@@ -235,6 +235,7 @@ class CudaRendererImpl final : public CudaRenderer {
   // The handles and buffers free themselves (members); only the work in flight is waited for.
   ~CudaRendererImpl() override {
     if (stream_) cudaStreamSynchronize(stream_);
+    if (copy_stream_handle_.get()) cudaStreamSynchronize(copy_stream_handle_.get());
   }
 
   std::string name() const override { return "cuda (" + device_name_ + ")"; }
@@ -348,15 +349,20 @@ class CudaRendererImpl final : public CudaRenderer {
     device_scene_ = next;
     scene_ = std::move(scene);
     last_tiles_ = 0;
+    settled_.known = false;  // the tile statistics were another scene's
   }
 
   void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
-    run_frame(camera, options, &out, 0, stats);
+    run_frame(camera, options, FrameTarget::host_image, &out, 0, stats);
   }
 
   void render_to_surface(const Camera& camera, const RenderOptions& options, std::uint64_t surface_object,
                          FrameStats* stats) override {
-    run_frame(camera, options, nullptr, surface_object, stats);
+    run_frame(camera, options, FrameTarget::surface, nullptr, surface_object, stats);
+  }
+
+  void render_queued(const Camera& camera, const RenderOptions& options, FrameStats* stats) override {
+    run_frame(camera, options, FrameTarget::device_image, nullptr, 0, stats);
   }
 
   void download_tile_counts(std::vector<std::uint32_t>& counts) override {
@@ -551,15 +557,19 @@ class CudaRendererImpl final : public CudaRenderer {
   // Whether ordering the tiles fullest first pays this frame. It costs two small kernels and
   // the locality of neighbouring tiles blending together, and gains when one tile's serial walk
   // outlasts what the blend's resident blocks do in a wave: when the fullest tile holds more
-  // pairs than the mean per resident block. Judged on the last frame of the same size (the
-  // view moves little between frames); the first frame blends in image order.
-  // Call once the last frame's read backs have arrived, with the event sets already switched.
-  bool dense_order_pays(std::uint64_t tiles, bool have_last_frame) const {
+  // pairs than the mean per resident block. Judged on the latest finished frame (settled_), if
+  // of the same size (the view moves little between frames); the first frame blends in image
+  // order.
+  bool dense_order_pays(std::uint64_t tiles) const {
     if (dense_tiles_mode_ != kAuto) return dense_tiles_mode_ == kAlways;
-    const std::uint64_t last_pairs = readback_->tile_pairs[event_set_ ^ 1];
-    if (!have_last_frame || tiles != last_tiles_ || last_pairs == 0) return false;
-    const std::uint64_t fullest = readback_->tile_max[event_set_ ^ 1];
-    return fullest * blend_resident_blocks_ > last_pairs;
+    if (!settled_.known || tiles != settled_.tiles || settled_.tile_pairs == 0) return false;
+    return settled_.fullest_tile * blend_resident_blocks_ > settled_.tile_pairs;
+  }
+
+  // Keeps the tile statistics of the frame of event set `set`, which has finished.
+  void settle(int set) {
+    const cuda::TileTotals& totals = readback_->tile_totals[set];
+    settled_ = SettledFrame{true, frame_tiles_[set], totals.tile_pairs, totals.max_tile_pairs};
   }
 
   // Whether sorting per bin (launch_bin_pairs, launch_bin_blocks) pays over CUB's radix sort of the whole frame.
@@ -582,12 +592,22 @@ class CudaRendererImpl final : public CudaRenderer {
            last_bin_pairs_ <= kBinSortMostPairsPerGaussian * last_records_;
   }
 
-  // Queues the read back of the frame's counters and the event the host waits for.
-  void read_back_counts(const cuda::FrameBuffers& b) {
+  // Queues the read back of the frame's counters and the event the host waits for (kCounted):
+  // on the frame's stream, or with `after` (the event of the work whose counts it reads) on a
+  // stream of its own, so that the frame's next kernels do not wait for the copy (2-4 us a
+  // frame on the H200 machine, docs/PERFORMANCE.md v31). Later kernels of the frame write only
+  // counters that this read back is not used for, and the next frame resets them only after
+  // the host has waited for it.
+  void read_back_counts(const cuda::FrameBuffers& b, cudaEvent_t after) {
+    cudaStream_t stream = stream_;
+    if (after) {
+      stream = copy_stream_handle_.get();
+      check_cuda(cudaStreamWaitEvent(stream, after, 0), "pair count read back");
+    }
     check_cuda(cudaMemcpyAsync(&readback_->counters, b.counters, sizeof(cuda::FrameCounters), cudaMemcpyDeviceToHost,
-                               stream_),
+                               stream),
                "pair count read back");
-    check_cuda(cudaEventRecord(events_[event_set_][kCounted], stream_), "event record");
+    check_cuda(cudaEventRecord(events_[event_set_][kCounted], stream), "event record");
   }
 
   // Stage times of the frame whose events are in `set` (its work must have finished).
@@ -630,6 +650,10 @@ class CudaRendererImpl final : public CudaRenderer {
                   std::to_string(camera.height) + " frame");
   }
 
+  // Where a frame's pixels go: the host (render: downloaded, the frame waited for), a surface
+  // or the device image (render_to_surface, render_queued: neither).
+  enum class FrameTarget { host_image, surface, device_image };
+
   // What the work after the pair count needs of its frame (run_frame).
   struct FramePlan {
     const Camera* camera;
@@ -638,9 +662,9 @@ class CudaRendererImpl final : public CudaRenderer {
     const cuda::PreprocessArgs* args;
     Image* out;
     std::uint64_t surface;
+    bool float_image;  // the blend writes the device image (out, or a queued frame)
     std::uint64_t tiles, bins, pixels;
     bool baseline, fused, binned;
-    bool previous_complete;  // the last frame recorded all its events
     bool sort_follows_project;  // nothing is queued between the project and sort stages
   };
 
@@ -652,7 +676,7 @@ class CudaRendererImpl final : public CudaRenderer {
     const gm::CameraParams& cam = *f.cam;
     const RenderOptions& options = *f.options;
     const bool dense_tiles_first =
-        !f.baseline && options.dense_tiles_first && dense_order_pays(f.tiles, f.previous_complete);
+        !f.baseline && options.dense_tiles_first && dense_order_pays(f.tiles);
     if (dense_tiles_first) {
       tile_order_.reserve(std::max<std::uint64_t>(f.bins, 1) * sizeof(std::uint32_t), "bin order");
       if (!bin_sort_frame_)  // the bin sort's counting pass orders the bins without it
@@ -729,19 +753,16 @@ class CudaRendererImpl final : public CudaRenderer {
     blend.bins_ready = ready;
     blend.frame_tag = overlap ? bin_frame_tag_ : 0u;
     blend.gaussians = b.blend;
-    blend.image_rgb = f.out ? b.image_rgb : nullptr;
+    blend.image_rgb = f.float_image ? b.image_rgb : nullptr;
     blend.surface = f.surface;
     cuda::launch_blend(blend, stream_);
     check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     // The fullest tile and the tile pairs, for the statistics (after the last timed event:
     // not a stage's cost).
     cuda::launch_tile_stats(f.tiles, b, stream_);
-    check_cuda(cudaMemcpyAsync(&readback_->tile_max[event_set_], &b.counters->max_tile_pairs, sizeof(std::uint32_t),
+    check_cuda(cudaMemcpyAsync(&readback_->tile_totals[event_set_], &b.counters->tile_totals, sizeof(cuda::TileTotals),
                                cudaMemcpyDeviceToHost, stream_),
-               "tile maximum read back");
-    check_cuda(cudaMemcpyAsync(&readback_->tile_pairs[event_set_], &b.counters->tile_pairs,
-                               sizeof(unsigned long long), cudaMemcpyDeviceToHost, stream_),
-               "tile pair read back");
+               "tile statistics read back");
     if (f.out) {
       Image* out = f.out;
       if (out->width != f.camera->width || out->height != f.camera->height) out->resize(f.camera->width, f.camera->height);
@@ -751,8 +772,8 @@ class CudaRendererImpl final : public CudaRenderer {
     }
   }
 
-  void run_frame(const Camera& camera, const RenderOptions& options, Image* out, std::uint64_t surface,
-                 FrameStats* stats_out) {
+  void run_frame(const Camera& camera, const RenderOptions& options, FrameTarget target, Image* out,
+                 std::uint64_t surface, FrameStats* stats_out) {
     if (!scene_) throw Error("cuda renderer: no scene set");
     if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
     if (surface) check_surface(surface, camera);
@@ -811,7 +832,8 @@ class CudaRendererImpl final : public CudaRenderer {
       tile_lists_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile lists");
       dense_bins_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "dense bin list");
     }
-    if (out) image_.reserve(pixels * 3 * sizeof(float), "frame image");
+    const bool float_image = target != FrameTarget::surface;
+    if (float_image) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     // Fused emission keeps a blend record per projected Gaussian (FrameBuffers::blend), the
     // separate path one per Gaussian.
     compact_records_ = fused;
@@ -860,10 +882,13 @@ class CudaRendererImpl final : public CudaRenderer {
     const bool previous_complete = last_frame_complete_;  // all its events recorded
     last_frame_complete_ = false;
     event_set_ ^= 1;
+    frame_tiles_[event_set_] = tiles;
     cudaEvent_t* events = events_[event_set_];
     // The bin sort reads the pair count on the device, so a frame of fused emission queues
     // the rest of its work before the host waits for the count: the GPU then runs on instead
     // of idling while the host reads the count and launches the sort (8-16 us a frame, v14).
+    // Nothing it queues waits for the last frame's end (dense_order_pays reads a finished
+    // frame's statistics), so frames queued back to back follow each other without a gap.
     const bool queue_before_count = bin_sort_frame_ && fused;
     // Such a frame that goes to the host (whose end the host waits for anyway) reads its counts
     // back at its end, after the blend: a copy between preprocess and sort kept the GPU idle
@@ -871,8 +896,8 @@ class CudaRendererImpl final : public CudaRenderer {
     // the host can go on while the GPU blends.
     const bool count_at_end = queue_before_count && out;
     separate_emit_[event_set_] = !fused;
-    const FramePlan frame{&camera, &cam, &options, &args, out, surface, tiles, bins, pixels, baseline, fused, binned,
-                          previous_complete, count_at_end};
+    const FramePlan frame{&camera, &cam, &options, &args, out, surface,
+                          float_image, tiles, bins, pixels, baseline, fused, binned, count_at_end};
     std::uint64_t pairs = 0;
     for (int attempt = 0;; ++attempt) {
       const cuda::FrameBuffers b = frame_buffers();
@@ -884,14 +909,13 @@ class CudaRendererImpl final : public CudaRenderer {
         cuda::launch_scan(n, b, stream_);
         check_cuda(cudaEventRecord(events[kScanned], stream_), "event record");
       }
-      if (!count_at_end) read_back_counts(b);
+      if (!count_at_end) read_back_counts(b, events[fused ? kProjected : kScanned]);
       if (queue_before_count) {
-        // The last frame's read backs (dense_order_pays) come before this frame's start.
-        check_cuda(cudaEventSynchronize(events[kBegin]), "last frame");
         queue_after_count(frame, 0);
-        if (count_at_end) read_back_counts(b);
+        if (count_at_end) read_back_counts(b, nullptr);
       }
       check_cuda(cudaEventSynchronize(events[kCounted]), "preprocess");
+      if (previous_complete) settle(previous_set);  // it ended before this frame began
       pairs = readback_->counters.pairs;
       if (pairs > static_cast<std::uint64_t>(INT32_MAX))
         throw Error("cuda renderer: the frame needs " + std::to_string(pairs) +
@@ -911,7 +935,10 @@ class CudaRendererImpl final : public CudaRenderer {
     last_bin_pairs_ = binned ? pairs : 0;
     last_records_ = compact_records_ ? readback_->counters.records : 0;
     last_frame_binned_ = binned;
-    if (out) check_cuda(cudaStreamSynchronize(stream_), "frame");
+    if (out) {
+      check_cuda(cudaStreamSynchronize(stream_), "frame");
+      settle(event_set_);
+    }
     last_frame_complete_ = true;
     if (!stats_out) return;
 
@@ -933,12 +960,12 @@ class CudaRendererImpl final : public CudaRenderer {
     if (out || !previous_complete) {
       check_cuda(cudaStreamSynchronize(stream_), "frame");
       stats.times = stage_times(event_set_);
-      stats.max_tile_pairs = readback_->tile_max[event_set_];
-      stats.kv_pairs = readback_->tile_pairs[event_set_];
+      stats.max_tile_pairs = readback_->tile_totals[event_set_].max_tile_pairs;
+      stats.kv_pairs = readback_->tile_totals[event_set_].tile_pairs;
     } else {
       stats.times = stage_times(previous_set);
-      stats.max_tile_pairs = readback_->tile_max[previous_set];
-      stats.kv_pairs = readback_->tile_pairs[previous_set];
+      stats.max_tile_pairs = readback_->tile_totals[previous_set].max_tile_pairs;
+      stats.kv_pairs = readback_->tile_totals[previous_set].tile_pairs;
     }
     // Tile keys count the tile pairs themselves; bins count them after the blend (above: this
     // frame's, or for a surface frame the previous one's, as the times).
@@ -955,6 +982,7 @@ class CudaRendererImpl final : public CudaRenderer {
   std::string device_name_;
   // Declared before the buffers: destroyed after them.
   StreamHandle stream_handle_;
+  StreamHandle copy_stream_handle_;  // the pair counts' read back (read_back_counts)
   EventHandle event_handles_[2][kEventCount];
   PinnedHandle pinned_;
   cudaStream_t stream_ = nullptr;  // stream_handle_'s
@@ -963,6 +991,12 @@ class CudaRendererImpl final : public CudaRenderer {
   int event_set_ = 0;
   bool separate_emit_[2] = {false, false};  // per event set: its frame recorded the emit events
   bool last_frame_complete_ = false;  // the last frame recorded all its events
+  std::uint64_t frame_tiles_[2] = {0, 0};  // per event set: its frame's tiles
+  // The tile statistics of the latest frame known to have finished (dense_order_pays).
+  struct SettledFrame {
+    bool known = false;
+    std::uint64_t tiles = 0, tile_pairs = 0, fullest_tile = 0;
+  } settled_;
   bool list_chunks_ = false;          // this frame's preprocess walks a chunk list (FrameBuffers::chunk_list)
   bool compact_records_ = false;      // this frame keeps a blend record per projected Gaussian
   std::shared_ptr<const Scene> scene_;

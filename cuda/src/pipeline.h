@@ -127,13 +127,18 @@ constexpr std::uint32_t kRecordMask = (1u << kBinTileBitsShift) - 1u;  // a binn
 constexpr int kTileClasses = 33;
 
 // Counters one frame accumulates on the device; copied to the host once per frame.
+// The frame's tile statistics (launch_tile_stats, after the blend), read back in one copy.
+struct TileTotals {
+  unsigned long long tile_pairs;  // Gaussian-tile pairs (FrameCounters::pairs counts bins)
+  unsigned int max_tile_pairs;    // pairs of the fullest tile
+};
+
 struct FrameCounters {
   unsigned long long pairs;        // Gaussian-tile pairs wanted (may exceed capacity)
   // Gaussians by gm::CullReason: kVisible counts those with at least one pair, and one whose
   // box met the image but whose ellipse missed every tile counts as kCulledOffscreen.
   unsigned int by_reason[gm::kCullReasonCount];
-  unsigned int max_tile_pairs;     // pairs of the fullest tile (launch_tile_stats, after the blend)
-  unsigned long long tile_pairs;   // Gaussian-tile pairs (launch_tile_stats; `pairs` counts bins)
+  TileTotals tile_totals;
   unsigned int deferred;           // Gaussians deferred to deferred_emit_kernel (may exceed capacity)
   unsigned long long deferred_items;  // their work items (may exceed item_capacity)
   unsigned long long chunk_culled; // Gaussians of chunks outside the view (classified, not projected)
@@ -284,7 +289,7 @@ void launch_tile_order(std::uint64_t bins, const FrameBuffers& buffers, cudaStre
 // values in buffer `which` (after launch_ranges).
 void launch_tile_lists(std::uint64_t pairs, int tiles_x, int tiles_y, const FrameBuffers& buffers, int which,
                        cudaStream_t stream);
-// FrameCounters::max_tile_pairs and tile_pairs from the tile ranges, or the tile lists of a
+// FrameCounters::tile_totals from the tile ranges, or the tile lists of a
 // binned frame (statistics: run outside the timed stages).
 void launch_tile_stats(std::uint64_t tiles, const FrameBuffers& buffers, cudaStream_t stream);
 

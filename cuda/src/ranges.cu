@@ -45,8 +45,8 @@ __global__ void __launch_bounds__(kBlock) tile_max_kernel(std::uint64_t tiles, c
   const unsigned warp_max = __reduce_max_sync(kFullMask, range.y - range.x);
   const unsigned warp_sum = __reduce_add_sync(kFullMask, range.y - range.x);
   if (lane_id() == 0 && warp_max > 0) {
-    atomicMax(&counters->max_tile_pairs, warp_max);
-    atomicAdd(&counters->tile_pairs, static_cast<unsigned long long>(warp_sum));
+    atomicMax(&counters->tile_totals.max_tile_pairs, warp_max);
+    atomicAdd(&counters->tile_totals.tile_pairs, static_cast<unsigned long long>(warp_sum));
   }
 }
 

@@ -23,6 +23,12 @@ class CudaRenderer : public Renderer {
   // (this frame's on the first call, or after a failed one).
   virtual void render_to_surface(const Camera& camera, const RenderOptions& options,
                                  std::uint64_t surface_object, FrameStats* stats) = 0;
+  // Renders into the renderer's own device image (float RGB, as render() computes it) and
+  // returns without copying it to the host or waiting for the frame's end, as
+  // render_to_surface does: frames queued back to back, the way the viewer renders them, so that
+  // the host's launches for the next frame overlap this one's GPU work (`flashgs bench` times
+  // these). `stats` as render_to_surface; a later render() waits for every queued frame.
+  virtual void render_queued(const Camera& camera, const RenderOptions& options, FrameStats* stats) = 0;
   // Per-tile pair counts of the last frame (row-major tiles_y x tiles_x), copied from the
   // device only when this is called.
   virtual void download_tile_counts(std::vector<std::uint32_t>& counts) = 0;
