@@ -764,6 +764,54 @@ TEST(CudaQueued, FramesQueuedBackToBackLeaveTheSameFrames) {
   }
 }
 
+// The upload's spatial order (flashgs/spatial_order.h) moves Gaussians in memory only. The demo
+// scene with a copy of some Gaussians in other colours (pairs of equal depth, which blend in
+// scene order), shuffled: uploaded in spatial order and as stored, every byte and count is the
+// same, and both match the CPU. By default only scenes of 2^18 Gaussians and more are put in
+// spatial order (the order's 4 bytes per Gaussian on the device show which were).
+std::unique_ptr<CudaRenderer> renderer_with_spatial_order(const char* mode, std::shared_ptr<const Scene> scene) {
+  if (mode) setenv("FLASHGS_SPATIAL_ORDER", mode, 1);
+  auto gpu = make_cuda_renderer();  // reads the variable once
+  unsetenv("FLASHGS_SPATIAL_ORDER");
+  gpu->set_scene(std::move(scene));
+  return gpu;
+}
+
+TEST(CudaSpatialOrder, MovesGaussiansInMemoryOnly) {
+  FLASHGS_REQUIRE_CUDA();
+  Scene scene = *test::load_demo_scene();
+  Scene twins = test::permuted(scene, test::random_order(200, 5));
+  for (float& c : twins.sh_dc) c = 1.0f - c;
+  scene.append(twins);
+  const auto shuffled = std::make_shared<Scene>(test::permuted(scene, test::random_order(scene.size(), 9)));
+  auto ordered = renderer_with_spatial_order("1", shuffled), stored = renderer_with_spatial_order("0", shuffled);
+  auto by_default = renderer_with_spatial_order(nullptr, shuffled);
+  auto cpu = make_cpu_renderer();
+  cpu->set_scene(shuffled);
+  const std::vector<Camera> cameras = test::load_demo_cameras();
+  for (const Camera& camera : {cameras[1].resized(333, 187), cameras[3].resized(1001, 563)}) {
+    for (const RenderOptions& o : {RenderOptions{}, RenderOptions::baseline()}) {
+      const std::string what = o.label() + " " + std::to_string(camera.width);
+      const Result a = render(*ordered, camera, o), b = render(*stored, camera, o);
+      EXPECT_EQ(a.image.rgb, b.image.rgb) << what;
+      expect_same_counts(what, a.stats, b.stats);
+      EXPECT_EQ(a.stats.scene_device_bytes, b.stats.scene_device_bytes + 4 * shuffled->size()) << what;
+      EXPECT_EQ(render(*by_default, camera, o).stats.scene_device_bytes, b.stats.scene_device_bytes) << what;
+      expect_match("spatial order, " + what, render(*cpu, camera, o), a);
+    }
+  }
+  // Nine copies, shuffled: 270k Gaussians in no spatial order, which the default puts in order.
+  const auto large = std::make_shared<Scene>(tile_scene(*test::load_demo_scene(), 9));
+  const auto large_shuffled = std::make_shared<Scene>(test::permuted(*large, test::random_order(large->size(), 4)));
+  by_default = renderer_with_spatial_order(nullptr, large_shuffled);
+  stored = renderer_with_spatial_order("0", large_shuffled);
+  const Camera camera = cameras[2].resized(640, 360);
+  const Result a = render(*by_default, camera, RenderOptions{}), b = render(*stored, camera, RenderOptions{});
+  EXPECT_EQ(a.image.rgb, b.image.rgb);
+  expect_same_counts("nine copies", a.stats, b.stats);
+  EXPECT_EQ(a.stats.scene_device_bytes, b.stats.scene_device_bytes + 4 * large_shuffled->size());
+}
+
 // A scene that cannot fit in GPU memory is a flashgs::Error, not a crash, and the old scene
 // stays usable. The GPU is first filled with ballast so that a 2M-Gaussian scene cannot fit.
 TEST(CudaEdgeCases, SceneTooLargeIsAnError) {

@@ -1,10 +1,13 @@
 // Helpers shared by the test suites (see test_support.h).
 #include "test_support.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <numeric>
+#include <random>
 
 #include "flashgs/demo_scene.h"
 #include "flashgs/io.h"
@@ -50,6 +53,32 @@ std::shared_ptr<const Scene> load_demo_scene() {
 
 std::vector<Camera> load_demo_cameras() {
   return load_cameras(demo_cameras_path());
+}
+
+Scene permuted(const Scene& scene, const std::vector<std::uint32_t>& order) {
+  Scene out;
+  out.sh_degree = scene.sh_degree;
+  out.reserve(order.size());
+  const std::size_t rest = static_cast<std::size_t>(scene.sh_rest_per_gaussian());
+  auto take = [](std::vector<float>& to, const std::vector<float>& from, std::size_t i, std::size_t width) {
+    to.insert(to.end(), from.begin() + i * width, from.begin() + (i + 1) * width);
+  };
+  for (std::uint32_t i : order) {
+    take(out.positions, scene.positions, i, 3);
+    take(out.scales, scene.scales, i, 3);
+    take(out.rotations, scene.rotations, i, 4);
+    take(out.opacities, scene.opacities, i, 1);
+    take(out.sh_dc, scene.sh_dc, i, 3);
+    if (rest) take(out.sh_rest, scene.sh_rest, i, rest);
+  }
+  return out;
+}
+
+std::vector<std::uint32_t> random_order(std::size_t n, unsigned seed) {
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::shuffle(order.begin(), order.end(), std::mt19937(seed));
+  return order;
 }
 
 void dump_images(const std::string& stem, const Image& expected, const Image& actual) {

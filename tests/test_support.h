@@ -1,6 +1,7 @@
 // Helpers shared by the test suites: scene paths, cached scene loading, image dumps.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +25,10 @@ std::vector<Camera> load_shared_cameras(const std::string& name);
 // The bundled demo scene.
 std::shared_ptr<const Scene> load_demo_scene();
 std::vector<Camera> load_demo_cameras();
+// The scene's Gaussians in another order: the k-th is scene.<arrays>[order[k]].
+Scene permuted(const Scene& scene, const std::vector<std::uint32_t>& order);
+// A random permutation of [0, n) (the same for the same seed).
+std::vector<std::uint32_t> random_order(std::size_t n, unsigned seed);
 // The bound between two renders that run the same operations except exp (CPU vs CUDA: glibc's
 // expf vs CUDA's; SIMD vs scalar CPU blend: Highway's vs glibc's). Such an ulp can move an
 // alpha across the 1/255 cut or a transmittance across 1e-4, which changes that pixel by at

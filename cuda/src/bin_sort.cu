@@ -592,7 +592,7 @@ void launch_bin_blocks(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned
   args.order = order;
   args.ready = ready;
   args.frame_tag = frame_tag;
-  args.records = Records{b.blend, b.record_ids, kRecordMask};
+  args.records = frame_records(b, kRecordMask);
   args.shared_pairs = std::min(shared_pairs, kBinSortSharedPairsMax);
   bin_sort_kernel<<<bins, kSortBlock, 0, stream>>>(args);
   check_cuda(cudaGetLastError(), "bin sort kernel launch");

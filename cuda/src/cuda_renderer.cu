@@ -12,6 +12,7 @@
 #include "flashgs/cuda_renderer.h"
 #include "flashgs/error.h"
 #include "flashgs/frame_params.h"
+#include "flashgs/spatial_order.h"
 #include "host_parallel.h"
 #include "pipeline.h"
 #include "scene_upload.h"
@@ -196,6 +197,9 @@ class CudaRendererImpl final : public CudaRenderer {
     // FLASHGS_CHUNK_CULL=0 projects every Gaussian, =1 culls chunks in any scene (unset: scenes
     // of kChunkCullMinGaussians and more).
     if (const char* cull = std::getenv("FLASHGS_CHUNK_CULL")) chunk_cull_ = std::atoi(cull) != 0 ? kAlways : kNever;
+    // FLASHGS_SPATIAL_ORDER=1 uploads every scene in spatial order, =0 none (unset: scenes whose
+    // stored order is not spatially coherent, see flashgs/spatial_order.h).
+    if (const char* order = std::getenv("FLASHGS_SPATIAL_ORDER")) spatial_order_ = std::atoi(order) != 0 ? kAlways : kNever;
     // FLASHGS_DENSE_TILES_FIRST=1 orders the tiles on every frame, =0 never (unset: when the
     // last frame's fullest tile outlasted a wave of the blend, see dense_order_pays).
     if (const char* dense = std::getenv("FLASHGS_DENSE_TILES_FIRST"))
@@ -263,8 +267,15 @@ class CudaRendererImpl final : public CudaRenderer {
     // Under fp16_sh the DC keeps its float slots but holds the half values.
     const auto dc = [&](std::size_t k) { return sh_half ? gm::round_to_half(scene->sh_dc[k]) : scene->sh_dc[k]; };
 
+    // The device layout in spatial order where the stored one lacks it: device Gaussian i is
+    // scene Gaussian source(i).
+    const bool reorder = spatial_order_ == kAlways || (spatial_order_ == kAuto && n >= kSpatialOrderMinGaussians &&
+                                                       !spatially_coherent(*scene));
+    const std::vector<std::uint32_t> order = reorder ? spatial_order(*scene) : std::vector<std::uint32_t>{};
+    const auto source = [&order](std::size_t i) -> std::size_t { return order.empty() ? i : order[i]; };
+
     // Allocate the new scene next to the old one; on failure the old one stays.
-    DeviceBuffer new_pos, new_rot, new_scale, new_dc, new_rest, new_chunks;
+    DeviceBuffer new_pos, new_rot, new_scale, new_dc, new_rest, new_chunks, new_ids;
     const std::size_t m = std::max<std::size_t>(n, 1);
     const std::size_t chunks = (n + cuda::kChunkSize - 1) / cuda::kChunkSize;
     new_pos.reserve(m * sizeof(float4), "scene positions");
@@ -273,6 +284,7 @@ class CudaRendererImpl final : public CudaRenderer {
     new_dc.reserve(m * sizeof(float2), "scene colours");
     if (stride_vec4 > 0) new_rest.reserve(n * stride_vec4 * rest_group_bytes, "scene SH bands");
     new_chunks.reserve(std::max<std::size_t>(chunks, 1) * sizeof(cuda::ChunkBound), "scene chunk bounds");
+    if (!order.empty()) new_ids.reserve(n * sizeof(std::uint32_t), "scene order");
 
     // Packed into the device layout chunk by chunk (no host copy of the whole scene).
     check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation");
@@ -281,37 +293,41 @@ class CudaRendererImpl final : public CudaRenderer {
     // The position's fourth float: the DC red under fp16_shape (the opacity moves into the
     // record of halves), the opacity otherwise.
     uploader.upload(new_pos.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
-      const float* p = &sc.positions[i * 3];
-      *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], shape_half ? dc(i * 3) : sc.opacities[i]);
+      const std::size_t j = source(i);
+      const float* p = &sc.positions[j * 3];
+      *static_cast<float4*>(dst) = make_float4(p[0], p[1], p[2], shape_half ? dc(j * 3) : sc.opacities[j]);
     });
     if (shape_half) {
       uploader.upload(new_rot.as<void>(), sizeof(uint4), n, [&](std::size_t i, void* dst) {
-        const float* q = &sc.rotations[i * 4];
-        const float* sv = &sc.scales[i * 3];
+        const std::size_t j = source(i);
+        const float* q = &sc.rotations[j * 4];
+        const float* sv = &sc.scales[j * 3];
         const auto pair = [](float low, float high) {
           return static_cast<unsigned>(gm::float_to_half_bits(low)) |
                  static_cast<unsigned>(gm::float_to_half_bits(high)) << 16;
         };
         *static_cast<uint4*>(dst) = make_uint4(pair(q[0], q[1]), pair(q[2], q[3]), pair(sv[0], sv[1]),
-                                               pair(sv[2], sc.opacities[i]));
+                                               pair(sv[2], sc.opacities[j]));
       });
     } else {
       uploader.upload(new_rot.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
-        const float* q = &sc.rotations[i * 4];
+        const float* q = &sc.rotations[source(i) * 4];
         *static_cast<float4*>(dst) = make_float4(q[0], q[1], q[2], q[3]);
       });
       uploader.upload(new_scale.as<void>(), sizeof(float4), n, [&](std::size_t i, void* dst) {
-        const float* sv = &sc.scales[i * 3];
-        *static_cast<float4*>(dst) = make_float4(sv[0], sv[1], sv[2], dc(i * 3));
+        const std::size_t j = source(i);
+        const float* sv = &sc.scales[j * 3];
+        *static_cast<float4*>(dst) = make_float4(sv[0], sv[1], sv[2], dc(j * 3));
       });
     }
     uploader.upload(new_dc.as<void>(), sizeof(float2), n, [&](std::size_t i, void* dst) {
-      *static_cast<float2*>(dst) = make_float2(dc(i * 3 + 1), dc(i * 3 + 2));
+      const std::size_t j = source(i);
+      *static_cast<float2*>(dst) = make_float2(dc(j * 3 + 1), dc(j * 3 + 2));
     });
     if (stride_vec4 > 0)
       uploader.upload(new_rest.as<void>(), stride_vec4 * rest_group_bytes, n, [&](std::size_t i, void* dst) {
         std::memset(dst, 0, rest_group_bytes * stride_vec4);
-        const float* rest = &sc.sh_rest[i * rest_floats];
+        const float* rest = &sc.sh_rest[source(i) * rest_floats];
         if (!sh_half) {
           std::memcpy(dst, rest, sizeof(float) * rest_floats);
           return;
@@ -319,6 +335,9 @@ class CudaRendererImpl final : public CudaRenderer {
         std::uint16_t* halves = static_cast<std::uint16_t*>(dst);
         for (int k = 0; k < rest_floats; ++k) halves[k] = gm::float_to_half_bits(rest[k]);
       });
+    if (!order.empty())
+      uploader.upload(new_ids.as<void>(), sizeof(std::uint32_t), n,
+                      [&](std::size_t i, void* dst) { *static_cast<std::uint32_t*>(dst) = order[i]; });
     cuda::DeviceScene next;
     next.count = n;
     next.sh_degree = degree;
@@ -337,6 +356,7 @@ class CudaRendererImpl final : public CudaRenderer {
     next.sh_rest = sh_half ? nullptr : new_rest.as<float4>();
     next.sh_rest_half = sh_half ? new_rest.as<uint2>() : nullptr;
     next.chunks = new_chunks.as<cuda::ChunkBound>();
+    next.scene_ids = order.empty() ? nullptr : new_ids.as<std::uint32_t>();
     cuda::launch_chunk_bounds(next, next.chunks, stream_);
     uploader.finish();
     // The buffers change owners, not addresses: `next` stays valid.
@@ -346,6 +366,7 @@ class CudaRendererImpl final : public CudaRenderer {
     scene_dc_.swap(new_dc);
     scene_rest_.swap(new_rest);
     scene_chunks_.swap(new_chunks);
+    scene_ids_.swap(new_ids);
     device_scene_ = next;
     scene_ = std::move(scene);
     last_tiles_ = 0;
@@ -503,6 +524,7 @@ class CudaRendererImpl final : public CudaRenderer {
     b.key_format = key_format_;
     b.blend = blend_.as<cuda::BlendGaussian>();
     b.record_ids = compact_records_ ? record_ids_.as<std::uint32_t>() : nullptr;
+    b.scene_ids = device_scene_.scene_ids;
     b.record_capacity = record_capacity();
     b.footprints = footprints_.as<gm::Footprint>();
     b.pair_counts = pair_counts_.as<std::uint32_t>();
@@ -973,7 +995,7 @@ class CudaRendererImpl final : public CudaRenderer {
     stats.device_memory_bytes = working_bytes_;
     stats.device_peak_bytes = peak_bytes_;
     stats.scene_device_bytes = scene_pos_.bytes() + scene_rot_.bytes() + scene_scale_.bytes() + scene_dc_.bytes() +
-                               scene_rest_.bytes() + scene_chunks_.bytes();
+                               scene_rest_.bytes() + scene_chunks_.bytes() + scene_ids_.bytes();
     if (options.collect_tile_counts) download_tile_counts(stats.tile_pair_counts);
     *stats_out = std::move(stats);
   }
@@ -1015,6 +1037,11 @@ class CudaRendererImpl final : public CudaRenderer {
   // 100M one's 2.8x on an H200) and costs a test per 256 Gaussians that cannot pay off when
   // the whole of a small scene is in view (pc_biker's and pc_playbot's orbit views).
   static constexpr std::size_t kChunkCullMinGaussians = std::size_t{1} << 20;
+  // Spatial order pays in scenes of a few waves of preprocess blocks and more (pc_playbot in
+  // random order: frames 8% / 6% shorter at 1080p / 4K; 10M Gaussians: 15% / 10%, the chunk
+  // cull working again). Below, it gathers a small grid's heavy Gaussians into a few blocks
+  // (v3dg_donut, 45k: 3% / 2% longer on the H200, docs/PERFORMANCE.md v31).
+  static constexpr std::size_t kSpatialOrderMinGaussians = std::size_t{1} << 18;
   // Compact records a scene's first frame starts with (100 MB): a view of more Gaussians grows
   // them once and runs again.
   std::uint64_t initial_records_ = std::uint64_t{1} << 21;
@@ -1022,6 +1049,7 @@ class CudaRendererImpl final : public CudaRenderer {
   unsigned bin_sort_shared_pairs_ = cuda::kBinSortSharedPairsMax;
   enum Mode { kAuto, kAlways, kNever };
   Mode chunk_cull_ = kAuto;
+  Mode spatial_order_ = kAuto;  // the scene's device layout in spatial order (upload_scene)
   Mode dense_tiles_mode_ = kAuto;
   Mode bin_sort_ = kAuto;        // binned frames with compact keys sort per bin (launch_bin_pairs, launch_bin_blocks)
   bool bin_sort_frame_ = false;  // this frame does
@@ -1046,7 +1074,7 @@ class CudaRendererImpl final : public CudaRenderer {
   double bounds_radius_ = 0;
   float max_opacity_ = 1.0f;             // of the scene (sets the flash extent's largest threshold)
   // Scene (not counted as working memory).
-  DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_;
+  DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_, scene_ids_;
   // Working memory.
   DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_, bin_fill_,
       bin_ready_, dense_bins_, tile_order_, tile_places_, chunk_list_, image_,

@@ -84,6 +84,9 @@ struct DeviceScene {
   float4* sh_rest = nullptr;           // [count][rest_stride_vec4] bands 1.., [k][channel], zero padded
   uint2* sh_rest_half = nullptr;       // the same as IEEE halves, 4 per uint2 (lowest bits first)
   ChunkBound* chunks = nullptr;        // [ceil(count / kChunkSize)]
+  // [count] the scene index of device Gaussian i, where the upload put them in spatial order
+  // (flashgs/spatial_order.h); null: i. Pairs of equal depth blend in scene index order.
+  const std::uint32_t* scene_ids = nullptr;
 };
 
 // What the blend stage reads per Gaussian (48 bytes, three 16-byte loads): the whitened
@@ -166,12 +169,14 @@ constexpr std::uint32_t kNoDeferredEntry = 0xffffffffu;  // an item reserved for
 // Buffers of the frame pipeline; every size is a high-water mark (grown, never shrunk).
 struct FrameBuffers {
   // Blend records. Fused emission keeps one per projected Gaussian: record_ids[r] is record
-  // r's Gaussian and the pairs' values are record numbers, so the blend data grows with what
-  // the frame sees, not with the scene. The separate path (record_ids null) indexes them by
-  // Gaussian id. A frame that wants more than record_capacity writes none past it; the host
-  // sees FrameCounters::records, grows the buffers and runs the frame again.
+  // r's Gaussian (its scene index) and the pairs' values are record numbers, so the blend data
+  // grows with what the frame sees, not with the scene. The separate path (record_ids null)
+  // indexes them by device Gaussian, whose scene index is scene_ids' (DeviceScene). A frame
+  // that wants more than record_capacity writes none past it; the host sees
+  // FrameCounters::records, grows the buffers and runs the frame again.
   BlendGaussian* blend = nullptr;         // [record_capacity]
   std::uint32_t* record_ids = nullptr;    // [record_capacity], or null
+  const std::uint32_t* scene_ids = nullptr;  // DeviceScene::scene_ids
   std::uint32_t record_capacity = 0;
   // Per Gaussian, separate-emission path only.
   gm::Footprint* footprints = nullptr;    // [gaussians]

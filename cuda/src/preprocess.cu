@@ -377,7 +377,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     const float dc[3] = {g.dc_red, gb.x, gb.y};
     float rgb[3];
     colour<DEGREE>(scene, i, cam, g.position, dc, rgb);
-    if (buf.record_ids) buf.record_ids[record] = i;
+    if (buf.record_ids) buf.record_ids[record] = scene.scene_ids ? __ldg(scene.scene_ids + i) : i;
     float4* out = reinterpret_cast<float4*>(buf.blend + record);
     if (args.exp2_alpha) {
       // w' = sqrt(log2(e) / 2) w, so o e^(-q/2) = exp2(log2 o - (u'^2 + v'^2)): one exp2.

@@ -174,7 +174,7 @@ void launch_ranges(std::uint64_t pairs, std::uint64_t bins, const FrameBuffers& 
   check_cuda(cudaMemsetAsync(b.tile_ranges, 0, bins * sizeof(uint2), stream), "bin range reset");
   if (pairs == 0) return;
   const unsigned blocks = static_cast<unsigned>((pairs + kBlock - 1) / kBlock);
-  const Records records{b.blend, b.record_ids, b.bins.shift ? kRecordMask : ~0u};
+  const Records records = frame_records(b, b.bins.shift ? kRecordMask : ~0u);
   if (b.key_format.depth_bits > 0)
     ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, reinterpret_cast<const std::uint32_t*>(b.keys[which]),
                                                  b.key_format.depth_bits, b.values[which], records, b.tile_ranges);

@@ -11,12 +11,18 @@
 namespace flashgs {
 namespace cuda {
 
-// The blend records and which Gaussian each one is (ids null: record r is Gaussian r).
+// The blend records and which Gaussian (scene index) each one is (ids null: record r is Gaussian r).
 struct Records {
   const BlendGaussian* gaussians;
   const std::uint32_t* ids;
   std::uint32_t value_mask;  // a pair value's record bits
 };
+
+// A frame's records: compact ones name their Gaussian's scene index (record_ids); otherwise
+// record r is device Gaussian r, whose scene index is scene_ids[r] (null: r).
+inline Records frame_records(const FrameBuffers& b, std::uint32_t value_mask) {
+  return Records{b.blend, b.record_ids ? b.record_ids : b.scene_ids, value_mask};
+}
 
 // The blend order of a pair: its Gaussian's exact depth bits, then its id.
 __device__ __forceinline__ std::uint64_t blend_order(const Records& r, std::uint32_t value) {

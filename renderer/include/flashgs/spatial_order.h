@@ -1,0 +1,25 @@
+// Spatial order of a scene's Gaussians: the CUDA backend lays them out so that neighbours in
+// memory are neighbours in space. A warp's Gaussians then meet the same few bins, so the sort's
+// counting and scatter passes write runs into each bin rather than a word here and there, and
+// the chunk cull sees compact chunks. Scenes in the PlayCanvas formats are stored that way
+// already; raw training output is not (pc_playbot in random order: frames 7-10% longer on the
+// H200, docs/PERFORMANCE.md v31).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "flashgs/scene.h"
+
+namespace flashgs {
+
+// Whether consecutive Gaussians lie much closer together than Gaussians drawn at random (by a
+// sample of each): such a scene gains nothing from spatial_order.
+bool spatially_coherent(const Scene& scene);
+
+// A permutation of the scene's Gaussians (order[k] = the scene index of the k-th) along a
+// Morton curve over 64^3 cells of their bounding box; within a cell, in scene order. A
+// non-finite position counts as the first cell's.
+std::vector<std::uint32_t> spatial_order(const Scene& scene);
+
+}  // namespace flashgs
