@@ -83,7 +83,7 @@ grep -m1 "viewer frame check" "$fallback_log" | sed 's/^/    /' | tee -a "$summa
 run_one() {  # scene-label render-size window-label viewer-args...
   local label=$1 res=$2 window=$3
   shift 3
-  local log="$OUT/viewer_fps/$(echo "${label}_${res}_${window}" | tr '/: @' '____').log"
+  local log="$OUT/viewer_fps/$(echo "${label}_${res}_${window}" | tr '/: @,' '_____').log"
   timeout 300 "$VIEWER" "$@" --path --frames "$FRAMES" --warmup "$WARMUP" --no-vsync --exit > "$log" 2>&1
   local rc=$?
   local path frames
@@ -112,7 +112,7 @@ for scene in "${scenes[@]}"; do
   [[ "$scene" == demo:* ]] && label=$scene
   # Correctness first: the texture shown (written through interop) must equal the backend's
   # own host image of the same view.
-  check_log="$OUT/viewer_fps/$(echo "${label}_check" | tr '/: @' '____').log"
+  check_log="$OUT/viewer_fps/$(echo "${label}_check" | tr '/: @,' '_____').log"
   timeout 300 "$VIEWER" "${args[@]}" --size 1920x1080 --camera 0 --frames 5 --check-frame --exit > "$check_log" 2>&1
   say "check $label: exit $? | $(grep -m1 "frame path:" "$check_log" | sed 's/.*frame path: //')"
   grep -m1 "viewer frame check" "$check_log" | sed 's/^/    /' | tee -a "$summary"
