@@ -7,11 +7,15 @@
 #include <limits>
 #include <numeric>
 
+#include "flashgs/generators.h"
 #include "flashgs/spatial_order.h"
 #include "test_support.h"
 
 namespace flashgs {
 namespace {
+
+// The verdict: whether the upload would keep the stored order.
+bool spatially_coherent(const Scene& scene) { return spatial_order_where_it_pays(scene).empty(); }
 
 void expect_permutation(const std::vector<std::uint32_t>& order, std::size_t n, const char* what) {
   ASSERT_EQ(order.size(), n) << what;
@@ -41,8 +45,8 @@ TEST(SpatialOrder, RestoresCoherenceFromARandomOrder) {
 
 // The scenes converted from the PlayCanvas formats (pc_*) are stored spatially coherent, so the
 // upload leaves them as they are, but not in random order; raw trainer output (v3dg_donut's
-// mip-splatting file, kacytran_try) is stored in an order as good as random (consecutive
-// Gaussians 0.96 and 0.80 of a random pair's distance apart, against 0.008-0.016 for pc_*).
+// mip-splatting file, kacytran_try) is stored in an order as good as random (runs of 256
+// consecutive Gaussians span 54-63 of the 64 cells along an axis, against 2-7 for pc_*).
 TEST(SpatialOrder, RealScenesNeedItWhereRawFromATrainer) {
   FLASHGS_REQUIRE_SHARED_SCENES();
   for (const std::string& name : test::shared_scene_names()) {
@@ -60,6 +64,19 @@ TEST(SpatialOrder, RealScenesNeedItWhereRawFromATrainer) {
     std::size_t moved = 0;
     for (std::size_t k = 0; k < again.size(); ++k) moved += again[k] != k;
     EXPECT_EQ(moved, 0u) << name;
+  }
+}
+
+// Shuffled scenes copied side by side: each run stays within one copy, which is small beside
+// the whole, yet the runs are as loose as the copy allows and the order pays; copies of a scene
+// in spatial order need none.
+TEST(SpatialOrder, ManyShuffledCopiesNeedIt) {
+  const Scene& demo = *test::load_demo_scene();
+  const Scene shuffled = test::permuted(demo, test::random_order(demo.size(), 5));
+  const Scene ordered = test::permuted(shuffled, spatial_order(shuffled));
+  for (int copies : {4, 64, 200}) {
+    EXPECT_FALSE(spatially_coherent(tile_scene(shuffled, copies))) << copies;
+    EXPECT_TRUE(spatially_coherent(tile_scene(ordered, copies))) << copies;
   }
 }
 

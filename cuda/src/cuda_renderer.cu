@@ -269,9 +269,9 @@ class CudaRendererImpl final : public CudaRenderer {
 
     // The device layout in spatial order where the stored one lacks it: device Gaussian i is
     // scene Gaussian order[i].
-    const bool reorder = spatial_order_ == kAlways || (spatial_order_ == kAuto && n >= kSpatialOrderMinGaussians &&
-                                                       !spatially_coherent(*scene));
-    const std::vector<std::uint32_t> order = reorder ? spatial_order(*scene) : std::vector<std::uint32_t>{};
+    std::vector<std::uint32_t> order;
+    if (spatial_order_ == kAlways) order = spatial_order(*scene);
+    else if (spatial_order_ == kAuto && n >= kSpatialOrderMinGaussians) order = spatial_order_where_it_pays(*scene);
 
     // Allocate the new scene next to the old one; on failure the old one stays.
     DeviceBuffer new_pos, new_rot, new_scale, new_dc, new_rest, new_chunks, new_ids;

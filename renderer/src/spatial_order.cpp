@@ -13,24 +13,37 @@ namespace flashgs {
 namespace {
 
 constexpr int kCellBits = 6;  // per axis: 64^3 cells
+constexpr int kCellsPerAxis = 1 << kCellBits;
 constexpr std::uint32_t kCells = 1u << (3 * kCellBits);
-constexpr std::size_t kSamples = 4096;
 // Gaussians per thread at least: the passes are a few nanoseconds per Gaussian.
 constexpr std::size_t kPerThread = 1 << 16;
-// Mean distances of consecutive Gaussians below this fraction of random pairs' mean distance
-// make a scene coherent: pc_playbot's is 0.008, its random order's about 1.
-constexpr double kCoherentRatio = 0.1;
+// The verdict's unit: runs of this many consecutive Gaussians (the chunk cull's chunk, 8 warps
+// of preprocess), kSampledRuns of them spread over the scene, measured by the most cells of the
+// grid that a run spans along an axis (the median over the sample).
+constexpr std::size_t kRun = 256;
+constexpr std::size_t kSampledRuns = 256;
+// Runs that span at most this many cells need no order: those of the real scenes stored in
+// spatial order span 2-7 at the median (pc_*), raw trainer output and shuffled scenes 54-63.
+constexpr int kCompactSpan = 8;
+// Otherwise the order is computed and kept where its runs span at most this fraction of the
+// stored ones. Small scenes (v3dg_donut, 45k Gaussians; kacytran_try, 9k) are sparse in the
+// grid, so even ordered runs span 15-20 cells; comparing with random pairs' distance instead
+// took shuffled scenes copied side by side for coherent once the copies were many (200 x
+// pc_playbot: project 0.97 ms against 0.31, PERFORMANCE.md v32).
+constexpr int kGainFactor = 2;
 
 bool finite_position(const Scene& scene, std::size_t i) {
   const float* p = &scene.positions[i * 3];
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
 
-double distance(const Scene& scene, std::size_t a, std::size_t b) {
-  const float* p = &scene.positions[a * 3];
-  const float* q = &scene.positions[b * 3];
-  const double dx = double(p[0]) - q[0], dy = double(p[1]) - q[1], dz = double(p[2]) - q[2];
-  return std::sqrt(dx * dx + dy * dy + dz * dz);
+int host_threads(std::size_t n) {
+#ifdef _OPENMP
+  return static_cast<int>(std::clamp<std::size_t>(n / kPerThread, 1, omp_get_max_threads()));
+#else
+  (void)n;
+  return 1;
+#endif
 }
 
 // The low kCellBits bits of v, each moved to every third bit.
@@ -63,58 +76,53 @@ struct CellGrid {
       if (!(lo[a] <= hi[a])) continue;  // no finite position
       low[a] = lo[a];
       const double extent = double(hi[a]) - lo[a];
-      scale[a] = extent > 0 ? static_cast<float>((1 << kCellBits) / extent) : 0.0f;
+      scale[a] = extent > 0 ? static_cast<float>(kCellsPerAxis / extent) : 0.0f;
     }
+  }
+
+  // The cell's coordinate along `axis` of a finite position.
+  std::uint32_t coordinate(const Scene& scene, std::size_t i, int axis) const {
+    const double q = (double(scene.positions[i * 3 + axis]) - low[axis]) * scale[axis];
+    return static_cast<std::uint32_t>(std::clamp(q, 0.0, double(kCellsPerAxis - 1)));
   }
 
   std::uint32_t cell(const Scene& scene, std::size_t i) const {
     if (!finite_position(scene, i)) return 0;
     std::uint32_t code = 0;
-    for (int a = 0; a < 3; ++a) {
-      const double q = (double(scene.positions[i * 3 + a]) - low[a]) * scale[a];
-      const auto c = static_cast<std::uint32_t>(std::clamp(q, 0.0, double((1 << kCellBits) - 1)));
-      code |= spread(c) << a;
-    }
+    for (int a = 0; a < 3; ++a) code |= spread(coordinate(scene, i, a)) << a;
     return code;
   }
 };
 
-}  // namespace
 
-bool spatially_coherent(const Scene& scene) {
+// The median over sampled runs of consecutive Gaussians (device order: scene Gaussian order[k],
+// or k where `order` is empty) of the most cells a run spans along an axis.
+int median_run_span(const Scene& scene, const CellGrid& grid, const std::vector<std::uint32_t>& order) {
   const std::size_t n = scene.size();
-  if (n < 2) return true;
-  double near = 0, far = 0;
-  std::size_t near_count = 0, far_count = 0;
-  std::uint64_t state = 0x9e3779b97f4a7c15ull;  // a fixed sequence: the same verdict every time
-  auto draw = [&] {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<std::size_t>((state >> 33) % n);
-  };
-  for (std::size_t k = 0; k < kSamples; ++k) {
-    const std::size_t i = (n - 1) * k / kSamples;
-    if (finite_position(scene, i) && finite_position(scene, i + 1)) {
-      near += distance(scene, i, i + 1);
-      ++near_count;
+  std::vector<int> spans;
+  for (std::size_t k = 0; k < kSampledRuns; ++k) {
+    const std::size_t first = (n - kRun) * k / (kSampledRuns - 1);
+    std::uint32_t low[3] = {kCellsPerAxis, kCellsPerAxis, kCellsPerAxis}, high[3] = {0, 0, 0};
+    bool any = false;
+    for (std::size_t place = first; place < first + kRun; ++place) {
+      const std::size_t i = order.empty() ? place : order[place];
+      if (!finite_position(scene, i)) continue;
+      any = true;
+      for (int a = 0; a < 3; ++a) {
+        const std::uint32_t c = grid.coordinate(scene, i, a);
+        low[a] = std::min(low[a], c);
+        high[a] = std::max(high[a], c);
+      }
     }
-    const std::size_t a = draw(), b = draw();
-    if (finite_position(scene, a) && finite_position(scene, b)) {
-      far += distance(scene, a, b);
-      ++far_count;
-    }
+    if (any) spans.push_back(static_cast<int>(std::max({high[0] - low[0], high[1] - low[1], high[2] - low[2]})));
   }
-  if (near_count == 0 || far_count == 0 || !(far > 0)) return true;
-  return near / near_count < kCoherentRatio * (far / far_count);
+  if (spans.empty()) return 0;
+  std::nth_element(spans.begin(), spans.begin() + spans.size() / 2, spans.end());
+  return spans[spans.size() / 2];
 }
 
-std::vector<std::uint32_t> spatial_order(const Scene& scene) {
+std::vector<std::uint32_t> order_by_cells(const Scene& scene, const CellGrid& grid, int threads) {
   const std::size_t n = scene.size();
-#ifdef _OPENMP
-  const int threads = static_cast<int>(std::clamp<std::size_t>(n / kPerThread, 1, omp_get_max_threads()));
-#else
-  const int threads = 1;
-#endif
-  const CellGrid grid(scene, threads);
   // A counting sort by cell, each thread over a contiguous share: the places of a cell go to
   // the threads in share order, so the sort is stable and a cell keeps its scene order.
   std::vector<std::uint32_t> place(static_cast<std::size_t>(threads) * kCells, 0);  // [thread][cell]
@@ -142,6 +150,25 @@ std::vector<std::uint32_t> spatial_order(const Scene& scene) {
     }  // (an implied barrier)
     for (std::size_t i = lo; i < hi; ++i) order[mine[grid.cell(scene, i)]++] = static_cast<std::uint32_t>(i);
   }
+  return order;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> spatial_order(const Scene& scene) {
+  const int threads = host_threads(scene.size());
+  return order_by_cells(scene, CellGrid(scene, threads), threads);
+}
+
+std::vector<std::uint32_t> spatial_order_where_it_pays(const Scene& scene) {
+  const std::size_t n = scene.size();
+  if (n <= kRun) return {};  // one run: nothing to gain
+  const int threads = host_threads(n);
+  const CellGrid grid(scene, threads);
+  const int stored = median_run_span(scene, grid, {});
+  if (stored <= kCompactSpan) return {};
+  std::vector<std::uint32_t> order = order_by_cells(scene, grid, threads);
+  if (kGainFactor * median_run_span(scene, grid, order) > stored) return {};
   return order;
 }
 
