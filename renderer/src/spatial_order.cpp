@@ -12,20 +12,26 @@
 namespace flashgs {
 namespace {
 
-constexpr int kCellBits = 6;  // per axis: 64^3 cells
+// The order's grid: 128^3 cells. With 64^3, 200 shuffled copies of pc_playbot side by side
+// (100M) kept cells of ~1/4 of a copy across, and preprocess took 0.44 ms against 0.31 in
+// PlayCanvas's own order (PERFORMANCE.md v32).
+constexpr int kCellBits = 7;
 constexpr int kCellsPerAxis = 1 << kCellBits;
 constexpr std::uint32_t kCells = 1u << (3 * kCellBits);
+// The verdict's grid: 64^3 cells, every 2^3 of the order's cells one.
+constexpr int kVerdictShift = kCellBits - 6;
+constexpr std::uint32_t kVerdictCellsPerAxis = kCellsPerAxis >> kVerdictShift;
 // Gaussians per thread at least: the passes are a few nanoseconds per Gaussian.
 constexpr std::size_t kPerThread = 1 << 16;
 // The verdict's unit: runs of this many consecutive Gaussians (the chunk cull's chunk, 8 warps
 // of preprocess), kSampledRuns of them spread over the scene, measured by the most cells of the
-// grid that a run spans along an axis (the median over the sample).
+// verdict grid that a run spans along an axis (the median over the sample).
 constexpr std::size_t kRun = 256;
 constexpr std::size_t kSampledRuns = 256;
 // Runs that span at most this many cells need no order: those of the real scenes stored in
 // spatial order span 2-7 at the median (pc_*), raw trainer output and shuffled scenes 54-63.
 constexpr int kCompactSpan = 8;
-// Otherwise the order is computed and kept where its runs span at most this fraction of the
+// Otherwise the order is computed and kept where its runs span at most 1/kGainFactor of the
 // stored ones. Small scenes (v3dg_donut, 45k Gaussians; kacytran_try, 9k) are sparse in the
 // grid, so even ordered runs span 15-20 cells; comparing with random pairs' distance instead
 // took shuffled scenes copied side by side for coherent once the copies were many (200 x
@@ -102,14 +108,14 @@ int median_run_span(const Scene& scene, const CellGrid& grid, const std::vector<
   std::vector<int> spans;
   for (std::size_t k = 0; k < kSampledRuns; ++k) {
     const std::size_t first = (n - kRun) * k / (kSampledRuns - 1);
-    std::uint32_t low[3] = {kCellsPerAxis, kCellsPerAxis, kCellsPerAxis}, high[3] = {0, 0, 0};
+    std::uint32_t low[3] = {kVerdictCellsPerAxis, kVerdictCellsPerAxis, kVerdictCellsPerAxis}, high[3] = {0, 0, 0};
     bool any = false;
     for (std::size_t place = first; place < first + kRun; ++place) {
       const std::size_t i = order.empty() ? place : order[place];
       if (!finite_position(scene, i)) continue;
       any = true;
       for (int a = 0; a < 3; ++a) {
-        const std::uint32_t c = grid.coordinate(scene, i, a);
+        const std::uint32_t c = grid.coordinate(scene, i, a) >> kVerdictShift;
         low[a] = std::min(low[a], c);
         high[a] = std::max(high[a], c);
       }

@@ -14,7 +14,7 @@
 namespace flashgs {
 
 // A permutation of the scene's Gaussians (order[k] = the scene index of the k-th) along a
-// Morton curve over 64^3 cells of their bounding box; within a cell, in scene order. A
+// Morton curve over 128^3 cells of their bounding box; within a cell, in scene order. A
 // non-finite position counts as the first cell's.
 std::vector<std::uint32_t> spatial_order(const Scene& scene);
 
