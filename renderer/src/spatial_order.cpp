@@ -14,8 +14,8 @@ namespace flashgs {
 namespace {
 
 // The order's grid: 128^3 cells. With 64^3, 200 shuffled copies of pc_playbot side by side
-// (100M) kept cells of ~1/4 of a copy across, and preprocess took 0.44 ms against 0.31 in
-// PlayCanvas's own order (PERFORMANCE.md v32).
+// (100M) kept cells of ~1/4 of a copy across, and their project stage took 0.44 ms against 0.31
+// in PlayCanvas's own order (0.37 with 128^3; PERFORMANCE.md v32).
 constexpr int kCellBits = 7;
 constexpr int kCellsPerAxis = 1 << kCellBits;
 constexpr std::uint32_t kCells = 1u << (3 * kCellBits);
@@ -100,7 +100,6 @@ struct CellGrid {
     return code;
   }
 };
-
 
 // The median over sampled runs of consecutive Gaussians (device order: scene Gaussian order[k],
 // or k where `order` is empty) of the most cells a run spans along an axis.
