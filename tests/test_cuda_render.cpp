@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <map>
 #include <numeric>
+#include <random>
 
 #include "flashgs/cuda_renderer.h"
 #include "flashgs/error.h"
@@ -801,8 +802,8 @@ TEST(CudaSpatialOrder, MovesGaussiansInMemoryOnly) {
     }
   }
   // Nine copies, shuffled: 270k Gaussians in no spatial order, which the default puts in order.
-  // The fp16 storages have other element sizes. (Each array fits one staging chunk here; scenes
-  // of many chunks were compared on the device by bench: 10M, same pairs and PSNR, v32.)
+  // The fp16 storages have other element sizes. (Each array fits one staging chunk here; the
+  // next test covers uploads of many chunks.)
   const auto large = std::make_shared<Scene>(tile_scene(*test::load_demo_scene(), 9));
   const auto large_shuffled = std::make_shared<Scene>(test::permuted(*large, test::random_order(large->size(), 4)));
   by_default = renderer_with_spatial_order(nullptr, large_shuffled);
@@ -816,6 +817,37 @@ TEST(CudaSpatialOrder, MovesGaussiansInMemoryOnly) {
     expect_same_counts("nine copies, " + o.label(), a.stats, b.stats);
     EXPECT_EQ(a.stats.scene_device_bytes, b.stats.scene_device_bytes + 4 * large_shuffled->size()) << o.label();
   }
+}
+
+// A reordered upload of many staging chunks (32 MB each, SceneUploader) scatters every chunk to
+// its own places: 2.3M shuffled Gaussians of SH degree 3 take 2 chunks of positions, rotations
+// and scales (16 bytes each) and 14 of SH bands (192 bytes; 7 as halves), and the frames are
+// the bytes of the same scene uploaded as stored.
+TEST(CudaSpatialOrder, ScattersUploadsOfManyChunks) {
+  FLASHGS_REQUIRE_CUDA();
+  const Scene demo = *test::load_demo_scene();
+  const int copies = static_cast<int>(2300000 / demo.size()) + 1;
+  Scene scene = tile_scene(demo, copies);
+  scene.sh_degree = 3;
+  scene.sh_rest.resize(scene.size() * scene.sh_rest_per_gaussian());
+  std::mt19937 random(11);
+  std::uniform_real_distribution<float> coefficient(-0.3f, 0.3f);
+  for (float& c : scene.sh_rest) c = coefficient(random);
+  const auto shuffled = std::make_shared<Scene>(test::permuted(scene, test::random_order(scene.size(), 6)));
+  auto by_default = renderer_with_spatial_order(nullptr, shuffled);
+  auto stored = renderer_with_spatial_order("0", shuffled);
+  const std::vector<Camera> cameras = test::load_demo_cameras();
+  std::vector<RenderOptions> storages = fp16_configs();
+  storages.insert(storages.begin(), RenderOptions{});
+  for (const Camera& camera : {cameras[0].resized(641, 359), cameras[2].resized(640, 360)})
+    for (const RenderOptions& o : storages) {
+      const std::string what = o.label() + " camera " + camera.name;
+      const Result a = render(*by_default, camera, o), b = render(*stored, camera, o);
+      EXPECT_GT(a.stats.kv_pairs, 0u) << what;
+      EXPECT_EQ(a.image.rgb, b.image.rgb) << what;
+      expect_same_counts(what, a.stats, b.stats);
+      EXPECT_EQ(a.stats.scene_device_bytes, b.stats.scene_device_bytes + 4 * shuffled->size()) << what;
+    }
 }
 
 // A scene that cannot fit in GPU memory is a flashgs::Error, not a crash, and the old scene

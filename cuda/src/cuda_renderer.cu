@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -53,6 +54,8 @@ bool cuda_available(std::string* why) {
 namespace {
 
 using cuda::check_cuda;
+using cuda::Clock;
+using cuda::seconds_since;
 
 // Owns one CUDA runtime handle (a stream, an event, pinned memory) and destroys it, so that a
 // constructor that throws half way leaks nothing.
@@ -200,6 +203,8 @@ class CudaRendererImpl final : public CudaRenderer {
     // FLASHGS_SPATIAL_ORDER=1 uploads every scene in spatial order, =0 none (unset: scenes whose
     // stored order is not spatially coherent, see flashgs/spatial_order.h).
     if (const char* order = std::getenv("FLASHGS_SPATIAL_ORDER")) spatial_order_ = std::atoi(order) != 0 ? kAlways : kNever;
+    // FLASHGS_UPLOAD_TIMES=1 prints where each set_scene's time went (stderr).
+    if (const char* times = std::getenv("FLASHGS_UPLOAD_TIMES")) print_upload_times_ = std::atoi(times) != 0;
     // FLASHGS_DENSE_TILES_FIRST=1 orders the tiles on every frame, =0 never (unset: when the
     // last frame's fullest tile outlasted a wave of the blend, see dense_order_pays).
     if (const char* dense = std::getenv("FLASHGS_DENSE_TILES_FIRST"))
@@ -250,7 +255,14 @@ class CudaRendererImpl final : public CudaRenderer {
   void set_scene(std::shared_ptr<const Scene> scene) override {
     if (!scene) throw Error("cuda renderer: null scene");
     upload_scene(std::move(scene), device_scene_.sh_half, device_scene_.shape_half);
+    const auto bounds_start = Clock::now();
     compute_bounds(*scene_);
+    if (print_upload_times_)
+      std::fprintf(stderr,
+                   "scene upload of %zu Gaussians (%u host threads): order %.3f s, allocation %.3f s, packing %.3f s, "
+                   "waiting for copies %.3f s, bounds %.3f s\n",
+                   scene_->size(), cuda::host_threads_for(scene_->size(), 1), upload_times_.order, upload_times_.allocation,
+                   upload_times_.packing, upload_times_.waiting, seconds_since(bounds_start));
   }
 
   // The scene on the device in the layout of DeviceScene: its SH as floats or (`sh_half`,
@@ -269,9 +281,12 @@ class CudaRendererImpl final : public CudaRenderer {
 
     // The device layout in spatial order where the stored one lacks it: device Gaussian i is
     // scene Gaussian order[i].
+    const auto order_start = Clock::now();
     std::vector<std::uint32_t> order;
     if (spatial_order_ == kAlways) order = spatial_order(*scene);
     else if (spatial_order_ == kAuto && n >= kSpatialOrderMinGaussians) order = spatial_order_where_it_pays(*scene);
+    upload_times_.order = seconds_since(order_start);
+    const auto allocation_start = Clock::now();
 
     // Allocate the new scene next to the old one; on failure the old one stays.
     DeviceBuffer new_pos, new_rot, new_scale, new_dc, new_rest, new_chunks, new_ids;
@@ -295,6 +310,7 @@ class CudaRendererImpl final : public CudaRenderer {
     // Packed into the device layout chunk by chunk (no host copy of the whole scene), each
     // pack(i) reading scene Gaussian i.
     check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation");
+    upload_times_.allocation = seconds_since(allocation_start);
     const Scene& sc = *scene;
     cuda::SceneUploader uploader(stream_);
     if (!order.empty()) {
@@ -365,6 +381,8 @@ class CudaRendererImpl final : public CudaRenderer {
     next.scene_ids = order.empty() ? nullptr : new_ids.as<std::uint32_t>();
     cuda::launch_chunk_bounds(next, next.chunks, stream_);
     uploader.finish();
+    upload_times_.packing = uploader.pack_seconds();
+    upload_times_.waiting = uploader.wait_seconds();
     // The buffers change owners, not addresses: `next` stays valid.
     scene_pos_.swap(new_pos);
     scene_rot_.swap(new_rot);
@@ -1056,6 +1074,12 @@ class CudaRendererImpl final : public CudaRenderer {
   enum Mode { kAuto, kAlways, kNever };
   Mode chunk_cull_ = kAuto;
   Mode spatial_order_ = kAuto;  // the scene's device layout in spatial order (upload_scene)
+  // Where the last upload's wall-clock seconds went, printed by set_scene where asked for.
+  struct UploadTimes {
+    double order = 0, allocation = 0, packing = 0, waiting = 0;
+  };
+  UploadTimes upload_times_;
+  bool print_upload_times_ = false;
   Mode dense_tiles_mode_ = kAuto;
   Mode bin_sort_ = kAuto;        // binned frames with compact keys sort per bin (launch_bin_pairs, launch_bin_blocks)
   bool bin_sort_frame_ = false;  // this frame does

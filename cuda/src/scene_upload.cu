@@ -83,9 +83,13 @@ void SceneUploader::upload(void* device, std::size_t element_bytes, std::size_t 
     const std::size_t end = std::min(count, begin + per_chunk);
     const int slot = m_next;
     m_next ^= 1;
+    const auto wait_start = Clock::now();
     check_cuda(cudaEventSynchronize(m_copied[slot]), "scene upload");  // the buffer's last copy landed
+    const auto pack_start = Clock::now();
+    m_wait_seconds += std::chrono::duration<double>(pack_start - wait_start).count();
     char* staging = static_cast<char*>(m_staging[slot]);
     pack_parallel(begin, end, element_bytes, staging, pack);
+    m_pack_seconds += seconds_since(pack_start);
     const std::size_t bytes = (end - begin) * element_bytes;
     if (!m_places) {
       check_cuda(cudaMemcpyAsync(static_cast<char*>(device) + begin * element_bytes, staging, bytes,
@@ -104,7 +108,11 @@ void SceneUploader::upload(void* device, std::size_t element_bytes, std::size_t 
   }
 }
 
-void SceneUploader::finish() { check_cuda(cudaStreamSynchronize(m_stream), "scene upload"); }
+void SceneUploader::finish() {
+  const auto start = Clock::now();
+  check_cuda(cudaStreamSynchronize(m_stream), "scene upload");
+  m_wait_seconds += seconds_since(start);
+}
 
 }  // namespace cuda
 }  // namespace flashgs

@@ -6,12 +6,18 @@
 
 #include <cuda_runtime_api.h>
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 
 namespace flashgs {
 namespace cuda {
+
+using Clock = std::chrono::steady_clock;
+inline double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 class SceneUploader {
  public:
@@ -34,6 +40,10 @@ class SceneUploader {
   void scatter_to(const std::uint32_t* places, void* device_staging);
   // Returns once every copy has landed.
   void finish();
+  // Wall-clock seconds so far spent packing on the host, and waiting for copies to land (a
+  // staging buffer to come free, or finish).
+  double pack_seconds() const { return m_pack_seconds; }
+  double wait_seconds() const { return m_wait_seconds; }
 
  private:
   static constexpr std::size_t kStagingBytes = kDeviceStagingBytes / 2;
@@ -43,6 +53,7 @@ class SceneUploader {
   void* m_staging[2] = {nullptr, nullptr};
   cudaEvent_t m_copied[2] = {nullptr, nullptr};
   int m_next = 0;
+  double m_pack_seconds = 0, m_wait_seconds = 0;
 };
 
 // places[order[i]] = i for i < count: where each scene Gaussian goes when device Gaussian i is
