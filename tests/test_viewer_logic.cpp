@@ -623,8 +623,32 @@ TEST(ViewerHeatmap, LegendTicksAreRoundValuesAtTheirPlaceOnTheScale) {
   EXPECT_EQ(lin, (std::vector<std::uint64_t>{0, 500, 1000, 1500, 1771}));
   EXPECT_NEAR(linear[1].position, 500.0f / 1771.0f, 1e-6f);
   EXPECT_EQ(fv::legend_ticks(0, true).back().value, 1u);  // an empty frame still has a scale
+  // 1000 sat 27 points left of 2087 on the 280-point bar: their labels ran together ("10002087").
+  std::vector<std::string> labels;
+  for (const auto& t : fv::legend_ticks(2087, true)) labels.push_back(t.label);
+  EXPECT_EQ(labels, (std::vector<std::string>{"0", "1", "10", "100", "2087"}));
+  EXPECT_EQ(fv::legend_ticks(123456, true).back().label, "123.5k");
   EXPECT_EQ(fv::legend_caption(16, true, false), "pairs per 16x16 tile, log scale");
   EXPECT_EQ(fv::legend_caption(16, false, true), "pairs per 16x16 tile, linear scale (max locked)");
+}
+
+// For any maximum, on either scale, neighbouring labels (centred on their ticks, in the UI's
+// monospace font) keep at least a character between them, and the maximum is always the last.
+TEST(ViewerHeatmap, LegendLabelsNeverRunTogether) {
+  const float char_fraction = fv::kLegendCharPoints / fv::kLegendBarPoints;
+  for (bool log_scale : {true, false})
+    for (std::uint64_t max = 1; max < 100000000; max = max * 3 / 2 + 1) {
+      const auto ticks = fv::legend_ticks(max, log_scale);
+      ASSERT_FALSE(ticks.empty());
+      EXPECT_EQ(ticks.back().value, max);
+      EXPECT_EQ(ticks.front().value, 0u) << max;
+      for (std::size_t k = 1; k < ticks.size(); ++k) {
+        const float gap = (ticks[k].position - ticks[k - 1].position) / char_fraction;
+        const float needed = 0.5f * float(ticks[k].label.size() + ticks[k - 1].label.size()) + 1.0f;
+        EXPECT_GE(gap, needed) << (log_scale ? "log" : "linear") << " max " << max << ": " << ticks[k - 1].label
+                               << " and " << ticks[k].label << " run together";
+      }
+    }
 }
 
 TEST(ViewerHeatmap, TheLockKeepsTheMaximumAcrossConfigurations) {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "count_text.h"
+
 namespace flashgs::viewer {
 
 // viridis at t = 0, 0.125, ..., 1: #440154 #472d7b #3b528b #2c728e #21908c
@@ -49,14 +51,19 @@ std::vector<LegendTick> legend_ticks(std::uint64_t max_count, bool log_scale) {
       if (m * decade >= raw) { step = m * decade; break; }
     for (double v = step; v < double(max_count); v += step) values.push_back(std::uint64_t(v));
   }
+  // Two labels centred on their ticks leave a character between them when the ticks lie half
+  // their lengths and one character apart.
+  const float char_fraction = kLegendCharPoints / kLegendBarPoints;
+  const auto clear_of = [&](const LegendTick& a, const LegendTick& b) {
+    return std::abs(b.position - a.position) >= char_fraction * (0.5f * float(a.label.size() + b.label.size()) + 1.0f);
+  };
+  const LegendTick top{max_count, 1.0f, human_count(double(max_count))};
   std::vector<LegendTick> ticks;
-  const float max_position = 1.0f;
   for (std::uint64_t v : values) {
-    const float p = heat_position(double(v), double(max_count), log_scale);
-    if (max_position - p < 0.08f) continue;  // its label would run into the maximum's
-    ticks.push_back({v, p});
+    const LegendTick tick{v, heat_position(double(v), double(max_count), log_scale), human_count(double(v))};
+    if (clear_of(tick, top) && (ticks.empty() || clear_of(ticks.back(), tick))) ticks.push_back(tick);
   }
-  ticks.push_back({max_count, max_position});
+  ticks.push_back(top);
   return ticks;
 }
 

@@ -20,13 +20,21 @@ std::array<float, 3> heat_colour(float t);
 // Where a pair count sits on the scale, 0..1: log(1 + c) / log(1 + max), or c / max.
 float heat_position(double count, double max_count, bool log_scale);
 
+// The legend bar is kLegendBarPoints wide and its labels are in ImGui's default font, a
+// monospace one of kLegendCharPoints a character; both grow with the UI scale, so the bar holds
+// the same labels at any scale.
+inline constexpr float kLegendBarPoints = 280.0f;
+inline constexpr float kLegendCharPoints = 7.0f;
+
 struct LegendTick {
   std::uint64_t value = 0;
   float position = 0;  // 0..1 along the bar
+  std::string label;   // centred under the tick
 };
 
 // Ticks at round values: 0, 1, 10, 100, ... (log) or 0 and steps of 1, 2 or 5 x 10^k (linear),
-// then the maximum itself; a round tick too close to the maximum's label is left out.
+// then the maximum itself. A round tick whose label would come within a character of its
+// neighbour's (the maximum's included) is left out.
 std::vector<LegendTick> legend_ticks(std::uint64_t max_count, bool log_scale);
 
 // "pairs per 16x16 tile, log scale (max locked)": what the bar measures and how.

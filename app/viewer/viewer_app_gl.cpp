@@ -835,7 +835,7 @@ void ViewerApp::collect_frame() {
 void ViewerApp::legend_rect(int fb_w, int fb_h, float* rect) const {
   // Bottom right, clear of the main panel (top left) and the statistics (top right).
   const float u = m_ui_scale * m_window->framebuffer_scale();
-  rect[0] = float(fb_w) - 300.0f * u;
+  rect[0] = float(fb_w) - (20.0f + kLegendBarPoints) * u;
   // Room below the bar for the tick labels, above it for the caption.
   rect[1] = float(fb_h) - 46.0f * u;
   rect[2] = float(fb_w) - 20.0f * u;

@@ -8,6 +8,7 @@
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
+#include "count_text.h"
 #include "heatmap_legend.h"
 #include "help_overlay_ui.h"
 #include "widget_places_ui.h"
@@ -24,14 +25,6 @@ float ui(float v) { return v * g_ui; }
 // picture visible beside them (at 800x450 they start folded; ImGui keeps what the user chose).
 ImGuiTreeNodeFlags open_if_roomy() {
   return ImGui::GetMainViewport()->WorkSize.y >= ui(600) ? ImGuiTreeNodeFlags_DefaultOpen : 0;
-}
-
-std::string human_count(double v) {
-  char text[32];
-  if (v >= 1e6) std::snprintf(text, sizeof text, "%.2fM", v / 1e6);
-  else if (v >= 1e4) std::snprintf(text, sizeof text, "%.1fk", v / 1e3);
-  else std::snprintf(text, sizeof text, "%.0f", v);
-  return text;
 }
 
 // Every slider clamps what is typed into it (Ctrl+click) to its range, not just what is dragged.
@@ -447,8 +440,10 @@ void stats_window(const UiModel& m) {
   if (const FrameStats* st = m.stats) {
     ImGui::Separator();
     ImGui::TextDisabled("last frame");
-    ImGui::Text("%.1f ms   kv pairs %s   visible %s / %s", m.last_frame_ms, human_count(double(st->kv_pairs)).c_str(),
-                human_count(double(st->visible)).c_str(), human_count(double(st->gaussians)).c_str());
+    // Two lines: one did not fit the window's fixed width once frames took 10 ms or more.
+    ImGui::Text("%.1f ms   kv pairs %s", m.last_frame_ms, human_count(double(st->kv_pairs)).c_str());
+    ImGui::Text("visible %s of %s Gaussians", human_count(double(st->visible)).c_str(),
+                human_count(double(st->gaussians)).c_str());
     ImGui::Text("culled: near %s  off-screen %s", human_count(double(st->culled_near)).c_str(),
                 human_count(double(st->culled_offscreen)).c_str());
     ImGui::Text("        low-opacity %s  degenerate %s", human_count(double(st->culled_low_opacity)).c_str(),
@@ -494,9 +489,8 @@ void legend_labels(const UiModel& m, const ViewerSettings& s) {
   for (const LegendTick& t : legend_ticks(m.heatmap_max, s.heatmap_log)) {
     const float x = r[0] + t.position * (r[2] - r[0]);
     draw->AddLine(ImVec2(x, r[3]), ImVec2(x, r[3] + ui(4)), white, ui(1.0f));
-    const std::string label = human_count(double(t.value));
-    const float w = ImGui::CalcTextSize(label.c_str()).x;
-    draw->AddText(ImVec2(x - 0.5f * w, r[3] + ui(4)), white, label.c_str());
+    const float w = ImGui::CalcTextSize(t.label.c_str()).x;
+    draw->AddText(ImVec2(x - 0.5f * w, r[3] + ui(4)), white, t.label.c_str());
   }
 }
 
@@ -516,7 +510,8 @@ void compare_labels(const UiModel& m, const ViewerSettings& s) {
   char text[160];
   if (s.compare_view == CompareView::difference) {
     std::snprintf(text, sizeof text, "|%s - %s| x %.0f", c->right_label.c_str(), c->left_label.c_str(), m.difference_factor);
-    label(vp->WorkPos.x + ui(12), text);
+    // Centred above the heads-up line: at the left edge it was drawn over the panel's text.
+    label(vp->WorkPos.x + 0.5f * (vp->WorkSize.x - ImGui::CalcTextSize(text).x), text);
     return;
   }
   const float at = vp->WorkPos.x + m.divider * vp->WorkSize.x;
