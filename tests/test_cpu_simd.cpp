@@ -216,13 +216,14 @@ TEST(CpuSimdBlend, AlphaWithinItsBoundOnEveryTarget) { on_every_target(expect_si
 
 // The vector exact tile test (cpu_emit_simd.cpp) keeps the tiles the scalar test keeps, in
 // the same order, on every target this CPU runs: footprints from a pixel to wider than the
-// image, needles included, on an odd-sized and a 1080p image (partial tiles at the edges).
+// image, needles included (narrow boxes' tiles are packed across rows), on an odd-sized and a
+// 1080p image (partial tiles at the edges).
 void expect_exact_box_tiles_match_the_scalar_test(const std::string& what) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> uni(0.0f, 1.0f);
   std::normal_distribution<float> normal(0.0f, 1.0f);
   const float eye[3] = {0.0f, 0.0f, -3.0f}, target[3] = {0.0f, 0.0f, 0.0f}, up[3] = {0.0f, -1.0f, 0.0f};
-  std::uint64_t boxes = 0, wide_boxes = 0, kept = 0;
+  std::uint64_t boxes = 0, wide_boxes = 0, narrow_tall_boxes = 0, kept = 0;
   for (const Camera& camera : {look_at_camera(eye, target, up, 93, 61, 60.0f), look_at_camera(eye, target, up, 1920, 1080, 60.0f)}) {
     const gm::CameraParams cam = make_camera_params(camera);
     const gm::GeometryParams geo = make_geometry_params(RenderOptions{});
@@ -241,6 +242,8 @@ void expect_exact_box_tiles_match_the_scalar_test(const std::string& what) {
       if (gm::project(cam, geo, position, scale, quat, 0.02f + 0.98f * uni(rng), f) != gm::kVisible) continue;
       ++boxes;
       wide_boxes += f.tile_x1 - f.tile_x0 > 16 ? 1 : 0;
+      // Narrower than any vector and more tiles than one holds: packed across rows.
+      narrow_tall_boxes += f.tile_x1 - f.tile_x0 < 4 && (f.tile_x1 - f.tile_x0) * (f.tile_y1 - f.tile_y0) > 16 ? 1 : 0;
       // Sentinels past the room the function asks for: it must not write there.
       const std::size_t room = cpu::exact_box_tiles_room(f);
       constexpr std::uint32_t kSentinel = 0xdeadbeefu;
@@ -261,6 +264,7 @@ void expect_exact_box_tiles_match_the_scalar_test(const std::string& what) {
   }
   EXPECT_GT(boxes, 5000u) << what;
   EXPECT_GT(wide_boxes, 200u) << what << ": too few boxes wider than a vector";
+  EXPECT_GT(narrow_tall_boxes, 50u) << what << ": too few narrow boxes of several vectors";
   EXPECT_GT(kept, 100000u) << what;
 }
 

@@ -14,9 +14,11 @@ namespace {
 // several chunks each, taken dynamically, even that out.
 constexpr int kChunksPerThread = 8;
 constexpr std::int64_t kMinChunkGaussians = 4096;
-// Boxes at least this many tiles wide take the vector test (exact_box_tiles); narrower ones
-// the scalar test, which a call and a vector of mostly idle lanes would not beat.
-constexpr int kVectorBoxWidth = 4;
+// Boxes of at least this many tiles take the vector test (exact_box_tiles), smaller ones the
+// scalar test: a call per box and a vector's latency chain cost more than a few scalar tests
+// (pc_playbot 1080p, 2 threads: emit 13.1 ms with the vector test from 4 tiles wide, 10.4-10.6
+// from 8 tiles, 15.7-16.4 from 2; batching several boxes' tiles into vectors, 11.2-11.9).
+constexpr int kVectorBoxTiles = 8;
 
 }  // namespace
 
@@ -64,7 +66,7 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
         const std::uint64_t key_low =
             (static_cast<std::uint64_t>(gm::depth_bits(f.depth)) << 32) | static_cast<std::uint64_t>(i);
         const std::size_t emitted_before = out_keys.size();
-        if (exact && f.tile_x1 - f.tile_x0 >= kVectorBoxWidth) {
+        if (exact && (f.tile_x1 - f.tile_x0) * (f.tile_y1 - f.tile_y0) >= kVectorBoxTiles) {
           const std::size_t room = exact_box_tiles_room(f);
           if (box_tiles.size() < room) box_tiles.resize(room);
           const std::size_t touched = exact_box_tiles(f, width, height, tiles_x, box_tiles.data());

@@ -1,5 +1,6 @@
-// CPU emit stage, SIMD exact tile test: gm::footprint_touches_tile on a vector of a box row's
-// tiles at a time (Google Highway, compiled for every x86 target, dispatched at run time).
+// CPU emit stage, SIMD exact tile test: gm::footprint_touches_tile on a vector of a box's tiles
+// at a time, a row's or, in a box narrower than a vector, several rows' (Google Highway,
+// compiled for every x86 target, dispatched at run time).
 //
 // The decisions are the scalar test's, bit for bit (tests/test_cpu_simd.cpp): each operation is
 // the scalar code's in its order, a Mul then an Add, never a MulAdd (this file is compiled with
@@ -36,39 +37,67 @@ HWY_INLINE FloatVec whitened_q(const FloatVec (&w)[4], FloatVec dx, FloatVec dy)
   return hn::Add(hn::Mul(u, u), hn::Mul(v, v));
 }
 
+// The test for a vector of tiles (tile_x, tile_y), as gm::ellipse_touches_tile per lane.
+struct FootprintVectors {
+  FloatVec w[4], slope_x, slope_y, threshold, mean_x, mean_y, last_x, last_y;
+};
+
+HWY_INLINE hn::Mask<FloatTag> touches_tiles(const FootprintVectors& f, hn::Vec<hn::RebindToSigned<FloatTag>> tile_x,
+                                            hn::Vec<hn::RebindToSigned<FloatTag>> tile_y) {
+  const FloatTag d;
+  const hn::RebindToSigned<FloatTag> di;
+  const FloatVec zero = hn::Zero(d), tile_span = hn::Set(d, static_cast<float>(gm::kTileSize - 1));
+  const FloatVec x0 = hn::ConvertTo(d, hn::Mul(tile_x, hn::Set(di, gm::kTileSize)));
+  const FloatVec y0 = hn::ConvertTo(d, hn::Mul(tile_y, hn::Set(di, gm::kTileSize)));
+  const FloatVec x1 = min_as_scalar(hn::Add(x0, tile_span), f.last_x);
+  const FloatVec y1 = min_as_scalar(hn::Add(y0, tile_span), f.last_y);
+  const FloatVec dx0 = hn::Sub(x0, f.mean_x), dx1 = hn::Sub(x1, f.mean_x);
+  const FloatVec dy0 = hn::Sub(y0, f.mean_y), dy1 = hn::Sub(y1, f.mean_y);
+  const FloatVec near_x = clamp(zero, dx0, dx1), near_y = clamp(zero, dy0, dy1);
+  const FloatVec q_on_x_edge = whitened_q(f.w, near_x, clamp(hn::Mul(f.slope_x, near_x), dy0, dy1));
+  const FloatVec q_on_y_edge = whitened_q(f.w, clamp(hn::Mul(f.slope_y, near_y), dx0, dx1), near_y);
+  return hn::Le(min_as_scalar(q_on_x_edge, q_on_y_edge), f.threshold);
+}
+
 std::size_t ExactBoxTiles(const gm::Footprint& f, int width, int height, int tiles_x, std::uint32_t* out) {
   const FloatTag d;
   const hn::RebindToSigned<FloatTag> di;
   const hn::RebindToUnsigned<FloatTag> du;
   const int lanes = static_cast<int>(hn::Lanes(d));
-  const FloatVec w[4] = {hn::Set(d, f.whiten[0]), hn::Set(d, f.whiten[1]), hn::Set(d, f.whiten[2]),
-                         hn::Set(d, f.whiten[3])};
-  const FloatVec slope_x = hn::Set(d, f.edge_slope_x), threshold = hn::Set(d, f.threshold);
-  const FloatVec mean_x = hn::Set(d, f.mean_x), zero = hn::Zero(d);
-  const FloatVec tile_span = hn::Set(d, static_cast<float>(gm::kTileSize - 1));
-  const FloatVec last_x = hn::Set(d, static_cast<float>(width - 1));
+  const FootprintVectors fv{{hn::Set(d, f.whiten[0]), hn::Set(d, f.whiten[1]), hn::Set(d, f.whiten[2]),
+                             hn::Set(d, f.whiten[3])},
+                            hn::Set(d, f.edge_slope_x),
+                            hn::Set(d, f.edge_slope_y),
+                            hn::Set(d, f.threshold),
+                            hn::Set(d, f.mean_x),
+                            hn::Set(d, f.mean_y),
+                            hn::Set(d, static_cast<float>(width - 1)),
+                            hn::Set(d, static_cast<float>(height - 1))};
+  const auto tiles_x_v = hn::Set(di, tiles_x);
   std::size_t count = 0;
-  for (int ty = f.tile_y0; ty < f.tile_y1; ++ty) {
-    // The row's half of ellipse_touches_tile and whitened_ellipse_meets_rect, once per row.
-    const float y0 = static_cast<float>(ty * gm::kTileSize);
-    const float y1 = gm::minf(y0 + (gm::kTileSize - 1), static_cast<float>(height - 1));
-    const float dy0 = y0 - f.mean_y, dy1 = y1 - f.mean_y;
-    const float near_y = gm::clampf(0.0f, dy0, dy1);
-    const FloatVec dy0_v = hn::Set(d, dy0), dy1_v = hn::Set(d, dy1), near_y_v = hn::Set(d, near_y);
-    const FloatVec y_edge_x = hn::Set(d, f.edge_slope_y * near_y);
-    const std::uint32_t row_start = static_cast<std::uint32_t>(ty) * static_cast<std::uint32_t>(tiles_x);
-    for (int tx = f.tile_x0; tx < f.tile_x1; tx += lanes) {
-      const FloatVec x0 = hn::ConvertTo(d, hn::Mul(hn::Iota(di, tx), hn::Set(di, gm::kTileSize)));
-      const FloatVec x1 = min_as_scalar(hn::Add(x0, tile_span), last_x);
-      const FloatVec dx0 = hn::Sub(x0, mean_x), dx1 = hn::Sub(x1, mean_x);
-      const FloatVec near_x = clamp(zero, dx0, dx1);
-      const FloatVec q_on_x_edge = whitened_q(w, near_x, clamp(hn::Mul(slope_x, near_x), dy0_v, dy1_v));
-      const FloatVec q_on_y_edge = whitened_q(w, clamp(y_edge_x, dx0, dx1), near_y_v);
-      const auto meets = hn::And(hn::Le(min_as_scalar(q_on_x_edge, q_on_y_edge), threshold),
-                                 hn::FirstN(d, static_cast<std::size_t>(f.tile_x1 - tx)));
-      const auto tiles = hn::Iota(du, row_start + static_cast<std::uint32_t>(tx));
-      count += hn::CompressStore(tiles, hn::RebindMask(du, meets), du, out + count);
-    }
+  const auto keep = [&](hn::Vec<decltype(di)> tx, hn::Vec<decltype(di)> ty, int valid) {
+    const auto meets = hn::And(touches_tiles(fv, tx, ty), hn::FirstN(d, static_cast<std::size_t>(valid)));
+    const auto tiles = hn::BitCast(du, hn::Add(hn::Mul(ty, tiles_x_v), tx));
+    count += hn::CompressStore(tiles, hn::RebindMask(du, meets), du, out + count);
+  };
+  const int box_w = f.tile_x1 - f.tile_x0, box_h = f.tile_y1 - f.tile_y0;
+  if (box_w >= lanes) {  // a vector of a row's tiles at a time
+    for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
+      for (int tx = f.tile_x0; tx < f.tile_x1; tx += lanes) keep(hn::Iota(di, tx), hn::Set(di, ty), f.tile_x1 - tx);
+    return count;
+  }
+  // A narrow box: a vector of its tiles in row-major order, across rows. Tile k of the box is
+  // at row k / box_w, found as floor((k + 0.5) / box_w) in float: k + 0.5 lies at least 0.5 from
+  // a multiple of box_w, and the two roundings move the quotient by less than k 2^-23 / box_w,
+  // below that margin for k < 2^22 (the box has at most 15 x 4096 tiles).
+  const int area = box_w * box_h;
+  const FloatVec inv_w = hn::Set(d, 1.0f / static_cast<float>(box_w)), half = hn::Set(d, 0.5f);
+  const auto box_w_v = hn::Set(di, box_w), x0 = hn::Set(di, f.tile_x0), y0 = hn::Set(di, f.tile_y0);
+  for (int k = 0; k < area; k += lanes) {
+    const auto index = hn::Iota(di, k);
+    const auto row = hn::ConvertTo(di, hn::Floor(hn::Mul(hn::Add(hn::ConvertTo(d, index), half), inv_w)));
+    const auto column = hn::Sub(index, hn::Mul(row, box_w_v));
+    keep(hn::Add(x0, column), hn::Add(y0, row), area - k);
   }
   return count;
 }

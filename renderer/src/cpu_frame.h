@@ -124,7 +124,7 @@ inline void set_row_pruning(BlendGaussian& g) {
 void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats);
 // The tiles of f's box that gm::footprint_touches_tile keeps, as tile indices in row-major
 // order, into out, which must hold exact_box_tiles_room(f) values; returns how many
-// (cpu_emit_simd.cpp: a vector of a row's tiles at a time, the scalar test's decisions).
+// (cpu_emit_simd.cpp: a vector of tiles at a time, the scalar test's decisions).
 std::size_t exact_box_tiles(const gm::Footprint& f, int width, int height, int tiles_x, std::uint32_t* out);
 std::size_t exact_box_tiles_room(const gm::Footprint& f);
 // Sorts by tile, then depth, then Gaussian id; fills tile_start (the ranges stage).
