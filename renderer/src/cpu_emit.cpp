@@ -16,8 +16,9 @@ constexpr int kChunksPerThread = 8;
 constexpr std::int64_t kMinChunkGaussians = 4096;
 // Boxes of at least this many tiles take the vector test (exact_box_tiles), smaller ones the
 // scalar test: a call per box and a vector's latency chain cost more than a few scalar tests
-// (pc_playbot 1080p, 2 threads: emit 13.1 ms with the vector test from 4 tiles wide, 10.4-10.6
-// from 8 tiles, 15.7-16.4 from 2; batching several boxes' tiles into vectors, 11.2-11.9).
+// (pc_playbot 1080p, 2 threads of a Zen 4 VM: emit 13.1 ms with the vector test for boxes 4+
+// tiles wide, 9.5-9.9 for boxes of 8+ tiles, 9.4-9.6 from 5, 10.4 from 3; batching several
+// boxes' tiles into shared vectors, gathered by lane, 11.2-11.9).
 constexpr int kVectorBoxTiles = 8;
 
 }  // namespace
