@@ -1,15 +1,17 @@
 // CPU blend, SIMD kernel: the scalar kernel's rules on a vector of pixels of one tile row at a
 // time (Google Highway, compiled for every x86 target and dispatched at run time).
 //
-// Per pixel it runs the scalar kernel's operations, with two differences in rounding: u, w, q
-// and the colour sums use fused multiply-adds, and alpha = opacity e^power is one exp2,
+// Per pixel it follows the scalar kernel, with three differences in rounding: the exponent is
+// formed along the row (q = the row's smallest q plus conic_a (x - x*)^2, see the batch's
+// records), the colour sums use fused multiply-adds, and alpha = opacity e^power is one exp2,
 // 2^(q * -log2(e)/2 + log2 opacity), by a short polynomial (see exp2_nonpositive): relative
 // error under kSimdAlphaMaxRelError (2e-6; glibc's expf and the product with opacity: about
 // 1.8e-7). Such an error can move alpha across 1/255 or T across 1e-4, the same flips as
 // between the CPU and CUDA backends (see test_cuda_render.cpp), so the images stay within that
-// bound of the scalar kernel's (test_cpu_simd.cpp, every real scene). The pruning margins
-// (0.5 in q, a pixel) dwarf these roundings. For a given CPU (target) and any thread count the
-// bytes are the same.
+// bound of the scalar kernel's (test_cpu_simd.cpp, every real scene), and as close to the fp64
+// reference as the scalar kernel's (test_cpu_render.cpp). The pruning margins (0.5 in q, a
+// pixel) dwarf these roundings. For a given CPU (target) and any thread count the bytes are
+// the same.
 #include <strings.h>
 
 #include <algorithm>
@@ -158,7 +160,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
 
   // The tile's vectors ("slots"): lane group j of row y is slot j * kTileSize + y (16 rows x at
   // most 4 groups), bit `slot` of a 64-bit set. Per slot, one vector each, next to each other
-  // (one base address per slot): the pixels' image x, transmittance, colour, and whether they
+  // (one base address per slot): the pixels' column in the tile, transmittance, colour, and whether they
   // still blend (all bits set) - pixels outside the image start finished. A slot whose lanes
   // have all finished leaves live_slots (and slot_live, the same as a word per slot, which the
   // span pass reads a vector of rows at a time), and the tile stops when none is left.
@@ -181,7 +183,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       const int slot = v * gm::kTileSize + y;
       const auto column = hn::Iota(d, static_cast<float>(v * lanes_i));
       const auto inside = hn::And(hn::Lt(column, tile_width), y < tile_h ? hn::FirstN(d, lanes) : hn::FirstN(d, 0));
-      hn::Store(hn::Add(column, hn::Set(d, static_cast<float>(x_begin))), d, slot_field(slot, kX));
+      hn::Store(column, d, slot_field(slot, kX));
       hn::Store(hn::Set(d, 1.0f), d, slot_field(slot, kT));
       hn::Store(hn::Zero(d), d, slot_field(slot, kRed));
       hn::Store(hn::Zero(d), d, slot_field(slot, kGreen));
@@ -199,17 +201,23 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
   // so it is loaded and stored once per batch instead of once per Gaussian. Per pixel the
   // Gaussians and the operations are those of one Gaussian at a time, in the same order.
   // Per batch member, one record: its broadcast constants (one vector each, read as memory
-  // operands; one spare, so that an AVX2 record is 512 bytes, one shift from the member's
-  // index), then its rows' terms of u and w (whiten[1] dy, whiten[3] dy; a vector of rows from
-  // y_first may run past row 15). Per slot, the set of members that touch it (bit j: member
-  // j), written by the span pass a vector of rows at a time. 32 members: 7.6% fewer
-  // instructions than one Gaussian at a time at 1080p (callgrind, pc_playbot), 16: 4.1%.
+  // operands), then per row the two terms of its exponent (a vector of rows from y_first may
+  // run past row 15). Along a row at offset dy, q is smallest at column x* = mean_x + row_slope
+  // dy, where it is row_q_coeff dy^2, and grows as conic_a (x - x*)^2 (conic_a = w0^2 + w2^2):
+  // so the exponent q * -log2(e)/2 + log2 opacity is a * (x - x*)^2 + c with
+  // a = conic_a * -log2(e)/2 per member and c = row_q_coeff dy^2 * -log2(e)/2 + log2 opacity per
+  // row, three operations per pixel instead of the whitened form's six. Both terms are <= 0, so
+  // their sum does not cancel, and x - x* is taken in the tile's columns from the member's
+  // centre relative to the tile (its float roundings are those of the whitened form's terms).
+  // Per slot, the set of members that touch it (bit j: member j), written by the span pass a
+  // vector of rows at a time. 32 members: 7.6% fewer instructions than one Gaussian at a time
+  // at 1080p (callgrind, pc_playbot), 16: 4.1%.
   constexpr int kBatch = 32;
   static_assert(kBatch <= 32, "member sets of 32 bits");
-  enum MemberField { kCentreX, kW0, kW2, kLog2Opacity, kMemberRed, kMemberGreen, kMemberBlue, kMemberFields = 8 };
+  enum MemberField { kQuadratic, kMemberRed, kMemberGreen, kMemberBlue, kMemberFields };
   constexpr std::size_t kRowTerms = 2 * gm::kTileSize;
-  const std::size_t u_terms = kMemberFields * lanes, w_terms = u_terms + kRowTerms;
-  const std::size_t member_stride = w_terms + kRowTerms;
+  const std::size_t centre_terms = kMemberFields * lanes, offset_terms = centre_terms + kRowTerms;
+  const std::size_t member_stride = offset_terms + kRowTerms;
   HWY_ALIGN float member_records[kBatch * (kMemberFields * gm::kTileSize + 2 * kRowTerms)];
   HWY_ALIGN std::uint32_t slot_members[kMaxSlots + gm::kTileSize] = {};
   const int slot_count = groups_per_row * gm::kTileSize;
@@ -235,8 +243,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         // The scalar kernel's row spans, computed the same way for a vector of rows at a time.
         const auto q_reach = hn::Set(d, gauss.q_cut + 0.5f), coeff = hn::Set(d, gauss.row_q_coeff);
         const auto slope = hn::Set(d, gauss.row_slope), inv_conic_a = hn::Set(d, gauss.inv_conic_a);
-        const auto mean_y_v = hn::Set(d, mean_y), w1 = hn::Set(d, gauss.whiten[1]), w3 = hn::Set(d, gauss.whiten[3]);
-        const auto centre_x = hn::Set(d, mean_x);
+        const auto mean_y_v = hn::Set(d, mean_y), log2_opacity = hn::Set(d, gauss.log2_opacity);
+        const auto centre_x = hn::Set(d, mean_x), local_centre_x = hn::Set(d, mean_x - static_cast<float>(x_begin));
         const auto member_bit = hn::Set(du, 1u << members);
         for (int row = y_first; row <= y_last; row += lanes_i) {
           const auto dy = hn::Sub(hn::Iota(d, static_cast<float>(y_begin + row)), mean_y_v);
@@ -250,8 +258,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
           // last, and rows past y_last (past the tile, or outside its row range).
           const auto touched = hn::And(hn::FirstN(d, static_cast<std::size_t>(y_last + 1 - row)),
                                        hn::And(hn::Le(row_q, q_reach), hn::Le(first, last)));
-          hn::StoreU(hn::Mul(w1, dy), d, member + u_terms + row);
-          hn::StoreU(hn::Mul(w3, dy), d, member + w_terms + row);
+          hn::StoreU(hn::Add(local_centre_x, hn::Mul(slope, dy)), d, member + centre_terms + row);
+          hn::StoreU(hn::MulAdd(row_q, minus_half_log2e, log2_opacity), d, member + offset_terms + row);
           // Group j holds columns [j lanes, (j + 1) lanes): the span meets it unless it ends
           // before or starts after.
           for (int v = 0; v < groups_per_row; ++v) {
@@ -266,10 +274,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         }
       }
       if (hn::AllTrue(du, hn::Eq(touches_any, no_members))) continue;  // no live slot: not a member
-      hn::Store(hn::Set(d, mean_x), d, member + kCentreX * lanes);
-      hn::Store(hn::Set(d, gauss.whiten[0]), d, member + kW0 * lanes);
-      hn::Store(hn::Set(d, gauss.whiten[2]), d, member + kW2 * lanes);
-      hn::Store(hn::Set(d, gauss.log2_opacity), d, member + kLog2Opacity * lanes);
+      const float conic_a = gauss.whiten[0] * gauss.whiten[0] + gauss.whiten[2] * gauss.whiten[2];
+      hn::Store(hn::Set(d, conic_a * -kHalfLog2E), d, member + kQuadratic * lanes);
       hn::Store(hn::Set(d, gauss.rgb[0]), d, member + kMemberRed * lanes);
       hn::Store(hn::Set(d, gauss.rgb[1]), d, member + kMemberGreen * lanes);
       hn::Store(hn::Set(d, gauss.rgb[2]), d, member + kMemberBlue * lanes);
@@ -299,16 +305,13 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
       for (; slot_batch != 0; slot_batch &= slot_batch - 1u) {
         const std::size_t offset = hwy::Num0BitsBelowLS1Bit_Nonzero32(slot_batch) * member_stride;
         const float* constants = member_records + offset;
-        const auto dx = hn::Sub(x, hn::Load(d, constants + kCentreX * lanes));
-        const auto u = hn::MulAdd(hn::Load(d, constants + kW0 * lanes), dx, hn::Set(d, constants[u_terms + row]));
-        const auto w = hn::MulAdd(hn::Load(d, constants + kW2 * lanes), dx, hn::Set(d, constants[w_terms + row]));
-        const auto q = hn::MulAdd(u, u, hn::Mul(w, w));
+        const auto dx = hn::Sub(x, hn::Set(d, constants[centre_terms + row]));
+        const auto exponent = hn::MulAdd(hn::Mul(dx, dx), hn::Load(d, constants + kQuadratic * lanes),
+                                         hn::Set(d, constants[offset_terms + row]));
         // Only the exact test: a lane outside the row's span or below power_cut has alpha <
         // 1/255 for certain (the margins the scalar kernel's pruning relies on), so it fails
         // this test as surely as it would have been skipped there.
-        const auto alpha = hn::Min(
-            alpha_max,
-            exp2_nonpositive(d, hn::MulAdd(q, minus_half_log2e, hn::Load(d, constants + kLog2Opacity * lanes))));
+        const auto alpha = hn::Min(alpha_max, exp2_nonpositive(d, exponent));
         const auto visible = hn::Ge(alpha, alpha_min);
         const auto next_t = hn::Mul(t, hn::Sub(one, alpha));
         // A live lane whose alpha passes but whose T would drop below the minimum finishes
