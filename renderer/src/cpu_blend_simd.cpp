@@ -88,11 +88,13 @@ void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, Til
 // would). x = n + f with n = round(x), f in [-0.5, 0.5] (exact); 2^f by a degree-5 polynomial
 // (Chebyshev interpolation, relative error 2.2e-7 in float with FMA); 2^n added to the
 // exponent. n comes from adding 1.5 * 2^23, which rounds x to an integer in the low mantissa
-// bits (so n << 23 is those bits shifted up; no float-to-int conversion). The blend's
-// x = q * -log2(e)/2 + log2 opacity is at most 0 (q >= 0, opacity <= 1); where alpha >= 1/255
+// bits (so n << 23 is those bits shifted up; no float-to-int conversion). The exponent
+// q * -log2(e)/2 + log2 opacity is at most 0 (q >= 0, opacity <= 1); where alpha >= 1/255
 // is possible both terms lie in [-8, 0], so rounding the argument (the constant: 8 * 2^-24;
 // log2 opacity: an ulp of 8; the FMA: half one) moves x by 1.25 * 2^-20 and alpha by 8.3e-7
 // at most: 1.05e-6 in all, under kSimdAlphaMaxRelError (targets without FMA round once more).
+// The clamp stays: without it a lane far outside a Gaussian gets a garbage alpha, possibly a
+// denormal, whose arithmetic costs a microcode assist on Intel CPUs even where masked off.
 template <class D, class V>
 HWY_INLINE V exp2_nonpositive(D d, V x) {
   const hn::RebindToSigned<D> di;
@@ -313,7 +315,10 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         // this test as surely as it would have been skipped there.
         const auto alpha = hn::Min(alpha_max, exp2_nonpositive(d, exponent));
         const auto visible = hn::Ge(alpha, alpha_min);
-        const auto next_t = hn::Mul(t, hn::Sub(one, alpha));
+        // T - alpha T with one rounding: the scalar kernel's T (1 - alpha) where 1 - alpha is
+        // exact (alpha >= 1/2), within an ulp elsewhere, and its product is the weight.
+        const auto weight_if_blended = hn::Mul(alpha, t);
+        const auto next_t = hn::NegMulAdd(alpha, t, t);
         // A live lane whose alpha passes but whose T would drop below the minimum finishes
         // instead of blending; the others that pass blend.
         const auto too_dark = hn::Lt(next_t, t_min);
@@ -321,7 +326,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
         live = hn::AndNot(hn::And(visible, too_dark), live);
         // Lanes that do not blend add colour * 0: the same bytes as leaving them (colours
         // start at +0 and stay >= 0), for one select instead of three.
-        const auto weight = hn::IfThenElseZero(blends, hn::Mul(alpha, t));
+        const auto weight = hn::IfThenElseZero(blends, weight_if_blended);
         red = hn::MulAdd(hn::Load(d, constants + kMemberRed * lanes), weight, red);
         green = hn::MulAdd(hn::Load(d, constants + kMemberGreen * lanes), weight, green);
         blue = hn::MulAdd(hn::Load(d, constants + kMemberBlue * lanes), weight, blue);
