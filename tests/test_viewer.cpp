@@ -143,8 +143,11 @@ RunResult run_live_viewer(const std::string& prefix, const std::string& name, co
                 "  return 1\n"
                 "}\n"
                 "wait_for() { wait_count \"$1\" 1; }\n"
+                // Keys go to the focused window: the viewer's, as a window manager would make it
+                // (x11_input focus: GLFW's own request can miss on a loaded machine).
                 "press() {\n"
                 "  n=$(grep -cF -- \"$2\" \"$log\")\n"
+                "  \"$input\" focus 1 1 || return 1\n"
                 "  \"$input\" down \"$1\" || return 1\n"
                 "  wait_count \"$2\" $((n + 2))\n"
                 "}\n"

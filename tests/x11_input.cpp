@@ -5,6 +5,7 @@
 //   x11_input down|up KEYSYM    key pressed / released (X keysym name: Control_L, Return, space, F12)
 //   x11_input type TEXT         each character of TEXT pressed and released
 //   x11_input close X Y         WM_DELETE_WINDOW to the top-level window at (X, Y)
+//   x11_input focus X Y         keyboard focus to the top-level window at (X, Y)
 //
 // Only single events: holding across the viewer's frames is the calling script's job (it
 // waits for the viewer's --log-input lines between down and up).
@@ -40,19 +41,32 @@ bool send_key(Display* d, const char* name, bool down) {
   return child;
 }
 
-bool close_window(Display* d, int x, int y) {
-  // The window may still be on its way to the screen on a loaded machine: wait for it to be
-  // mapped there (up to 10 s), rather than failing at once.
+// The top-level window at (x, y), waiting for it to be mapped there (up to 10 s: it may still
+// be on its way to the screen on a loaded machine), or 0 with a line saying so.
+::Window wait_for_top_level_at(Display* d, int x, int y) {
   ::Window target = top_level_at(d, x, y);
   for (int attempt = 0; !target && attempt < 200; ++attempt) {
     usleep(50000);
     XSync(d, False);
     target = top_level_at(d, x, y);
   }
-  if (!target) {
-    std::fprintf(stderr, "x11_input: no window at %d,%d\n", x, y);
-    return false;
-  }
+  if (!target) std::fprintf(stderr, "x11_input: no window at %d,%d\n", x, y);
+  return target;
+}
+
+// What a window manager does when the user clicks a window. Without one (Xvfb), the window has
+// the focus only if GLFW's own request when it showed it found it mapped: on a loaded machine
+// it may not have, and keys then went to the window under the pointer, the root.
+bool focus_window(Display* d, int x, int y) {
+  const ::Window target = wait_for_top_level_at(d, x, y);
+  if (!target) return false;
+  XSetInputFocus(d, target, RevertToParent, CurrentTime);
+  return true;
+}
+
+bool close_window(Display* d, int x, int y) {
+  const ::Window target = wait_for_top_level_at(d, x, y);
+  if (!target) return false;
   XEvent e;
   std::memset(&e, 0, sizeof e);
   e.xclient.type = ClientMessage;
@@ -69,7 +83,7 @@ bool close_window(Display* d, int x, int y) {
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: x11_input move X Y | down|up button|KEYSYM | type TEXT | close X Y\n");
+    std::fprintf(stderr, "usage: x11_input move X Y | down|up button|KEYSYM | type TEXT | close X Y | focus X Y\n");
     return 2;
   }
   Display* d = XOpenDisplay(nullptr);
@@ -95,6 +109,8 @@ int main(int argc, char** argv) {
     }
   } else if (verb == "close" && argc == 4) {
     ok = close_window(d, std::atoi(argv[2]), std::atoi(argv[3]));
+  } else if (verb == "focus" && argc == 4) {
+    ok = focus_window(d, std::atoi(argv[2]), std::atoi(argv[3]));
   } else {
     std::fprintf(stderr, "x11_input: bad arguments\n");
     ok = false;
