@@ -134,6 +134,10 @@ RunResult run_live_viewer(const std::string& prefix, const std::string& name, co
                 "open_gate\n"
                 "rm -f \"$load_gate\"\n"
                 "cd \"$(dirname \"$log\")\"\n"
+                // Emptied here, not only by the viewer's redirection below: that one runs in the
+                // background job, and a step could read the last run's log before it, see its
+                // "UI ready" and act on a window that is not there yet.
+                ": > \"$log\"\n"
                 + (env.empty() ? std::string() : "env " + env + " ") + "\"$viewer\" " + viewer_args + " > \"$log\" 2>&1 &\n"
                 "pid=$!\n"
                 "closed=0 exit_status=\n"
@@ -144,7 +148,8 @@ RunResult run_live_viewer(const std::string& prefix, const std::string& name, co
                 "}\n"
                 "wait_for() { wait_count \"$1\" 1; }\n"
                 // Keys go to the focused window: the viewer's, as a window manager would make it
-                // (x11_input focus: GLFW's own request can miss on a loaded machine).
+                // (x11_input focus). Without one, GLFW asks for the focus itself after waiting at
+                // most 0.1 s for the window to be mapped, which a loaded machine can exceed.
                 "press() {\n"
                 "  n=$(grep -cF -- \"$2\" \"$log\")\n"
                 "  \"$input\" focus 1 1 || return 1\n"

@@ -55,8 +55,8 @@ bool send_key(Display* d, const char* name, bool down) {
 }
 
 // What a window manager does when the user clicks a window. Without one (Xvfb), the window has
-// the focus only if GLFW's own request when it showed it found it mapped: on a loaded machine
-// it may not have, and keys then went to the window under the pointer, the root.
+// the focus only if GLFW's own request when it showed it found it mapped (GLFW waits 0.1 s for
+// that); otherwise keys go to the window under the pointer, which may be the root.
 bool focus_window(Display* d, int x, int y) {
   const ::Window target = wait_for_top_level_at(d, x, y);
   if (!target) return false;

@@ -163,8 +163,8 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
 
   // The tile's vectors ("slots"): lane group j of row y is slot j * kTileSize + y (16 rows x at
   // most 4 groups), bit `slot` of a 64-bit set. Per slot, one vector each, next to each other
-  // (one base address per slot): the pixels' column in the tile, transmittance, colour, and whether they
-  // still blend (all bits set) - pixels outside the image start finished. A slot whose lanes
+  // (one base address per slot): the pixels' column in the tile, transmittance, colour, and
+  // whether they still blend (all bits set) - pixels outside the image start finished. A slot whose lanes
   // have all finished leaves live_slots (and slot_live, the same as a word per slot, which the
   // span pass reads a vector of rows at a time), and the tile stops when none is left.
   static_assert(gm::kTileSize <= 16, "64 slots: 16 rows of at most 4 lane groups");
