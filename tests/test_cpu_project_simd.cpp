@@ -25,6 +25,7 @@ struct Projected {
   std::vector<gm::Footprint> footprints;
   std::vector<cpu::BlendGaussian> blend_data;
   std::size_t reasons[gm::kCullReasonCount] = {};  // Gaussians per cull reason
+  std::size_t wrong_depth_bits = 0;  // visible Gaussians whose depth_bits are not their footprint's depth
 };
 
 Projected project(const Scene& scene, const Camera& camera, const RenderOptions& options, cpu::ProjectKernel kernel,
@@ -41,6 +42,8 @@ Projected project(const Scene& scene, const Camera& camera, const RenderOptions&
   p.footprints.assign(frame.footprints.begin(), frame.footprints.begin() + n);
   p.blend_data.assign(frame.blend_data.begin(), frame.blend_data.begin() + n);
   for (const std::uint8_t reason : p.cull) p.reasons[reason]++;
+  for (std::size_t i = 0; i < n; ++i)
+    p.wrong_depth_bits += p.cull[i] == gm::kVisible && frame.depth_bits[i] != gm::depth_bits(p.footprints[i].depth);
   return p;
 }
 
@@ -79,7 +82,8 @@ struct Totals {
 };
 
 // The SIMD kernel on every target gives the scalar kernel's bytes: the same cull reason for each
-// Gaussian, and for the visible ones the same Footprint and BlendGaussian.
+// Gaussian, and for the visible ones the same Footprint and BlendGaussian (and both kernels
+// leave each visible Gaussian's depth bits for the depth sort).
 void expect_same_bytes(const Scene& scene, const Camera& camera, const RenderOptions& options,
                        const std::string& what, Totals& totals) {
   const Projected scalar = project(scene, camera, options, cpu::ProjectKernel::scalar, 1);
@@ -105,6 +109,8 @@ void expect_same_bytes(const Scene& scene, const Camera& camera, const RenderOpt
                               << ", simd " << int(simd.cull[first]) << ")";
     EXPECT_EQ(wrong_footprint, 0u) << where << ": first at " << first;
     EXPECT_EQ(wrong_blend, 0u) << where << ": first at " << first;
+    EXPECT_EQ(scalar.wrong_depth_bits, 0u) << where << " (scalar)";
+    EXPECT_EQ(simd.wrong_depth_bits, 0u) << where;
     totals.compared += scene.size();
     for (int r = 0; r < gm::kCullReasonCount; ++r) totals.reasons[r] += scalar.reasons[r];
   }

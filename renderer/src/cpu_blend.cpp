@@ -65,7 +65,7 @@ bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const
       }
       const std::uint32_t tile = frame.tile_order[i];
       const std::uint64_t begin = frame.tile_start[tile], end = frame.tile_start[tile + 1];
-      const TileJob job{frame.sorted_keys.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
+      const TileJob job{frame.tile_ids.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
                         static_cast<int>(tile / tiles_x), options.background};
       if (kernel == BlendKernel::scalar) {
         blend_tile_scalar(frame, job, rgb);

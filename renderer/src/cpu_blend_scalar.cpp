@@ -17,7 +17,7 @@ constexpr int kTilePixels = gm::kTileSize * gm::kTileSize;
 // the pixel loop runs over contiguous arrays. Per pixel the rules are those of 3DGS:
 // alpha = min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4.
 void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb) {
-  const std::uint64_t* keys = tile.keys;
+  const std::uint32_t* ids = tile.ids;
   const std::uint64_t count = tile.count;
   const float* background = tile.background;
   const int tile_x = tile.tile_x, tile_y = tile.tile_y;
@@ -35,7 +35,7 @@ void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb) {
     active[p] = true;
   }
   for (std::uint64_t k = 0; k < count && active_count > 0; ++k) {
-    const BlendGaussian& g = frame.blend_data[static_cast<std::uint32_t>(keys[k])];
+    const BlendGaussian& g = frame.blend_data[ids[k]];
     // Only the rows, and in each row the pixels, that can reach power_cut; the margins (0.5
     // in q, one pixel each side) exceed the float rounding of the per-pixel power, so pruning
     // never changes which pixels pass the exact test below.

@@ -41,7 +41,7 @@ constexpr int kTilePixels = gm::kTileSize * gm::kTileSize;
 using FloatTag = hn::CappedTag<float, gm::kTileSize>;
 
 // Copies what the row ranges need of the tile's Gaussians, in blend order, into arrays
-// (prefetching the ones a few keys ahead, which lie anywhere in blend_data; the blend loop
+// (prefetching the ones a few ahead, which lie anywhere in blend_data; the blend loop
 // then finds their lines in the cache), then finds each one's rows: the scalar kernel's
 // y_first / y_last, several Gaussians per vector.
 void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, TileGaussians& g) {
@@ -58,8 +58,8 @@ void gather(const Frame& frame, const TileJob& job, int y_begin, int tile_h, Til
       continue;
     }
     if (k + kPrefetchAhead < count)
-      hwy::Prefetch(&frame.blend_data[static_cast<std::uint32_t>(job.keys[k + kPrefetchAhead])]);
-    const BlendGaussian& b = frame.blend_data[static_cast<std::uint32_t>(job.keys[k])];
+      hwy::Prefetch(&frame.blend_data[job.ids[k + kPrefetchAhead]]);
+    const BlendGaussian& b = frame.blend_data[job.ids[k]];
     g.mean_y[k] = b.mean_y;
     g.row_q_coeff[k] = b.row_q_coeff;
     g.q_cut[k] = b.q_cut;
@@ -236,7 +236,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
     for (; k < job.count && members < kBatch; ++k) {
       const int y_first = g.row_first[k], y_last = g.row_last[k];
       if (y_first > y_last) continue;
-      const BlendGaussian& gauss = frame.blend_data[static_cast<std::uint32_t>(job.keys[k])];
+      const BlendGaussian& gauss = frame.blend_data[job.ids[k]];
       const float mean_x = gauss.mean_x, mean_y = gauss.mean_y;
       float* member = member_records + static_cast<std::size_t>(members) * member_stride;
       // The slots whose row's span of pixels that can reach power_cut meets their group, and

@@ -1,5 +1,5 @@
-// CPU emit stage: one key per Gaussian-tile pair (baseline: every tile of the box; flash with
-// the exact test: only tiles the ellipse touches).
+// CPU emit stage: a (tile, Gaussian id) pair per tile a visible Gaussian reaches (baseline: every
+// tile of the box; flash with the exact test: only tiles the ellipse touches), in depth order.
 #include <algorithm>
 
 #include "cpu_frame.h"
@@ -9,11 +9,14 @@ namespace flashgs {
 namespace cpu {
 namespace {
 
-// Chunks per thread: a scene's pairs are far from even along its Gaussian order (pc_playbot's
-// sixteenths hold 2k to 152k pairs of one view), so equal static shares left threads idle;
-// several chunks each, taken dynamically, even that out.
+// Chunks per thread: a scene's pairs are far from even along its Gaussians (pc_playbot's
+// sixteenths in id order hold 2k to 152k pairs of one view), so equal static shares left
+// threads idle; several chunks each, taken dynamically, even that out.
 constexpr int kChunksPerThread = 8;
 constexpr std::int64_t kMinChunkGaussians = 4096;
+// Footprints are read in depth order, anywhere in the array: this many Gaussians ahead are
+// prefetched.
+constexpr std::int64_t kPrefetchAhead = 16;
 // Boxes of at least this many tiles take the vector test (exact_box_tiles), smaller ones the
 // scalar test: a call per box and a vector's latency chain cost more than a few scalar tests
 // (pc_playbot 1080p, 2 threads of a Zen 4 VM: emit 13.1 ms with the vector test for boxes 4+
@@ -23,15 +26,16 @@ constexpr int kVectorBoxTiles = 8;
 
 }  // namespace
 
-void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats) {
-  const std::int64_t n = static_cast<std::int64_t>(scene.size());
+void emit(const RenderOptions& options, Frame& frame, FrameStats& stats) {
+  const std::int64_t n = static_cast<std::int64_t>(frame.visible_count);
   const std::size_t tiles = static_cast<std::size_t>(frame.camera.tiles_x) * frame.camera.tiles_y;
   const bool exact = options.uses_exact_tile_test();
   const int width = frame.camera.width, height = frame.camera.height, tiles_x = frame.camera.tiles_x;
   std::uint64_t visible = 0, ellipse_missed = 0;
 
-  // Chunk c holds Gaussians [c n / C, (c + 1) n / C): the pair lists, concatenated in chunk
-  // order, are in Gaussian order however the chunks were scheduled (sort_by_tile relies on it).
+  // Chunk c holds entries [c n / C, (c + 1) n / C) of the depth order: the pair lists,
+  // concatenated in chunk order, are in (depth, id) order however the chunks were scheduled
+  // (sort_by_tile relies on it).
   const int chunks = static_cast<int>(
       std::max<std::int64_t>(1, std::min<std::int64_t>(std::int64_t{frame.threads} * kChunksPerThread,
                                                        n / kMinChunkGaussians)));
@@ -39,7 +43,7 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
   // Grown only: shrinking would free the inner vectors' capacity.
   if (frame.chunk_tiles.size() < static_cast<std::size_t>(chunks)) {
     frame.chunk_tiles.resize(chunks);
-    frame.chunk_keys.resize(chunks);
+    frame.chunk_ids.resize(chunks);
     frame.chunk_tile_counts.resize(chunks);
   }
   ParallelErrors errors;
@@ -49,42 +53,45 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
       // The outputs as this thread's locals (swapped in and back, capacity kept): the vectors'
       // headers sit side by side in frame, and a push_back to one would invalidate the cache
       // line of the others' (false sharing cost more than the work at 2 threads).
-      std::vector<std::uint32_t> out_tiles, counts, box_tiles;
-      std::vector<std::uint64_t> out_keys;
+      std::vector<std::uint32_t> out_tiles, out_ids, counts, box_tiles;
       out_tiles.swap(frame.chunk_tiles[c]);
-      out_keys.swap(frame.chunk_keys[c]);
+      out_ids.swap(frame.chunk_ids[c]);
       counts.swap(frame.chunk_tile_counts[c]);
       out_tiles.clear();
-      out_keys.clear();
+      out_ids.clear();
       counts.assign(tiles, 0);
       std::uint64_t my_visible = 0, my_missed = 0;
       const gm::Footprint* footprints = frame.footprints.data();
       std::uint8_t* cull = frame.cull.data();
+      const std::uint64_t* order = frame.depth_order;
       const std::int64_t begin = n * c / chunks, end = n * (c + 1) / chunks;
-      for (std::int64_t i = begin; i < end; ++i) {
-        if (cull[i] != gm::kVisible) continue;
+      for (std::int64_t k = begin; k < end; ++k) {
+        if (k + kPrefetchAhead < end) {  // both cache lines a footprint may straddle
+          const char* ahead = reinterpret_cast<const char*>(&footprints[static_cast<std::uint32_t>(order[k + kPrefetchAhead])]);
+          __builtin_prefetch(ahead);
+          __builtin_prefetch(ahead + sizeof(gm::Footprint) - 1);
+        }
+        const std::uint32_t i = static_cast<std::uint32_t>(order[k]);
         const gm::Footprint& f = footprints[i];
-        const std::uint64_t key_low =
-            (static_cast<std::uint64_t>(gm::depth_bits(f.depth)) << 32) | static_cast<std::uint64_t>(i);
-        const std::size_t emitted_before = out_keys.size();
+        const std::size_t emitted_before = out_ids.size();
         if (exact && (f.tile_x1 - f.tile_x0) * (f.tile_y1 - f.tile_y0) >= kVectorBoxTiles) {
           const std::size_t room = exact_box_tiles_room(f);
           if (box_tiles.size() < room) box_tiles.resize(room);
           const std::size_t touched = exact_box_tiles(f, width, height, tiles_x, box_tiles.data());
           out_tiles.insert(out_tiles.end(), box_tiles.begin(), box_tiles.begin() + touched);
-          out_keys.insert(out_keys.end(), touched, key_low);
-          for (std::size_t k = 0; k < touched; ++k) counts[box_tiles[k]]++;
+          out_ids.insert(out_ids.end(), touched, i);
+          for (std::size_t b = 0; b < touched; ++b) counts[box_tiles[b]]++;
         } else {
           for (int ty = f.tile_y0; ty < f.tile_y1; ++ty)
             for (int tx = f.tile_x0; tx < f.tile_x1; ++tx) {
               if (exact && !gm::footprint_touches_tile(f, tx, ty, width, height)) continue;
               const std::uint32_t tile = static_cast<std::uint32_t>(ty) * tiles_x + tx;
               out_tiles.push_back(tile);
-              out_keys.push_back(key_low);
+              out_ids.push_back(i);
               counts[tile]++;
             }
         }
-        if (out_keys.size() > emitted_before) {
+        if (out_ids.size() > emitted_before) {
           my_visible++;
         } else {  // the box reached the image, the ellipse did not
           cull[i] = gm::kCulledOffscreen;
@@ -94,13 +101,13 @@ void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameS
       visible += my_visible;
       ellipse_missed += my_missed;
       out_tiles.swap(frame.chunk_tiles[c]);
-      out_keys.swap(frame.chunk_keys[c]);
+      out_ids.swap(frame.chunk_ids[c]);
       counts.swap(frame.chunk_tile_counts[c]);
     });
   errors.rethrow();
   stats.visible = visible;
   std::uint64_t pairs = 0;
-  for (int c = 0; c < chunks; ++c) pairs += frame.chunk_keys[c].size();
+  for (int c = 0; c < chunks; ++c) pairs += frame.chunk_ids[c].size();
   stats.kv_pairs = pairs;
   stats.sorted_pairs = pairs;
   stats.culled_offscreen += ellipse_missed;  // project counted the boxes that missed the image

@@ -49,6 +49,9 @@ struct Frame {
   std::vector<gm::Footprint> footprints;   // [gaussians]
   std::vector<std::uint8_t> cull;          // [gaussians] gm::CullReason
   std::vector<BlendGaussian> blend_data;   // [gaussians]
+  // [gaussians] gm::depth_bits of a visible Gaussian's depth: the depth sort reads these 4 bytes
+  // instead of a footprint's cache line
+  std::vector<std::uint32_t> depth_bits;
   // RenderOptions::fp16_sh: the SH of scene `half_sh_of` rounded to halves, made by its first
   // such frame (the renderer resets half_sh_of with the scene).
   const Scene* half_sh_of = nullptr;
@@ -64,25 +67,32 @@ struct Frame {
   std::size_t opacity_terms_size = 0;
   std::vector<float> log2_opacity, q_cut;  // [gaussians]
 
-  // Emission: the pairs (tile, key) of each chunk of consecutive Gaussians, and the chunk's
-  // per-tile histogram (then, after sort_by_tile's ranges, its write cursor per tile).
-  // key = depth bits << 32 | Gaussian id. Only the first emit_chunks entries belong to this frame.
+  // The visible Gaussians as keys (depth bits << 32 | id), in (depth, id) order after
+  // order_by_depth: depth_order points at visible_count of them, in depth_keys or depth_scratch
+  // (whichever the last radix pass wrote).
+  std::vector<std::uint64_t> depth_keys, depth_scratch;
+  std::vector<std::uint32_t> depth_slice_counts;  // [threads][256] the radix passes' digit counts
+  const std::uint64_t* depth_order = nullptr;
+  std::size_t visible_count = 0;
+
+  // Emission: the pairs (tile, Gaussian id) of each chunk of consecutive Gaussians of the depth
+  // order, and the chunk's per-tile histogram (then, after sort_by_tile's ranges, its write
+  // cursor per tile). Only the first emit_chunks entries belong to this frame.
   int emit_chunks = 0;
   std::vector<std::vector<std::uint32_t>> chunk_tiles;
-  std::vector<std::vector<std::uint64_t>> chunk_keys;
+  std::vector<std::vector<std::uint32_t>> chunk_ids;
   std::vector<std::vector<std::uint32_t>> chunk_tile_counts;  // [chunk][tile]
 
-  std::vector<std::uint64_t> tile_start;   // [tiles + 1] offsets into sorted_keys
-  std::vector<std::uint64_t> sorted_keys;  // [pairs], tile-major, (depth, id) within a tile
-  std::vector<std::vector<std::uint64_t>> sort_scratch;  // [threads] the per-tile radix sort's buffer
+  std::vector<std::uint64_t> tile_start;  // [tiles + 1] offsets into tile_ids
+  std::vector<std::uint32_t> tile_ids;    // [pairs] Gaussian ids, tile-major, (depth, id) order within a tile
 
   std::vector<std::uint32_t> tile_order;       // [tiles] the blend's schedule: longest pair counts first
   std::vector<TileGaussians> tile_gaussians;   // [threads] the SIMD blend's per-tile gather
 };
 
-// One tile for a blend kernel: its sorted keys and where it lies in the image.
+// One tile for a blend kernel: its Gaussians in blend order and where it lies in the image.
 struct TileJob {
-  const std::uint64_t* keys;
+  const std::uint32_t* ids;
   std::uint64_t count;
   int tile_x, tile_y;
   const float* background;  // [3]
@@ -121,13 +131,18 @@ inline void set_row_pruning(BlendGaussian& g) {
   g.row_slope = static_cast<float>(-(w0 * w1 + w2 * w3) / conic_a);
   g.inv_conic_a = static_cast<float>(1.0 / conic_a);
 }
-void emit(const Scene& scene, const RenderOptions& options, Frame& frame, FrameStats& stats);
+// Puts the visible Gaussians (cull == kVisible) of the first `gaussians` in (depth, id) order:
+// depth_order, visible_count. Part of the sort stage, run before emit.
+void order_by_depth(Frame& frame, std::int64_t gaussians);
+// Emits the pairs of the visible Gaussians, walking them in depth order.
+void emit(const RenderOptions& options, Frame& frame, FrameStats& stats);
 // The tiles of f's box that gm::footprint_touches_tile keeps, as tile indices in row-major
 // order, into out, which must hold exact_box_tiles_room(f) values; returns how many
 // (cpu_emit_simd.cpp: a vector of tiles at a time, the scalar test's decisions).
 std::size_t exact_box_tiles(const gm::Footprint& f, int width, int height, int tiles_x, std::uint32_t* out);
 std::size_t exact_box_tiles_room(const gm::Footprint& f);
-// Sorts by tile, then depth, then Gaussian id; fills tile_start (the ranges stage).
+// Puts emit's pairs in tile order, keeping their (depth, id) order within a tile: tile_ids and
+// tile_start (the ranges stage).
 void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms);
 // Which kernel composites the tiles.
 enum class BlendKernel { simd, scalar };

@@ -19,6 +19,7 @@ void project_range(const SceneArrays& scene, Frame& frame, std::int64_t begin, s
                                               &scene.scales[i * 3], &scene.rotations[i * 4], opacity, f);
     frame.cull[i] = reason;
     if (reason != gm::kVisible) continue;
+    frame.depth_bits[i] = gm::depth_bits(f.depth);
     BlendGaussian& g = frame.blend_data[i];
     g.mean_x = f.mean_x;
     g.mean_y = f.mean_y;
@@ -118,6 +119,7 @@ void project(const Scene& scene, const RenderOptions& options, Frame& frame, Fra
     frame.footprints.resize(n);
     frame.cull.resize(n);
     frame.blend_data.resize(n);
+    frame.depth_bits.resize(n);
   }
   // A scene pays only for the SH bands it has (and the viewer's cap).
   const int degree = std::max(0, std::min(scene.sh_degree, options.sh_degree_cap));

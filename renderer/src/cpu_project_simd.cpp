@@ -364,6 +364,7 @@ void store_lanes(const SceneArrays& scene, Frame& frame, std::int64_t i,
     f.mean_x = v.mean_x[l];
     f.mean_y = v.mean_y[l];
     f.depth = v.depth[l];
+    frame.depth_bits[id] = gm::depth_bits(f.depth);
     f.conic_a = v.conic_a[l];
     f.conic_b = v.conic_b[l];
     f.conic_c = v.conic_c[l];

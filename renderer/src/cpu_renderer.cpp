@@ -90,13 +90,18 @@ class CpuRenderer final : public Renderer {
     cpu::project(*scene_, options, frame_, stats);
     stats.times.project_ms = ms_since(t);
     if (cancelled()) return finish_cancelled();
+    // The sort stage runs in two parts: the depth order before emit, the tile order after it.
     t = Clock::now();
-    cpu::emit(*scene_, options, frame_, stats);
+    cpu::order_by_depth(frame_, static_cast<std::int64_t>(scene_->size()));
+    const double depth_order_ms = ms_since(t);
+    if (cancelled()) return finish_cancelled();
+    t = Clock::now();
+    cpu::emit(options, frame_, stats);
     stats.times.emit_ms = ms_since(t);
     if (cancelled()) return finish_cancelled();
     t = Clock::now();
     cpu::sort_by_tile(frame_, stats, &stats.times.ranges_ms);
-    stats.times.sort_ms = ms_since(t) - stats.times.ranges_ms;
+    stats.times.sort_ms = depth_order_ms + ms_since(t) - stats.times.ranges_ms;
     if (cancelled()) return finish_cancelled();
     t = Clock::now();
     if (out.width != camera.width || out.height != camera.height) out.resize(camera.width, camera.height);
