@@ -56,7 +56,7 @@ TEST(FrameMemory, ShortfallNamesTheFrameAndBothFigures) {
   const FrameMemory need = estimate_frame_memory(BackendKind::cpu, 30000, 51200, 28800, 30000, 2);
   AvailableMemory available{4000000000ull, "the address-space limit, RLIMIT_AS"};
   const std::string text = frame_memory_shortfall(need, 51200, 28800, available);
-  EXPECT_EQ(text.rfind("a 51200x28800 frame needs about 17.", 0), 0u) << text;
+  EXPECT_EQ(text.rfind("a 51200x28800 frame needs about 18.", 0), 0u) << text;
   EXPECT_NE(text.find("image 17.7 GB"), std::string::npos) << text;
   EXPECT_NE(text.find("but 4.0 GB is available (the address-space limit, RLIMIT_AS)"), std::string::npos) << text;
   available.bytes = need.host;

@@ -10,9 +10,9 @@ namespace flashgs::viewer {
 namespace {
 
 constexpr std::uint64_t kRgba8Bytes = 4;  // the upload copy, and each texture
-// What a backend keeps per Gaussian beside the scene: footprint, cull flag, blend record and
-// a few tile pairs (renderer/src/cpu_frame.h); the CUDA backend keeps less on the host.
-constexpr std::uint64_t kBackendBytesPerGaussian = 160;
+// Tile pairs per Gaussian that the scene's memory estimate allows for (pc_playbot at 1080p: 3.1
+// with flash, 7.6 with the baseline, whose pairs are counted when the frame is sized).
+constexpr std::uint64_t kPairsPerGaussian = 4;
 
 std::string share_text(std::uint64_t available) {
   return format_bytes(available) + " is available (at most " + std::to_string(int(kMemoryShare * 100)) +
@@ -31,7 +31,11 @@ std::uint64_t frame_bytes(int width, int height, int texture_count) {
 }
 
 std::uint64_t scene_bytes(std::uint64_t gaussians, std::uint64_t scene_bytes_per_gaussian) {
-  return gaussians * (scene_bytes_per_gaussian + kBackendBytesPerGaussian);
+  // What the CPU backend keeps per Gaussian beside the scene (the CUDA backend keeps less on
+  // the host): its per-Gaussian arrays and a few tile pairs.
+  const FrameMemory backend =
+      estimate_frame_memory(BackendKind::cpu, gaussians, 0, 0, gaussians * kPairsPerGaussian, 1);
+  return gaussians * scene_bytes_per_gaussian + backend.per_gaussian + backend.pairs;
 }
 
 std::uint64_t scene_bytes_per_gaussian(int sh_degree) {

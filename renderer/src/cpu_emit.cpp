@@ -9,11 +9,6 @@ namespace flashgs {
 namespace cpu {
 namespace {
 
-// Chunks per thread: a scene's pairs are far from even along its Gaussians (pc_playbot's
-// sixteenths in id order hold 2k to 152k pairs of one view), so equal static shares left
-// threads idle; several chunks each, taken dynamically, even that out.
-constexpr int kChunksPerThread = 8;
-constexpr std::int64_t kMinChunkGaussians = 4096;
 // Footprints are read in depth order, anywhere in the array: this many Gaussians ahead are
 // prefetched.
 constexpr std::int64_t kPrefetchAhead = 16;
@@ -36,9 +31,7 @@ void emit(const RenderOptions& options, Frame& frame, FrameStats& stats) {
   // Chunk c holds entries [c n / C, (c + 1) n / C) of the depth order: the pair lists,
   // concatenated in chunk order, are in (depth, id) order however the chunks were scheduled
   // (sort_by_tile relies on it).
-  const int chunks = static_cast<int>(
-      std::max<std::int64_t>(1, std::min<std::int64_t>(std::int64_t{frame.threads} * kChunksPerThread,
-                                                       n / kMinChunkGaussians)));
+  const int chunks = emit_chunk_count(frame.threads, static_cast<std::uint64_t>(n));
   frame.emit_chunks = chunks;
   // Grown only: shrinking would free the inner vectors' capacity.
   if (frame.chunk_tiles.size() < static_cast<std::size_t>(chunks)) {

@@ -1,6 +1,7 @@
 // Working memory and stage functions of the CPU backend (internal to renderer/).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -75,7 +76,7 @@ struct Frame {
   const std::uint64_t* depth_order = nullptr;
   std::size_t visible_count = 0;
 
-  // Emission: the pairs (tile, Gaussian id) of each chunk of consecutive Gaussians of the depth
+  // Emission: the pairs (tile, Gaussian id) of each chunk (emit_chunk_count) of consecutive Gaussians of the depth
   // order, and the chunk's per-tile histogram (then, after sort_by_tile's ranges, its write
   // cursor per tile). Only the first emit_chunks entries belong to this frame.
   int emit_chunks = 0;
@@ -89,6 +90,16 @@ struct Frame {
   std::vector<std::uint32_t> tile_order;       // [tiles] the blend's schedule: longest pair counts first
   std::vector<TileGaussians> tile_gaussians;   // [threads] the SIMD blend's per-tile gather
 };
+
+// How many chunks emit splits `visible` Gaussians into on `threads` threads: several per thread,
+// taken dynamically, since a scene's pairs are far from even along its Gaussians (pc_playbot's
+// sixteenths in id order hold 2k to 152k pairs of one view) and equal static shares left
+// threads idle; at least 4096 Gaussians each.
+inline int emit_chunk_count(int threads, std::uint64_t visible) {
+  constexpr std::uint64_t kChunksPerThread = 8, kMinChunkGaussians = 4096;
+  const std::uint64_t most = static_cast<std::uint64_t>(threads > 1 ? threads : 1) * kChunksPerThread;
+  return static_cast<int>(std::max<std::uint64_t>(1, std::min(most, visible / kMinChunkGaussians)));
+}
 
 // One tile for a blend kernel: its Gaussians in blend order and where it lies in the image.
 struct TileJob {

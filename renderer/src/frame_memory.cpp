@@ -72,13 +72,15 @@ FrameMemory estimate_frame_memory(BackendKind backend, std::size_t gaussians, in
   FrameMemory m;
   m.image = pixels * 3 * sizeof(float);
   if (backend == BackendKind::cpu) {
-    // cpu::Frame: footprints, cull flags and blend data per Gaussian; tile_start and each
-    // thread's tile histogram per tile; per pair the emitted (tile, key), the sorted key and,
-    // at most, the per-tile sort's scratch copy (all of it when one tile holds every pair).
-    m.per_gaussian = n * (sizeof(gm::Footprint) + sizeof(std::uint8_t) + sizeof(cpu::BlendGaussian));
-    m.per_tile = (tiles + 1) * sizeof(std::uint64_t) + static_cast<std::uint64_t>(std::max(threads, 1)) * tiles *
-                                                           sizeof(std::uint32_t);
-    m.pairs = pairs * (sizeof(std::uint32_t) + 3 * sizeof(std::uint64_t));
+    // cpu::Frame: per Gaussian its footprint, cull flag, blend data, opacity terms, depth bits
+    // and the depth sort's two key arrays; tile_start and each emit chunk's tile histogram per
+    // tile (as many chunks as a scene of any size gets); per pair the emitted (tile, id) and
+    // the id in its tile's list.
+    m.per_gaussian = n * (sizeof(gm::Footprint) + sizeof(std::uint8_t) + sizeof(cpu::BlendGaussian) +
+                          2 * sizeof(float) + sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t));
+    const std::uint64_t emit_chunks = static_cast<std::uint64_t>(cpu::emit_chunk_count(threads, ~std::uint64_t{0}));
+    m.per_tile = (tiles + 1) * sizeof(std::uint64_t) + emit_chunks * tiles * sizeof(std::uint32_t);
+    m.pairs = pairs * 3 * sizeof(std::uint32_t);
     m.host = m.image + m.per_gaussian + m.per_tile + m.pairs;
   } else {
     // The CUDA pipeline's buffers: footprints, pair counts and offsets, blend data per
