@@ -22,11 +22,13 @@ std::uint32_t bits_of(float depth) {
   return bits;
 }
 
-// A frame holding only what order_by_depth reads: the cull reasons and depths of n Gaussians.
+// A frame holding only what order_by_depth reads: the cull reasons and depths of n Gaussians,
+// and the count of visible ones (as project leaves them).
 cpu::Frame frame_with(const std::vector<std::uint8_t>& cull, const std::vector<float>& depths, int threads) {
   cpu::Frame frame;
   frame.threads = threads;
   frame.cull = cull;
+  frame.visible_count = static_cast<std::size_t>(std::count(cull.begin(), cull.end(), gm::kVisible));
   frame.depth_bits.resize(depths.size());
   for (std::size_t i = 0; i < depths.size(); ++i) frame.depth_bits[i] = bits_of(depths[i]);
   return frame;

@@ -69,8 +69,9 @@ struct Frame {
   std::vector<float> log2_opacity, q_cut;  // [gaussians]
 
   // The visible Gaussians as keys (depth bits << 32 | id), in (depth, id) order after
-  // order_by_depth: depth_order points at visible_count of them, in depth_keys or depth_scratch
-  // (whichever the last radix pass wrote).
+  // order_by_depth: depth_order points at visible_count of them (project counts them), in
+  // depth_keys or depth_scratch (whichever the last radix pass wrote), which have room for the
+  // most Gaussians a frame had in view.
   std::vector<std::uint64_t> depth_keys, depth_scratch;
   std::vector<std::uint32_t> depth_slice_counts;  // [threads][256] the radix passes' digit counts
   const std::uint64_t* depth_order = nullptr;
@@ -143,7 +144,7 @@ inline void set_row_pruning(BlendGaussian& g) {
   g.inv_conic_a = static_cast<float>(1.0 / conic_a);
 }
 // Puts the visible Gaussians (cull == kVisible) of the first `gaussians` in (depth, id) order:
-// depth_order, visible_count. Part of the sort stage, run before emit.
+// depth_order (visible_count of them, as project counted). Part of the sort stage, run before emit.
 void order_by_depth(Frame& frame, std::int64_t gaussians);
 // Emits the pairs of the visible Gaussians, walking them in depth order.
 void emit(const RenderOptions& options, Frame& frame, FrameStats& stats);

@@ -139,11 +139,12 @@ void project(const Scene& scene, const RenderOptions& options, Frame& frame, Fra
       project_block(arrays, degree, frame, b * kBlock, std::min(count, (b + 1) * kBlock));
     });
   errors.rethrow();
-  std::uint64_t near = 0, offscreen = 0, low_opacity = 0, degenerate = 0;
+  std::uint64_t visible = 0, near = 0, offscreen = 0, low_opacity = 0, degenerate = 0;
 #pragma omp parallel for schedule(static) num_threads(frame.threads) \
-    reduction(+ : near, offscreen, low_opacity, degenerate)
+    reduction(+ : visible, near, offscreen, low_opacity, degenerate)
   for (std::int64_t i = 0; i < count; ++i) {
     const std::uint8_t reason = frame.cull[i];
+    visible += reason == gm::kVisible;
     near += reason == gm::kCulledNear;
     offscreen += reason == gm::kCulledOffscreen;
     low_opacity += reason == gm::kCulledLowOpacity;
@@ -153,6 +154,7 @@ void project(const Scene& scene, const RenderOptions& options, Frame& frame, Fra
   stats.culled_offscreen += offscreen;
   stats.culled_low_opacity += low_opacity;
   stats.culled_degenerate += degenerate;
+  frame.visible_count = static_cast<std::size_t>(visible);
 }
 
 }  // namespace cpu

@@ -41,9 +41,10 @@ void order_by_depth(Frame& frame, std::int64_t gaussians) {
   const std::size_t n = static_cast<std::size_t>(gaussians);
   const int threads = frame.threads;
   frame.depth_slice_counts.assign(static_cast<std::size_t>(threads) * kDigits, 0);
-  if (frame.depth_keys.size() < n) {
-    frame.depth_keys.resize(n);
-    frame.depth_scratch.resize(n);
+  // Room for the Gaussians in view, not the scene: project counted them (grown only).
+  if (frame.depth_keys.size() < frame.visible_count) {
+    frame.depth_keys.resize(frame.visible_count);
+    frame.depth_scratch.resize(frame.visible_count);
   }
   std::size_t visible = 0;
   // One parallel region: the key list, then an LSD radix sort on the four depth bytes, each pass
