@@ -73,10 +73,9 @@ FrameMemory estimate_frame_memory(BackendKind backend, std::size_t gaussians, in
   m.image = pixels * 3 * sizeof(float);
   if (backend == BackendKind::cpu) {
     // cpu::Frame: per Gaussian its footprint, cull flag, blend data, opacity terms, depth bits
-    // and the depth sort's two key arrays (sized to the Gaussians in view: this is the most they
-    // take); tile_start and each emit chunk's tile histogram per
-    // tile (as many chunks as a scene of any size gets); per pair the emitted (tile, id) and
-    // the id in its tile's list.
+    // and the depth sort's two key arrays (sized to the Gaussians in view: the most they take);
+    // per tile tile_start and each emit chunk's histogram (as many chunks as a scene of any size
+    // gets); per pair the emitted (tile, id) and the id in its tile's list.
     m.per_gaussian = n * (sizeof(gm::Footprint) + sizeof(std::uint8_t) + sizeof(cpu::BlendGaussian) +
                           2 * sizeof(float) + sizeof(std::uint32_t) + 2 * sizeof(std::uint64_t));
     const std::uint64_t emit_chunks = static_cast<std::uint64_t>(cpu::emit_chunk_count(threads, ~std::uint64_t{0}));
