@@ -60,7 +60,8 @@ void emit(const RenderOptions& options, Frame& frame, FrameStats& stats) {
       const std::int64_t begin = n * c / chunks, end = n * (c + 1) / chunks;
       for (std::int64_t k = begin; k < end; ++k) {
         if (k + kPrefetchAhead < end) {  // both cache lines a footprint may straddle
-          const char* ahead = reinterpret_cast<const char*>(&footprints[static_cast<std::uint32_t>(order[k + kPrefetchAhead])]);
+          const std::uint32_t later = static_cast<std::uint32_t>(order[k + kPrefetchAhead]);
+          const char* ahead = reinterpret_cast<const char*>(&footprints[later]);
           __builtin_prefetch(ahead);
           __builtin_prefetch(ahead + sizeof(gm::Footprint) - 1);
         }

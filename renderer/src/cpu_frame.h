@@ -77,9 +77,9 @@ struct Frame {
   const std::uint64_t* depth_order = nullptr;
   std::size_t visible_count = 0;
 
-  // Emission: the pairs (tile, Gaussian id) of each chunk (emit_chunk_count) of consecutive Gaussians of the depth
-  // order, and the chunk's per-tile histogram (then, after sort_by_tile's ranges, its write
-  // cursor per tile). Only the first emit_chunks entries belong to this frame.
+  // Emission: the pairs (tile, Gaussian id) of each chunk (emit_chunk_count) of consecutive
+  // Gaussians of the depth order, and the chunk's per-tile histogram (then, after sort_by_tile's
+  // ranges, its write cursor per tile). Only the first emit_chunks entries belong to this frame.
   int emit_chunks = 0;
   std::vector<std::vector<std::uint32_t>> chunk_tiles;
   std::vector<std::vector<std::uint32_t>> chunk_ids;

@@ -10,7 +10,7 @@ namespace flashgs {
 struct StageTimes {
   double project_ms = 0;  // cull, 3D->2D covariance, extent, box, SH -> colour
   double emit_ms = 0;     // Gaussian-tile keys
-  double sort_ms = 0;     // by tile, then depth
+  double sort_ms = 0;     // by tile, then depth (CPU: the depth order before emit, the pairs placed by tile after)
   double ranges_ms = 0;   // per-tile start/end in the sorted list (CUDA bin sort: in sort_ms, 0 here)
   double blend_ms = 0;    // front-to-back compositing
   double total_ms = 0;
