@@ -313,20 +313,22 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, TileGaussians& g, flo
                                          hn::Set(d, constants[offset_terms + row]));
         // Only the exact test: a lane outside the row's span or below power_cut has alpha <
         // 1/255 for certain (the margins the scalar kernel's pruning relies on), so it fails
-        // this test as surely as it would have been skipped there.
-        const auto alpha = hn::Min(alpha_max, exp2_nonpositive(d, exponent));
-        const auto visible = hn::Ge(alpha, alpha_min);
+        // this test as surely as it would have been skipped there. A lane that fails it gets
+        // alpha 0, which leaves its T and colour as they are, bit for bit (T - 0 T = T, colour
+        // + c 0 = colour: both start at +0 or 1 and stay >= 0): no mask of its own below.
+        const auto unclamped = exp2_nonpositive(d, exponent);
+        const auto alpha = hn::IfThenElseZero(hn::Ge(unclamped, alpha_min), hn::Min(alpha_max, unclamped));
         // T - alpha T with one rounding: the scalar kernel's T (1 - alpha) where 1 - alpha is
         // exact (alpha >= 1/2), within an ulp elsewhere, and its product is the weight.
         const auto weight_if_blended = hn::Mul(alpha, t);
         const auto next_t = hn::NegMulAdd(alpha, t, t);
-        // A live lane whose alpha passes but whose T would drop below the minimum finishes
-        // instead of blending; the others that pass blend.
+        // A live lane whose T would drop below the minimum finishes instead of blending (alpha
+        // 0 never does: a live lane's T is at least the minimum); the others blend.
         const auto too_dark = hn::Lt(next_t, t_min);
-        const auto blends = hn::AndNot(too_dark, hn::And(live, visible));
-        live = hn::AndNot(hn::And(visible, too_dark), live);
-        // Lanes that do not blend add colour * 0: the same bytes as leaving them (colours
-        // start at +0 and stay >= 0), for one select instead of three.
+        const auto blends = hn::AndNot(too_dark, live);
+        live = blends;
+        // Lanes that do not blend add colour * 0: the same bytes as leaving them, for one
+        // select instead of three.
         const auto weight = hn::IfThenElseZero(blends, weight_if_blended);
         red = hn::MulAdd(hn::Load(d, constants + kMemberRed * lanes), weight, red);
         green = hn::MulAdd(hn::Load(d, constants + kMemberGreen * lanes), weight, green);
