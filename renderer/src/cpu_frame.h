@@ -146,6 +146,8 @@ inline void set_row_pruning(BlendGaussian& g) {
 // Puts the visible Gaussians (cull == kVisible) of the first `gaussians` in (depth, id) order:
 // depth_order (visible_count of them, as project counted). Part of the sort stage, run before emit.
 void order_by_depth(Frame& frame, std::int64_t gaussians);
+// The same on `threads` threads, however many processors there are (the tests' uneven splits).
+void order_by_depth_on(Frame& frame, std::int64_t gaussians, int threads);
 // Emits the pairs of the visible Gaussians, walking them in depth order.
 void emit(const RenderOptions& options, Frame& frame, FrameStats& stats);
 // The tiles of f's box that gm::footprint_touches_tile keeps, as tile indices in row-major

@@ -21,9 +21,11 @@ namespace {
 #ifdef _OPENMP
 int thread_index() { return omp_get_thread_num(); }
 int team_size() { return omp_get_num_threads(); }
+int processors() { return omp_get_num_procs(); }
 #else
 int thread_index() { return 0; }
 int team_size() { return 1; }
+int processors() { return 1; }
 #endif
 
 constexpr int kDigitBits = 8;
@@ -38,8 +40,14 @@ std::size_t slice_begin(std::size_t count, int slice, int slices) {
 }  // namespace
 
 void order_by_depth(Frame& frame, std::int64_t gaussians) {
+  // The passes meet at barriers, so at most one thread per processor: more (--threads above the
+  // core count) would wait at each barrier for threads that are not running (pc_playbot 1080p,
+  // 64 threads on 2 cores: sort 14.2 ms against 9.4 for the per-tile sorts before, 10.4 capped).
+  order_by_depth_on(frame, gaussians, std::max(1, std::min(frame.threads, processors())));
+}
+
+void order_by_depth_on(Frame& frame, std::int64_t gaussians, int threads) {
   const std::size_t n = static_cast<std::size_t>(gaussians);
-  const int threads = frame.threads;
   frame.depth_slice_counts.assign(static_cast<std::size_t>(threads) * kDigits, 0);
   // Room for the Gaussians in view, not the scene: project counted them (grown only).
   if (frame.depth_keys.size() < frame.visible_count) {
