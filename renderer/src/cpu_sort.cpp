@@ -100,7 +100,7 @@ void order_by_depth_on(Frame& frame, std::int64_t gaussians, int threads) {
         running += digit_total;
         shared_by_all = std::max(shared_by_all, digit_total);
       }
-      if (shared_by_all == visible) {  // every key has this digit (most frames: the sign byte)
+      if (shared_by_all == visible) {  // every key has this digit (the top byte, when all depths share a pair of binades)
 #pragma omp barrier
         continue;
       }
