@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
 #include <random>
 #include <vector>
 
@@ -16,12 +15,6 @@
 namespace flashgs {
 namespace {
 
-std::uint32_t bits_of(float depth) {
-  std::uint32_t bits;
-  std::memcpy(&bits, &depth, 4);
-  return bits;
-}
-
 // A frame holding only what order_by_depth reads: the cull reasons and depths of n Gaussians,
 // and the count of visible ones (as project leaves them).
 cpu::Frame frame_with(const std::vector<std::uint8_t>& cull, const std::vector<float>& depths) {
@@ -29,7 +22,7 @@ cpu::Frame frame_with(const std::vector<std::uint8_t>& cull, const std::vector<f
   frame.cull = cull;
   frame.visible_count = static_cast<std::size_t>(std::count(cull.begin(), cull.end(), gm::kVisible));
   frame.depth_bits.resize(depths.size());
-  for (std::size_t i = 0; i < depths.size(); ++i) frame.depth_bits[i] = bits_of(depths[i]);
+  for (std::size_t i = 0; i < depths.size(); ++i) frame.depth_bits[i] = gm::depth_bits(depths[i]);
   return frame;
 }
 
