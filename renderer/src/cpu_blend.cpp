@@ -2,10 +2,6 @@
 #include <algorithm>
 #include <atomic>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "cpu_frame.h"
 #include "parallel_errors.h"
 
@@ -36,21 +32,11 @@ void order_tiles_by_pairs(Frame& frame, std::size_t tiles) {
 
 }  // namespace
 
-void TileGaussians::grow(std::size_t n) {
-  if (mean_y.size() >= n) return;
-  for (std::vector<float>* v : {&mean_y, &row_q_coeff, &q_cut})
-    v->resize(n);
-  row_first.resize(n);
-  row_last.resize(n);
-}
-
 bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const std::function<bool()>& cancelled,
            float* rgb) {
   const int tiles_x = frame.camera.tiles_x;
   const std::size_t tiles = static_cast<std::size_t>(tiles_x) * frame.camera.tiles_y;
   order_tiles_by_pairs(frame, tiles);
-  if (frame.tile_gaussians.size() < static_cast<std::size_t>(frame.threads))
-    frame.tile_gaussians.resize(frame.threads);
 
   std::atomic<bool> stop{false};
   ParallelErrors errors;
@@ -67,16 +53,10 @@ bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const
       const std::uint64_t begin = frame.tile_start[tile], end = frame.tile_start[tile + 1];
       const TileJob job{frame.tile_ids.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
                         static_cast<int>(tile / tiles_x), options.background};
-      if (kernel == BlendKernel::scalar) {
+      if (kernel == BlendKernel::scalar)
         blend_tile_scalar(frame, job, rgb);
-      } else {
-#ifdef _OPENMP
-        const int thread = omp_get_thread_num();
-#else
-        const int thread = 0;
-#endif
-        blend_tile_simd(frame, job, frame.tile_gaussians[thread], rgb);
-      }
+      else
+        blend_tile_simd(frame, job, rgb);
     });
   errors.rethrow();
   return !stop.load();

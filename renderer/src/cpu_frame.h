@@ -32,15 +32,6 @@ struct alignas(64) BlendGaussian {
   float inv_conic_a;
 };
 
-// What the SIMD kernel needs of one tile's Gaussians as arrays, in blend order, gathered
-// from blend_data: the row range of several Gaussians per vector (the other fields are read
-// from each Gaussian's BlendGaussian line, broadcast). One per thread; vectors only grow.
-struct TileGaussians {
-  std::vector<float> mean_y, row_q_coeff, q_cut;
-  std::vector<std::int32_t> row_first, row_last;  // rows of the tile that can reach power_cut
-  void grow(std::size_t n);
-};
-
 // Reused from frame to frame; vectors only grow (high-water mark), nothing is freed.
 struct Frame {
   gm::CameraParams camera{};
@@ -88,8 +79,7 @@ struct Frame {
   std::vector<std::uint64_t> tile_start;  // [tiles + 1] offsets into tile_ids
   std::vector<std::uint32_t> tile_ids;    // [pairs] Gaussian ids, tile-major, (depth, id) order within a tile
 
-  std::vector<std::uint32_t> tile_order;       // [tiles] the blend's schedule: longest pair counts first
-  std::vector<TileGaussians> tile_gaussians;   // [threads] the SIMD blend's per-tile gather
+  std::vector<std::uint32_t> tile_order;  // [tiles] the blend's schedule: longest pair counts first
 };
 
 // How many chunks emit splits `visible` Gaussians into on `threads` threads: several per thread,
@@ -167,7 +157,7 @@ bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const
 // The scalar reference kernel (cpu_blend_scalar.cpp) and the SIMD one (cpu_blend_simd.cpp;
 // without Highway it is the scalar one). Both write the tile's pixels of `rgb`.
 void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb);
-void blend_tile_simd(const Frame& frame, const TileJob& tile, TileGaussians& scratch, float* rgb);
+void blend_tile_simd(const Frame& frame, const TileJob& tile, float* rgb);
 // The SIMD kernel's alpha before its 0.99 cap, opacity e^(-q/2) computed as 2^(q * -log2(e)/2 +
 // log2_opacity), for n lanes (the tests check its bound on every target). Its relative error
 // against the exact value is below kSimdAlphaMaxRelError wherever alpha >= 1/255, and it is
