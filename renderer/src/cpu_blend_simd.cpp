@@ -90,17 +90,6 @@ void SimdAlpha(const float* q, const float* log2_opacity, float* alpha, std::siz
   }
 }
 
-// std::max(a, x) and std::min(a, x) lane by lane, NaN included ((a < x) ? x : a), so that the
-// spans are those of the scalar kernel for any input.
-template <class V>
-HWY_INLINE V max_like_std(V a, V x) {
-  return hn::IfThenElse(hn::Lt(a, x), x, a);
-}
-template <class V>
-HWY_INLINE V min_like_std(V a, V x) {
-  return hn::IfThenElse(hn::Lt(x, a), x, a);
-}
-
 #if HWY_TARGET == HWY_SCALAR
 // One lane (a CPU without SIMD): 256 slots would overflow the 64-bit slot sets, and a vector of
 // one pixel has nothing over the scalar kernel, which blends instead.
@@ -184,10 +173,11 @@ struct TileState {
 };
 
 // The scalar kernel's row range and row spans, a vector of candidates at a time and row by
-// row, the same operations per lane as there: each slot whose row's span of pixels that can
-// reach power_cut meets its lane group, and which is live, gets the candidate's bit. Also
-// writes the members' records (whatever the candidate: one that touches no live slot is never
-// read).
+// row: each slot whose row's span of pixels that can reach power_cut meets its lane group, and
+// which is live, gets the candidate's bit. A span may hold a few more pixels than the scalar
+// kernel's (float roundings, well inside its margins), which then fail the exact test: the
+// same pixels blend. Also writes the members' records (whatever the candidate: one that
+// touches no live slot is never read).
 void find_members(const BatchFields& fields, int padded, int x_begin, int y_begin, int tile_w, int tile_h,
                   TileState& tile, MemberRecords& records) {
   const FloatTag d;
@@ -213,16 +203,15 @@ void find_members(const BatchFields& fields, int padded, int x_begin, int y_begi
     const auto local_y = hn::Sub(mean_y, top);
     const auto reach = hn::IfThenElse(hn::Gt(coeff, zero), hn::Add(hn::Sqrt(hn::Div(q_reach, coeff)), one),
                                       hn::Set(d, 1e30f));
-    // q_cut + 0.5 < 0 (opacity < 1/255, drawn by the baseline): no pixel passes, no row.
-    const auto none = hn::Not(hn::Ge(q_reach, zero));
-    const auto first_row =
-        hn::IfThenElse(none, hn::Set(d, static_cast<float>(gm::kTileSize)), hn::Max(zero, hn::Ceil(hn::Sub(local_y, reach))));
-    const auto last_row =
-        hn::IfThenElse(none, hn::Set(d, -1.0f), hn::Min(last_tile_row, hn::Floor(hn::Add(local_y, reach))));
-    // The rows some candidate of the vector may reach (NaN rows reach none).
-    const float lowest = hn::GetLane(hn::MinOfLanes(d, first_row));
-    const float highest = hn::GetLane(hn::MaxOfLanes(d, last_row));
-    if (!(lowest <= highest)) continue;
+    const auto first_row = hn::Max(zero, hn::Ceil(hn::Sub(local_y, reach)));
+    const auto last_row = hn::Min(last_tile_row, hn::Floor(hn::Add(local_y, reach)));
+    // The rows some candidate of the vector reaches. q_cut + 0.5 < 0 (opacity < 1/255, drawn by
+    // the baseline): no pixel passes, no row; nor for NaN rows.
+    const auto reaches = hn::And(hn::Ge(q_reach, zero), hn::Le(first_row, last_row));
+    const float lowest =
+        hn::GetLane(hn::MinOfLanes(d, hn::IfThenElse(reaches, first_row, hn::Set(d, static_cast<float>(gm::kTileSize)))));
+    const float highest = hn::GetLane(hn::MaxOfLanes(d, hn::IfThenElse(reaches, last_row, hn::Set(d, -1.0f))));
+    if (lowest > highest) continue;
     const int row_lo = static_cast<int>(lowest), row_hi = static_cast<int>(highest);
     std::uint32_t rows = live_rows & (((2u << row_hi) - 1u) & ~((1u << row_lo) - 1u));
 
@@ -236,26 +225,27 @@ void find_members(const BatchFields& fields, int padded, int x_begin, int y_begi
     const auto local_centre_x = hn::Sub(mean_x, tile_left);
     for (; rows != 0; rows &= rows - 1u) {
       const int row = static_cast<int>(hwy::Num0BitsBelowLS1Bit_Nonzero32(rows));
-      const auto row_v = hn::Set(d, static_cast<float>(row));
       const auto dy = hn::Sub(hn::Set(d, static_cast<float>(y_begin + row)), mean_y);
       const auto row_q = hn::Mul(hn::Mul(coeff, dy), dy);
-      const auto centre = hn::Sub(hn::Add(mean_x, hn::Mul(slope, dy)), tile_left);
-      const auto half_width =
-          hn::Add(hn::Sqrt(hn::Mul(max_like_std(zero, hn::Sub(q_reach, row_q)), inv_conic_a)), one);
-      const auto first = max_like_std(zero, hn::Ceil(hn::Sub(centre, half_width)));
-      const auto last = min_like_std(tile_right, hn::Floor(hn::Add(centre, half_width)));
-      // The scalar kernel skips a row unless it lies in the candidate's row range, row_q <=
-      // q_reach (false for NaN) and first <= last.
-      const auto in_range = hn::And(hn::Ge(row_v, first_row), hn::Le(row_v, last_row));
-      const auto touched = hn::And(in_range, hn::And(hn::Le(row_q, q_reach), hn::Le(first, last)));
-      hn::Store(hn::Add(local_centre_x, hn::Mul(slope, dy)), d, records.centre[row] + base);
+      const auto centre = hn::Add(local_centre_x, hn::Mul(slope, dy));
+      hn::Store(centre, d, records.centre[row] + base);
       hn::Store(hn::MulAdd(row_q, minus_half_log2e, log2_opacity), d, records.offset[row] + base);
-      // Group v holds columns [v lanes, (v + 1) lanes): the span meets it unless it ends
-      // before or starts after.
+      // The pixels of the row that can reach power_cut lie within `half_width` of the centre
+      // (with the scalar kernel's margins, which also cover the centre's rounding here: taken
+      // from the tile's left edge, not the image's). A row is touched where row_q <= q_reach
+      // (false for NaN; rows outside the candidate's row range fail it too, by its margin).
+      const auto half_width = hn::Add(hn::Sqrt(hn::Mul(hn::Max(zero, hn::Sub(q_reach, row_q)), inv_conic_a)), one);
+      const auto span_first = hn::Sub(centre, half_width), span_last = hn::Add(centre, half_width);
+      // Group v holds columns [v lanes, (v + 1) lanes) of the tile's: the span meets it unless
+      // it ends before or starts after. half_width >= 1, so a span that meets the group's
+      // columns as an interval holds one of them (the scalar kernel's integer first <= last);
+      // a NaN span meets every group, as there (its alpha fails the exact test instead).
+      const auto touched = hn::AndNot(hn::Gt(span_first, tile_right), hn::Le(row_q, q_reach));
       for (int v = 0; v < groups_per_row; ++v) {
         const int slot = v * gm::kTileSize + row;
-        const auto meets = hn::And(touched, hn::And(hn::Lt(first, hn::Set(d, static_cast<float>((v + 1) * lanes))),
-                                                     hn::Ge(last, hn::Set(d, static_cast<float>(v * lanes)))));
+        const auto before = hn::Gt(span_first, hn::Set(d, static_cast<float>((v + 1) * lanes - 1)));
+        const auto after = hn::Lt(span_last, hn::Set(d, static_cast<float>(v * lanes)));
+        const auto meets = hn::AndNot(hn::Or(before, after), touched);
         std::uint8_t bits[(gm::kTileSize + 7) / 8] = {};
         hn::StoreMaskBits(d, meets, bits);
         const MemberSet set = (static_cast<MemberSet>(bits[0]) | (lanes > 8 ? static_cast<MemberSet>(bits[1]) << 8 : 0u));
