@@ -1,11 +1,13 @@
-// The CPU backend's SIMD blend against its scalar reference kernel, cancelling a render from
-// another thread, and rendering at another resolution with the same renderer.
+// The CPU backend's SIMD blend against its scalar reference kernel and against itself without
+// its span pruning, cancelling a render from another thread, and rendering at another
+// resolution with the same renderer.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <future>
 #include <random>
@@ -17,9 +19,11 @@
 #endif
 
 #include "cpu_frame.h"  // simd_alpha and its bound
+#include "cpu_stages.h"
 #include "flashgs/frame_params.h"
 #include "flashgs/generators.h"
 #include "flashgs/renderer.h"
+#include "flashgs/stress_scenes.h"
 #include "test_support.h"
 
 namespace flashgs {
@@ -301,6 +305,49 @@ TEST(CpuSimdBlend, RealScenesMatchTheScalarKernel) {
     const Camera camera = test::load_shared_cameras(name)[0];
     expect_simd_matches_scalar(test::load_shared_scene(name), camera.resized(camera.width / 2, camera.height / 2),
                                name);
+  }
+}
+
+// The SIMD kernel visits a slot only where a Gaussian's row span meets it, with margins of its
+// own, much tighter than the scalar kernel's (cpu_blend_simd.cpp): the spans must hold every
+// pixel that passes the exact test, so that the bytes are those of the kernel without pruning,
+// on every SIMD target, for both algorithms, with 2 threads.
+void expect_span_pruning_changes_no_byte(const Scene& scene, const Camera& camera, const std::string& what) {
+  on_every_target([&](const std::string& target) {
+    for (const RenderOptions& options : {RenderOptions{}, RenderOptions::baseline()}) {
+      cpu::Frame frame;
+      FrameStats stats;
+      test::build_tile_lists(scene, camera, options, 2, frame, stats);
+      const std::size_t floats = static_cast<std::size_t>(camera.width) * camera.height * 3;
+      std::vector<float> pruned(floats, -1.0f), unpruned(floats, -2.0f);
+      cpu::blend(options, frame, cpu::BlendKernel::simd, nullptr, pruned.data());
+      cpu::blend(options, frame, cpu::BlendKernel::simd_unpruned, nullptr, unpruned.data());
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < floats; ++i) differ += std::memcmp(&pruned[i], &unpruned[i], sizeof(float)) != 0;
+      EXPECT_EQ(differ, 0u) << what << " " << options.label() << " " << target << ": values that pruning changed, of "
+                            << floats << " (" << stats.kv_pairs << " pairs)";
+    }
+  });
+}
+
+// Needles, a camera inside a Gaussian, far origins, opacities at the cut, stacked and
+// equal-depth Gaussians, tiny images; the demo scene at an odd size (partial tiles).
+TEST(CpuSimdBlend, SpanPruningChangesNoByte) {
+  for (const std::string& name : stress_case_names()) {
+    StressCase c = make_stress_case(name);
+    if (c.huge) continue;
+    load_stress_scene(c);
+    expect_span_pruning_changes_no_byte(c.scene, c.cameras.at(0), name);
+  }
+  expect_span_pruning_changes_no_byte(*test::load_demo_scene(), test::load_demo_cameras()[2].resized(333, 187), "demo");
+}
+
+TEST(CpuSimdBlend, SpanPruningChangesNoByteOnRealScenes) {
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  for (const std::string& name : test::shared_scene_names()) {
+    const Camera camera = test::load_shared_cameras(name)[1];
+    expect_span_pruning_changes_no_byte(*test::load_shared_scene(name), camera.resized(camera.width / 2, camera.height / 2),
+                                        name);
   }
 }
 

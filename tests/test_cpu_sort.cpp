@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include "cpu_frame.h"  // order_by_depth, emit, sort_by_tile
-#include "flashgs/frame_params.h"
+#include "cpu_frame.h"  // order_by_depth
+#include "cpu_stages.h"
 #include "flashgs/stress_scenes.h"
 #include "test_support.h"
 
@@ -84,7 +84,7 @@ TEST(CpuDepthOrder, EqualDepthsKeepIdOrderAndEmptyFramesAreEmpty) {
   expect_depth_order({}, {}, "no Gaussians");
 }
 
-// project, order_by_depth, emit and sort_by_tile on a scene, as the CPU renderer runs them.
+// The tile lists of a scene and the depths they are ordered by.
 struct TileLists {
   std::vector<std::uint64_t> tile_start;
   std::vector<std::uint32_t> ids;
@@ -93,15 +93,8 @@ struct TileLists {
 
 TileLists tile_lists(const Scene& scene, const Camera& camera, const RenderOptions& options, int threads) {
   cpu::Frame frame;
-  frame.threads = threads;
-  frame.camera = make_camera_params(camera);
-  frame.geometry = make_geometry_params(options);
   FrameStats stats;
-  cpu::project(scene, options, frame, stats);
-  cpu::order_by_depth(frame, static_cast<std::int64_t>(scene.size()));
-  cpu::emit(options, frame, stats);
-  double ranges_ms = 0;
-  cpu::sort_by_tile(frame, stats, &ranges_ms);
+  test::build_tile_lists(scene, camera, options, threads, frame, stats);
   TileLists lists;
   lists.tile_start = frame.tile_start;
   lists.ids.assign(frame.tile_ids.begin(), frame.tile_ids.begin() + static_cast<std::ptrdiff_t>(stats.kv_pairs));

@@ -56,7 +56,7 @@ bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const
       if (kernel == BlendKernel::scalar)
         blend_tile_scalar(frame, job, rgb);
       else
-        blend_tile_simd(frame, job, rgb);
+        blend_tile_simd(frame, job, rgb, kernel == BlendKernel::simd ? SpanPruning::on : SpanPruning::off);
     });
   errors.rethrow();
   return !stop.load();

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <mutex>
 #include <string>
 
@@ -93,7 +94,9 @@ void SimdAlpha(const float* q, const float* log2_opacity, float* alpha, std::siz
 #if HWY_TARGET == HWY_SCALAR
 // One lane (a CPU without SIMD): 256 slots would overflow the 64-bit slot sets, and a vector of
 // one pixel has nothing over the scalar kernel, which blends instead.
-void BlendTileSimd(const Frame& frame, const TileJob& job, float* rgb) { blend_tile_scalar(frame, job, rgb); }
+void BlendTileSimd(const Frame& frame, const TileJob& job, float* rgb, SpanPruning) {
+  blend_tile_scalar(frame, job, rgb);
+}
 #else
 // The tile's Gaussians are taken kBatch at a time, in blend order ("candidates"); a candidate
 // that touches a live slot (below) is a member of its batch. Per batch: the candidates' fields
@@ -190,7 +193,7 @@ constexpr float kSpanPixelMargin = 1.0f / 64;
 // the same pixels blend. Also writes the members' records (whatever the candidate: one that
 // touches no live slot is never read).
 void find_members(const BatchFields& fields, int padded, int x_begin, int y_begin, int tile_w, int tile_h,
-                  TileState& tile, MemberRecords& records) {
+                  float q_margin, TileState& tile, MemberRecords& records) {
   const FloatTag d;
   const int lanes = static_cast<int>(hn::Lanes(d));
   const int groups_per_row = gm::kTileSize / lanes;
@@ -209,7 +212,7 @@ void find_members(const BatchFields& fields, int padded, int x_begin, int y_begi
     const auto coeff = hn::Load(d, fields.row_q_coeff + base), slope = hn::Load(d, fields.row_slope + base);
     const auto width_coeff = hn::Mul(hn::Load(d, fields.inv_conic_a + base), hn::Set(d, kSpanWidthScale));
     const auto log2_opacity = hn::Load(d, fields.log2_opacity + base);
-    const auto q_reach = hn::Add(hn::Load(d, fields.q_cut + base), hn::Set(d, kSpanQMargin));
+    const auto q_reach = hn::Add(hn::Load(d, fields.q_cut + base), hn::Set(d, q_margin));
     // The candidates' row ranges, as the scalar kernel's: reach = sqrt(q_reach / coeff) + 1, or
     // everything when coeff is 0.
     const auto local_y = hn::Sub(mean_y, top);
@@ -335,7 +338,7 @@ void blend_members(const MemberRecords& records, int slot_count, TileState& tile
   }
 }
 
-void BlendTileSimd(const Frame& frame, const TileJob& job, float* rgb) {
+void BlendTileSimd(const Frame& frame, const TileJob& job, float* rgb, SpanPruning pruning) {
   const FloatTag d;
   const std::size_t lanes = hn::Lanes(d);
   const int lanes_i = static_cast<int>(lanes);
@@ -373,12 +376,14 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, float* rgb) {
 
   BatchFields fields;
   MemberRecords records;
+  // Without pruning every span holds the whole tile: q_reach and the spans are infinite.
+  const float q_margin = pruning == SpanPruning::on ? kSpanQMargin : std::numeric_limits<float>::infinity();
   const int slot_count = groups_per_row * gm::kTileSize;
   for (std::uint64_t k = 0; k < job.count && tile.live_slots != 0; k += kBatch) {
     const int n = static_cast<int>(std::min<std::uint64_t>(kBatch, job.count - k));
     const int padded = (n + lanes_i - 1) / lanes_i * lanes_i;
     copy_candidates(frame, job, k, n, padded, fields);
-    find_members(fields, padded, x_begin, y_begin, tile_w, tile_h, tile, records);
+    find_members(fields, padded, x_begin, y_begin, tile_w, tile_h, q_margin, tile, records);
     blend_members(records, slot_count, tile);
   }
   // Colour plus the transmittance's share of the background, as the scalar kernel (no FMA),
@@ -420,8 +425,8 @@ HWY_EXPORT(BlendTileSimd);
 HWY_EXPORT(SimdAlpha);
 HWY_EXPORT(TargetName);
 
-void blend_tile_simd(const Frame& frame, const TileJob& tile, float* rgb) {
-  HWY_DYNAMIC_DISPATCH(BlendTileSimd)(frame, tile, rgb);
+void blend_tile_simd(const Frame& frame, const TileJob& tile, float* rgb, SpanPruning pruning) {
+  HWY_DYNAMIC_DISPATCH(BlendTileSimd)(frame, tile, rgb, pruning);
 }
 
 void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::size_t n) {
@@ -463,7 +468,7 @@ void apply_simd_target_limit() {
 namespace flashgs {
 namespace cpu {
 
-void blend_tile_simd(const Frame& frame, const TileJob& tile, float* rgb) {
+void blend_tile_simd(const Frame& frame, const TileJob& tile, float* rgb, SpanPruning) {
   blend_tile_scalar(frame, tile, rgb);
 }
 

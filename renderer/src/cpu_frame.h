@@ -148,8 +148,10 @@ std::size_t exact_box_tiles_room(const gm::Footprint& f);
 // Puts emit's pairs in tile order, keeping their (depth, id) order within a tile: tile_ids and
 // tile_start (the ranges stage).
 void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms);
-// Which kernel composites the tiles.
-enum class BlendKernel { simd, scalar };
+// Which kernel composites the tiles. simd_unpruned: the SIMD kernel with row spans that hold
+// the whole tile (every Gaussian of a tile visits every live row; slow), for the tests, which
+// check that the spans change no byte.
+enum class BlendKernel { simd, scalar, simd_unpruned };
 // Blends every tile, densest first. `cancelled` is asked between tiles; once it says yes the
 // remaining tiles are left as they are and blend returns false.
 bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const std::function<bool()>& cancelled,
@@ -157,7 +159,8 @@ bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const
 // The scalar reference kernel (cpu_blend_scalar.cpp) and the SIMD one (cpu_blend_simd.cpp;
 // without Highway it is the scalar one). Both write the tile's pixels of `rgb`.
 void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb);
-void blend_tile_simd(const Frame& frame, const TileJob& tile, float* rgb);
+enum class SpanPruning { on, off };
+void blend_tile_simd(const Frame& frame, const TileJob& tile, float* rgb, SpanPruning pruning = SpanPruning::on);
 // The SIMD kernel's alpha before its 0.99 cap, opacity e^(-q/2) computed as 2^(q * -log2(e)/2 +
 // log2_opacity), for n lanes (the tests check its bound on every target). Its relative error
 // against the exact value is below kSimdAlphaMaxRelError wherever alpha >= 1/255, and it is
