@@ -126,8 +126,8 @@ struct MemberRecords {
   HWY_ALIGN float centre[gm::kTileSize][kBatch], offset[gm::kTileSize][kBatch];
 };
 
-// Candidates [begin, begin + n) of the tile into `fields`, padded to whole vectors with
-// candidates that reach no row. Prefetches the lines kBatch candidates ahead: the next batch's,
+// Candidates [begin, begin + n) of the tile into `fields`, padded to whole vectors with zeros
+// (finite values; find_members leaves those lanes out). Prefetches the lines kBatch candidates ahead: the next batch's,
 // which the rest of this batch's work gives time to arrive.
 void copy_candidates(const Frame& frame, const TileJob& job, std::uint64_t begin, int n, int padded,
                      BatchFields& fields) {
@@ -135,8 +135,7 @@ void copy_candidates(const Frame& frame, const TileJob& job, std::uint64_t begin
     if (j >= n) {
       fields.mean_x[j] = fields.mean_y[j] = fields.whiten0[j] = fields.whiten2[j] = 0.0f;
       fields.red[j] = fields.green[j] = fields.blue[j] = fields.log2_opacity[j] = 0.0f;
-      fields.row_q_coeff[j] = fields.row_slope[j] = fields.inv_conic_a[j] = 0.0f;
-      fields.q_cut[j] = -1.0f;  // q_cut + 0.5 < 0: no row
+      fields.row_q_coeff[j] = fields.q_cut[j] = fields.row_slope[j] = fields.inv_conic_a[j] = 0.0f;
       continue;
     }
     const std::uint64_t k = begin + static_cast<std::uint64_t>(j);
@@ -188,11 +187,11 @@ constexpr float kSpanWidthScale = 1.0f + 1.0f / 16384;  // on (half width)^2
 constexpr float kSpanPixelMargin = 1.0f / 64;
 
 // Each slot whose row's span of pixels that can pass the exact test meets its lane group, and
-// which is live, gets the candidate's bit: a vector of candidates at a time, row by row. A
+// which is live, gets the bit of candidate j < n: a vector of candidates at a time, row by row. A
 // span holds every such pixel (the margins above) and may hold a few that then fail the test:
 // the same pixels blend. Also writes the members' records (whatever the candidate: one that
 // touches no live slot is never read).
-void find_members(const BatchFields& fields, int padded, int x_begin, int y_begin, int tile_w, int tile_h,
+void find_members(const BatchFields& fields, int n, int x_begin, int y_begin, int tile_w, int tile_h,
                   float q_margin, TileState& tile, MemberRecords& records) {
   const FloatTag d;
   const int lanes = static_cast<int>(hn::Lanes(d));
@@ -207,7 +206,8 @@ void find_members(const BatchFields& fields, int padded, int x_begin, int y_begi
   std::uint32_t live_rows = 0;
   for (int v = 0; v < groups_per_row; ++v)
     live_rows |= static_cast<std::uint32_t>(tile.live_slots >> (v * gm::kTileSize)) & ((1u << gm::kTileSize) - 1u);
-  for (int base = 0; base < padded; base += lanes) {
+  for (int base = 0; base < n; base += lanes) {
+    const auto candidate = hn::FirstN(d, static_cast<std::size_t>(n - base));
     const auto mean_x = hn::Load(d, fields.mean_x + base), mean_y = hn::Load(d, fields.mean_y + base);
     const auto coeff = hn::Load(d, fields.row_q_coeff + base), slope = hn::Load(d, fields.row_slope + base);
     const auto width_coeff = hn::Mul(hn::Load(d, fields.inv_conic_a + base), hn::Set(d, kSpanWidthScale));
@@ -222,7 +222,7 @@ void find_members(const BatchFields& fields, int padded, int x_begin, int y_begi
     const auto last_row = hn::Min(last_tile_row, hn::Floor(hn::Add(local_y, reach)));
     // The rows some candidate of the vector reaches. q_reach < 0 (opacity < 1/255, drawn by the
     // baseline): no pixel passes, no row; nor for NaN rows.
-    const auto reaches = hn::And(hn::Ge(q_reach, zero), hn::Le(first_row, last_row));
+    const auto reaches = hn::And(candidate, hn::And(hn::Ge(q_reach, zero), hn::Le(first_row, last_row)));
     const float lowest =
         hn::GetLane(hn::MinOfLanes(d, hn::IfThenElse(reaches, first_row, hn::Set(d, static_cast<float>(gm::kTileSize)))));
     const float highest = hn::GetLane(hn::MaxOfLanes(d, hn::IfThenElse(reaches, last_row, hn::Set(d, -1.0f))));
@@ -254,7 +254,7 @@ void find_members(const BatchFields& fields, int padded, int x_begin, int y_begi
       // Group v holds columns [v lanes, (v + 1) lanes) of the tile's: the span meets it unless
       // it ends before or starts after (a span between two columns counts too: a visit whose
       // lanes all fail the test); a NaN span meets every group (its alpha fails the test).
-      const auto touched = hn::AndNot(hn::Gt(span_first, tile_right), hn::Le(row_q, q_reach));
+      const auto touched = hn::And(candidate, hn::AndNot(hn::Gt(span_first, tile_right), hn::Le(row_q, q_reach)));
       for (int v = 0; v < groups_per_row; ++v) {
         const int slot = v * gm::kTileSize + row;
         const auto before = hn::Gt(span_first, hn::Set(d, static_cast<float>((v + 1) * lanes - 1)));
@@ -302,9 +302,8 @@ void blend_members(const MemberRecords& records, int slot_count, TileState& tile
       const std::size_t j = hwy::Num0BitsBelowLS1Bit_Nonzero32(members);
       const auto dx = hn::Sub(x, hn::Set(d, centre_row[j]));
       const auto exponent = hn::MulAdd(hn::Mul(dx, dx), hn::Set(d, records.quadratic[j]), hn::Set(d, offset_row[j]));
-      // Only the exact test: a lane outside the row's span or below power_cut has alpha <
-      // 1/255 for certain (the margins the scalar kernel's pruning relies on), so it fails
-      // this test as surely as it would have been skipped there. A lane that fails it gets
+      // Only the exact test: a lane outside the row's span has alpha < 1/255 for certain (the
+      // spans' margins, above), so it fails this test as surely as it would have been skipped. A lane that fails it gets
       // alpha 0, which leaves its T and colour as they are, bit for bit (T - 0 T = T, colour
       // + c 0 = colour: both start at +0 or 1 and stay >= 0): no mask of its own below.
       const auto unclamped = exp2_nonpositive(d, exponent);
@@ -383,7 +382,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, float* rgb, SpanPruni
     const int n = static_cast<int>(std::min<std::uint64_t>(kBatch, job.count - k));
     const int padded = (n + lanes_i - 1) / lanes_i * lanes_i;
     copy_candidates(frame, job, k, n, padded, fields);
-    find_members(fields, padded, x_begin, y_begin, tile_w, tile_h, q_margin, tile, records);
+    find_members(fields, n, x_begin, y_begin, tile_w, tile_h, q_margin, tile, records);
     blend_members(records, slot_count, tile);
   }
   // Colour plus the transmittance's share of the background, as the scalar kernel (no FMA),
