@@ -9,9 +9,9 @@
 // 1.8e-7). Such an error can move alpha across 1/255 or T across 1e-4, the same flips as
 // between the CPU and CUDA backends (see test_cuda_render.cpp), so the images stay within that
 // bound of the scalar kernel's (test_cpu_simd.cpp, every real scene), and as close to the fp64
-// reference as the scalar kernel's (test_cpu_render.cpp). The pruning margins (0.5 in q, a
-// pixel) dwarf these roundings. For a given CPU (target) and any thread count the bytes are
-// the same.
+// reference as the scalar kernel's (test_cpu_render.cpp). The row spans' margins (kSpanQMargin
+// and beside it) exceed these roundings more than 30x, so pruning changes no byte
+// (test_cpu_simd.cpp). For a given CPU (target) and any thread count the bytes are the same.
 #include <strings.h>
 
 #include <algorithm>
