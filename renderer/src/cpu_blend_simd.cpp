@@ -127,8 +127,8 @@ struct MemberRecords {
 };
 
 // Candidates [begin, begin + n) of the tile into `fields`, padded to whole vectors with zeros
-// (finite values; find_members leaves those lanes out). Prefetches the lines kBatch candidates ahead: the next batch's,
-// which the rest of this batch's work gives time to arrive.
+// (finite values; find_members leaves those lanes out). Prefetches the lines kBatch candidates
+// ahead: the next batch's, which the rest of this batch's work gives time to arrive.
 void copy_candidates(const Frame& frame, const TileJob& job, std::uint64_t begin, int n, int padded,
                      BatchFields& fields) {
   for (int j = 0; j < padded; ++j) {
@@ -158,13 +158,14 @@ void copy_candidates(const Frame& frame, const TileJob& job, std::uint64_t begin
 
 // The tile's vectors ("slots"): lane group j of row y is slot j * kTileSize + y (16 rows x at
 // most 4 groups), bit `slot` of a 64-bit set. Per slot, one vector each, next to each other
-// (one base address per slot): the pixels' column in the tile, transmittance, colour, and
-// whether they still blend (all bits set) - pixels outside the image start finished. A slot
-// whose lanes have all finished leaves live_slots (and slot_live, the same as a word per slot,
-// which the span pass reads), and the tile stops when none is left.
+// (one base address per slot): the pixels' column in the tile, transmittance, colour, and the
+// transmittance of the pixels that still blend, 0 on the finished ones (which need no mask of
+// their own then) - pixels outside the image start finished. A slot whose lanes have all
+// finished leaves live_slots (and slot_live, the same as a word per slot, which the span pass
+// reads), and the tile stops when none is left.
 static_assert(gm::kTileSize <= 16, "64 slots: 16 rows of at most 4 lane groups");
 constexpr int kMaxSlots = 64;
-enum SlotField { kX, kT, kRed, kGreen, kBlue, kActive, kSlotFields };
+enum SlotField { kX, kT, kRed, kGreen, kBlue, kLiveT, kSlotFields };
 
 struct TileState {
   HWY_ALIGN float slots[kSlotFields * kTilePixels];
@@ -292,7 +293,7 @@ void blend_members(const MemberRecords& records, int slot_count, TileState& tile
     auto t = hn::Load(d, state + kT * lanes);
     auto red = hn::Load(d, state + kRed * lanes), green = hn::Load(d, state + kGreen * lanes);
     auto blue = hn::Load(d, state + kBlue * lanes);
-    auto live = hn::MaskFromVec(hn::Load(d, state + kActive * lanes));
+    auto live_t = hn::Load(d, state + kLiveT * lanes);
     MemberSet members = tile.slot_members[slot];
     tile.slot_members[slot] = 0;
     // No early outs per visit (no lane above power_cut, a lane finishing): the masks below
@@ -303,34 +304,34 @@ void blend_members(const MemberRecords& records, int slot_count, TileState& tile
       const auto dx = hn::Sub(x, hn::Set(d, centre_row[j]));
       const auto exponent = hn::MulAdd(hn::Mul(dx, dx), hn::Set(d, records.quadratic[j]), hn::Set(d, offset_row[j]));
       // Only the exact test: a lane outside the row's span has alpha < 1/255 for certain (the
-      // spans' margins, above), so it fails this test as surely as it would have been skipped. A lane that fails it gets
-      // alpha 0, which leaves its T and colour as they are, bit for bit (T - 0 T = T, colour
-      // + c 0 = colour: both start at +0 or 1 and stay >= 0): no mask of its own below.
+      // spans' margins, above), so it fails this test as surely as it would have been skipped.
+      // A lane that fails it gets alpha 0, which leaves its T and colour as they are, bit for
+      // bit (T - 0 T = T, colour + c 0 = colour: both start at +0 or 1 and stay >= 0): no mask
+      // of its own below.
       const auto unclamped = exp2_nonpositive(d, exponent);
       const auto alpha = hn::IfThenElseZero(hn::Ge(unclamped, alpha_min), hn::Min(alpha_max, unclamped));
       // T - alpha T with one rounding: the scalar kernel's T (1 - alpha) where 1 - alpha is
-      // exact (alpha >= 1/2), within an ulp elsewhere, and its product is the weight.
-      const auto weight_if_blended = hn::Mul(alpha, t);
-      const auto next_t = hn::NegMulAdd(alpha, t, t);
+      // exact (alpha >= 1/2), within an ulp elsewhere, and its product is the weight. live_t is
+      // a live lane's T and 0 on a finished one, whose next T, 0, is then below the minimum.
+      const auto next_t = hn::NegMulAdd(alpha, live_t, live_t);
       // A live lane whose T would drop below the minimum finishes instead of blending (alpha
       // 0 never does: a live lane's T is at least the minimum); the others blend.
-      const auto too_dark = hn::Lt(next_t, t_min);
-      const auto blends = hn::AndNot(too_dark, live);
-      live = blends;
+      const auto blends = hn::Ge(next_t, t_min);
       // Lanes that do not blend add colour * 0: the same bytes as leaving them, for one
       // select instead of three.
-      const auto weight = hn::IfThenElseZero(blends, weight_if_blended);
+      const auto weight = hn::IfThenElseZero(blends, hn::Mul(alpha, live_t));
       red = hn::MulAdd(hn::Set(d, records.red[j]), weight, red);
       green = hn::MulAdd(hn::Set(d, records.green[j]), weight, green);
       blue = hn::MulAdd(hn::Set(d, records.blue[j]), weight, blue);
-      t = hn::IfThenElse(blends, next_t, t);
+      t = hn::IfThenElse(blends, next_t, t);  // a finishing lane keeps its T
+      live_t = hn::IfThenElseZero(blends, next_t);
     }
     hn::Store(t, d, state + kT * lanes);
     hn::Store(red, d, state + kRed * lanes);
     hn::Store(green, d, state + kGreen * lanes);
     hn::Store(blue, d, state + kBlue * lanes);
-    hn::Store(hn::VecFromMask(d, live), d, state + kActive * lanes);
-    if (hn::AllFalse(d, live)) {
+    hn::Store(live_t, d, state + kLiveT * lanes);
+    if (hn::AllTrue(d, hn::Eq(live_t, hn::Zero(d)))) {
       tile.live_slots &= ~(std::uint64_t{1} << slot);
       tile.slot_live[slot] = 0;
     }
@@ -367,7 +368,7 @@ void BlendTileSimd(const Frame& frame, const TileJob& job, float* rgb, SpanPruni
       hn::Store(hn::Zero(d), d, slot_field(slot, kRed));
       hn::Store(hn::Zero(d), d, slot_field(slot, kGreen));
       hn::Store(hn::Zero(d), d, slot_field(slot, kBlue));
-      hn::Store(hn::VecFromMask(d, inside), d, slot_field(slot, kActive));
+      hn::Store(hn::IfThenElseZero(inside, hn::Set(d, 1.0f)), d, slot_field(slot, kLiveT));
       const bool any_inside = !hn::AllFalse(d, inside);
       tile.slot_live[slot] = any_inside ? ~MemberSet{0} : 0u;
       if (any_inside) tile.live_slots |= std::uint64_t{1} << slot;
