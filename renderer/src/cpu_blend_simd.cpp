@@ -188,10 +188,10 @@ constexpr float kSpanWidthScale = 1.0f + 1.0f / 16384;  // on (half width)^2
 constexpr float kSpanPixelMargin = 1.0f / 64;
 
 // Each slot whose row's span of pixels that can pass the exact test meets its lane group, and
-// which is live, gets the bit of candidate j < n: a vector of candidates at a time, row by row. A
-// span holds every such pixel (the margins above) and may hold a few that then fail the test:
-// the same pixels blend. Also writes the members' records (whatever the candidate: one that
-// touches no live slot is never read).
+// which is live, gets the bit of candidate j < n: a vector of candidates at a time, row by
+// row. A span holds every such pixel (the margins above) and may hold a few that then fail the
+// test: the same pixels blend. Also writes the members' records (whatever the candidate: one
+// that touches no live slot is never read).
 void find_members(const BatchFields& fields, int n, int x_begin, int y_begin, int tile_w, int tile_h,
                   float q_margin, TileState& tile, MemberRecords& records) {
   const FloatTag d;
