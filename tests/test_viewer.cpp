@@ -1077,6 +1077,60 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
 #endif
 }
 
+// A drag on the CPU path goes on showing frames: while the view moves, a newer view does not
+// cancel the frame in flight; that frame is shown, and the newest view renders after it. Before,
+// each UI frame's new view cancelled the frame in flight, so a drag whose views came faster than
+// a frame rendered showed nothing until it ended (pc_biker at 1280x800 on two cores: no frame in
+// the first 570 UI frames of a drag). Here the render gate holds the first frame of the drag while
+// two more views come (each logged twice, so the second log line is of a UI frame after the one
+// that asked for it); the render size is pinned, so that no view asks for fewer pixels.
+TEST(Viewer, ADragDoesNotCancelTheFrameInFlight) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string steps =
+      "wait_for \"first frame shown\" || status=10\n"
+      "shown=$(grep -c \"frame shown\" \"$log\")\n"
+      "close_gate\n"
+      "\"$input\" move 300 200\n"
+      "[ $status -eq 0 ] && { press button \" mouse0 \" || status=11; }\n"
+      "\"$input\" move 330 200\n"
+      "[ $status -eq 0 ] && { wait_for \"render gate: a 320x180 frame waits\" || status=12; }\n"
+      "\"$input\" move 360 200\n"
+      "[ $status -eq 0 ] && { wait_count \"held: mouse0 at 360,200 \" 2 || status=13; }\n"
+      "\"$input\" move 390 200\n"
+      "[ $status -eq 0 ] && { wait_count \"held: mouse0 at 390,200 \" 2 || status=13; }\n"
+      "open_gate\n"
+      "[ $status -eq 0 ] && { wait_count \"frame shown\" $((shown + 1)) || status=14; }\n"
+      "\"$input\" up button\n"
+      "[ $status -eq 0 ] && { close_window || status=16; }\n";
+  const RunResult r = run_live_viewer(prefix, "drag_keeps_frame",
+                                      "--backend cpu --size 640x360 --render-size 320x180 --camera 1 --no-ui "
+                                      "--log-input" + gate_args("drag_keeps_frame"),
+                                      steps, 15);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 first frame, 11 press, 12 no frame at the gate, 13 views not taken, "
+                               "14 no frame shown, 15 crash, 16 close)\n"
+                            << r.output;
+  EXPECT_EQ(r.output.find("render gate: the waiting frame was cancelled"), std::string::npos)
+      << "a newer view cancelled the frame in flight during the drag\n" << r.output;
+  std::size_t waited = 0;
+  for (auto at = r.output.find("render gate: a "); at != std::string::npos; at = r.output.find("render gate: a ", at + 1))
+    ++waited;
+  EXPECT_EQ(waited, 1u) << "one frame waits at the gate while the views come\n" << r.output;
+  // The drag turned the view: the views were taken, and not as a click on the panels.
+  const auto first = r.output.find("held: mouse0 at "), last = r.output.rfind("held: mouse0 at ");
+  ASSERT_NE(first, std::string::npos) << r.output;
+  auto forward = [&](std::size_t at) {
+    const auto f = r.output.find(" forward ", at);
+    return r.output.substr(f, r.output.find(" right ", f) - f);
+  };
+  EXPECT_NE(forward(first), forward(last)) << r.output;
+#endif
+}
+
 // "Compare this view" on the CPU path renders two frames of pc_playbot beside the frame loop.
 // While they are in flight (held by the render gate), a second C is refused with a notice and
 // a click changes an option (frames logged as "(comparing)"); then the gate opens and the

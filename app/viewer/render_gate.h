@@ -10,8 +10,9 @@
 
 namespace flashgs::viewer {
 
-// Returns once `gate_file` exists or `stop()` is true; `waiting` is true while it waits.
-void wait_at_gate(const std::string& gate_file, const std::function<bool()>& stop, std::atomic<bool>& waiting);
+// Returns once `gate_file` exists (true) or `stop()` is true (false); `waiting` is true while
+// it waits.
+bool wait_at_gate(const std::string& gate_file, const std::function<bool()>& stop, std::atomic<bool>& waiting);
 
 class FileGatedRenderer final : public Renderer {
  public:

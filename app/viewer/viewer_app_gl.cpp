@@ -755,9 +755,11 @@ void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
                        request.options != m_requested.options;
   const bool again = m_scripted || (m_settings.continuous && !m_path->busy());
   if (!changed && !again) return;
-  // While the view moves, a reduced frame in flight may finish (it is quick; cancelling one
-  // every frame would show nothing); a full frame in flight stops for the new view.
-  const bool cancel_in_flight = (!moving || m_requested_full) && !shot_pending;
+  // While the view moves, the frame in flight finishes and the newest view renders next: a drag
+  // brings a new view every UI frame, faster than a frame renders, so cancelling each would show
+  // nothing until the drag ends. Only a full frame too slow for a moving view stops for the
+  // first reduced one; a view that has come to rest replaces whatever is in flight.
+  const bool cancel_in_flight = !shot_pending && (!moving || (m_requested_full && reduced));
   const auto t0 = Clock::now();
   try {
     if (!m_path->renders_in_background()) ensure_texture(rw, rh);
