@@ -1077,57 +1077,98 @@ TEST(Viewer, TheUiAnswersAClickWhileACpuRenderIsInFlight) {
 #endif
 }
 
-// A drag on the CPU path goes on showing frames: while the view moves, a newer view does not
-// cancel the frame in flight; that frame is shown, and the newest view renders after it. Before,
-// each UI frame's new view cancelled the frame in flight, so a drag whose views came faster than
-// a frame rendered showed nothing until it ended (pc_biker at 1280x800 on two cores: no frame in
-// the first 570 UI frames of a drag). Here the render gate holds the first frame of the drag while
-// two more views come (each logged twice, so the second log line is of a UI frame after the one
-// that asked for it); the render size is pinned, so that no view asks for fewer pixels.
+#ifdef FLASHGS_X11_INPUT
+// A continuous change on the CPU path (a drag, a slider) goes on showing frames: a newer request
+// does not cancel the frame in flight; that frame is shown, and the newest request renders after
+// it. Before, each UI frame's change cancelled the frame in flight, so changes coming faster than
+// a frame rendered showed nothing until they ended (pc_biker at 1280x800 on two cores: no frame
+// in the first 570 UI frames of a drag, 3 frames in a 3-second drag of the FOV slider).
+// `to_start` sets the shell's x and y and moves the pointer there; the button goes down and the
+// pointer moves 10 px right three times. The render gate holds the first frame of the change
+// while the other two come (each move logged twice, so that the second line is of a UI frame
+// after the one that asked for its frame); the render size is pinned, so that no change asks for
+// fewer pixels. Returns the viewer's log.
+std::string expect_continuous_change_keeps_frame(const std::string& prefix, const std::string& name,
+                                                 const std::string& viewer_args, const std::string& to_start) {
+  const std::string steps =
+      "wait_for \"first frame shown\" || status=10\n"
+      "shown=$(grep -c \"frame shown\" \"$log\")\n"
+      "close_gate\n" + to_start +
+      "[ $status -eq 0 ] && { press button \" mouse0 \" || status=11; }\n"
+      "\"$input\" move $((x + 10)) $y\n"
+      "[ $status -eq 0 ] && { wait_for \"render gate: a 320x180 frame waits\" || status=12; }\n"
+      "for k in 2 3; do\n"
+      "  \"$input\" move $((x + 10 * k)) $y\n"
+      "  [ $status -eq 0 ] && { wait_count \"held: mouse0 at $((x + 10 * k)),$y \" 2 || status=13; }\n"
+      "done\n"
+      "open_gate\n"
+      "[ $status -eq 0 ] && { wait_count \"frame shown\" $((shown + 1)) || status=14; }\n"
+      "\"$input\" up button\n"
+      "[ $status -eq 0 ] && { close_window || status=16; }\n";
+  const RunResult r = run_live_viewer(prefix, name,
+                                      viewer_args + " --backend cpu --render-size 320x180 --log-input" + gate_args(name),
+                                      steps, 15);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 first frame, 11 press, 12 no frame at the gate, 13 moves not taken, "
+                               "14 no frame shown, 15 crash, 16 close)\n"
+                            << r.output;
+  EXPECT_EQ(r.output.find("render gate: the waiting frame was cancelled"), std::string::npos)
+      << "a newer request cancelled the frame in flight\n" << r.output;
+  std::size_t waited = 0;
+  for (auto at = r.output.find("render gate: a "); at != std::string::npos; at = r.output.find("render gate: a ", at + 1))
+    ++waited;
+  EXPECT_EQ(waited, 1u) << "one frame waits at the gate while the changes come\n" << r.output;
+  return r.output;
+}
+
+// The text between `from` and `to` in the first line at or after `at` holding `from`.
+std::string field_after(const std::string& log, std::size_t at, const std::string& from, const std::string& to) {
+  const auto f = log.find(from, at);
+  if (f == std::string::npos) return "";
+  return log.substr(f, log.find(to, f) - f);
+}
+#endif
+
 TEST(Viewer, ADragDoesNotCancelTheFrameInFlight) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
 #else
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
-  const std::string steps =
-      "wait_for \"first frame shown\" || status=10\n"
-      "shown=$(grep -c \"frame shown\" \"$log\")\n"
-      "close_gate\n"
-      "\"$input\" move 300 200\n"
-      "[ $status -eq 0 ] && { press button \" mouse0 \" || status=11; }\n"
-      "\"$input\" move 330 200\n"
-      "[ $status -eq 0 ] && { wait_for \"render gate: a 320x180 frame waits\" || status=12; }\n"
-      "\"$input\" move 360 200\n"
-      "[ $status -eq 0 ] && { wait_count \"held: mouse0 at 360,200 \" 2 || status=13; }\n"
-      "\"$input\" move 390 200\n"
-      "[ $status -eq 0 ] && { wait_count \"held: mouse0 at 390,200 \" 2 || status=13; }\n"
-      "open_gate\n"
-      "[ $status -eq 0 ] && { wait_count \"frame shown\" $((shown + 1)) || status=14; }\n"
-      "\"$input\" up button\n"
-      "[ $status -eq 0 ] && { close_window || status=16; }\n";
-  const RunResult r = run_live_viewer(prefix, "drag_keeps_frame",
-                                      "--backend cpu --size 640x360 --render-size 320x180 --camera 1 --no-ui "
-                                      "--log-input" + gate_args("drag_keeps_frame"),
-                                      steps, 15);
-  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
-                            << " failed (10 first frame, 11 press, 12 no frame at the gate, 13 views not taken, "
-                               "14 no frame shown, 15 crash, 16 close)\n"
-                            << r.output;
-  EXPECT_EQ(r.output.find("render gate: the waiting frame was cancelled"), std::string::npos)
-      << "a newer view cancelled the frame in flight during the drag\n" << r.output;
-  std::size_t waited = 0;
-  for (auto at = r.output.find("render gate: a "); at != std::string::npos; at = r.output.find("render gate: a ", at + 1))
-    ++waited;
-  EXPECT_EQ(waited, 1u) << "one frame waits at the gate while the views come\n" << r.output;
-  // The drag turned the view: the views were taken, and not as a click on the panels.
-  const auto first = r.output.find("held: mouse0 at "), last = r.output.rfind("held: mouse0 at ");
-  ASSERT_NE(first, std::string::npos) << r.output;
-  auto forward = [&](std::size_t at) {
-    const auto f = r.output.find(" forward ", at);
-    return r.output.substr(f, r.output.find(" right ", f) - f);
+  const std::string log = expect_continuous_change_keeps_frame(
+      prefix, "drag_keeps_frame", "--size 640x360 --camera 1 --no-ui", "x=300 y=200\n\"$input\" move $x $y\n");
+  // The drag turned the view at each move (not taken as a click on the panels).
+  const std::string second = field_after(log, log.find("held: mouse0 at 320,200 "), " forward ", " right ");
+  const std::string third = field_after(log, log.find("held: mouse0 at 330,200 "), " forward ", " right ");
+  EXPECT_NE(field_after(log, log.find("held: mouse0 at "), " forward ", " right "), second) << log;
+  EXPECT_NE(second, third) << log;
+#endif
+}
+
+TEST(Viewer, DraggingASliderDoesNotCancelTheFrameInFlight) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // The FOV slider's centre, as the viewer logs it (--log-input); 1024x600: its section is open.
+  const std::string to_start =
+      "wait_for \"widget \\\"FOV (deg)\\\" at \" || status=17\n"
+      "at=$(grep -F \"widget \\\"FOV (deg)\\\" at \" \"$log\" | tail -n 1 | sed 's/.* at //')\n"
+      "x=${at%,*} y=${at#*,}\n"
+      "\"$input\" move $x $y\n";
+  const std::string log =
+      expect_continuous_change_keeps_frame(prefix, "slider_keeps_frame", "--size 1024x600 --camera 1", to_start);
+  // Each move changed the field of view.
+  const auto at_move = [&](int k) {
+    const auto first = log.find("held: mouse0 at ");
+    if (first == std::string::npos) return std::string();
+    const std::string x = field_after(log, first, " at ", ",").substr(4);
+    const int moved = std::atoi(x.c_str()) + 10 * k;
+    return field_after(log, log.find("held: mouse0 at " + std::to_string(moved) + ","), " fov ", ",");
   };
-  EXPECT_NE(forward(first), forward(last)) << r.output;
+  EXPECT_NE(at_move(1), at_move(2)) << log;
+  EXPECT_NE(at_move(2), at_move(3)) << log;
 #endif
 }
 

@@ -105,5 +105,6 @@ void ImGuiLayer::end_frame() {
 
 bool ImGuiLayer::wants_mouse() const { return ImGui::GetIO().WantCaptureMouse; }
 bool ImGuiLayer::wants_keyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
+bool ImGuiLayer::widget_held() const { return ImGui::IsAnyItemActive(); }
 
 }  // namespace flashgs::viewer

@@ -23,6 +23,8 @@ class ImGuiLayer {
   void end_frame();  // draws into the current framebuffer
   bool wants_mouse() const;
   bool wants_keyboard() const;
+  // A widget is held this frame (a slider or drag box being dragged, a field being edited).
+  bool widget_held() const;
 
  private:
   void update_platform_inputs();

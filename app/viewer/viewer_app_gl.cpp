@@ -755,11 +755,13 @@ void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
                        request.options != m_requested.options;
   const bool again = m_scripted || (m_settings.continuous && !m_path->busy());
   if (!changed && !again) return;
-  // While the view moves, the frame in flight finishes and the newest view renders next: a drag
-  // brings a new view every UI frame, faster than a frame renders, so cancelling each would show
-  // nothing until the drag ends. Only a full frame too slow for a moving view stops for the
-  // first reduced one; a view that has come to rest replaces whatever is in flight.
-  const bool cancel_in_flight = !shot_pending && (!moving || (m_requested_full && reduced));
+  // While the view moves or a widget is held (a slider dragged), the frame in flight finishes
+  // and the newest request renders next: such changes come every UI frame, faster than a frame
+  // renders, so cancelling each would show nothing until they end. Only a full frame too slow for
+  // a moving view stops for the first reduced one; any other change (a click, the view coming to
+  // rest) replaces whatever is in flight.
+  const bool changing = moving || (m_ui && m_ui->widget_held());
+  const bool cancel_in_flight = !shot_pending && (!changing || (m_requested_full && reduced));
   const auto t0 = Clock::now();
   try {
     if (!m_path->renders_in_background()) ensure_texture(rw, rh);
@@ -908,9 +910,9 @@ void ViewerApp::log_held_input() {
   const glm::vec3 f = p.rotation[2], r = p.rotation[0], pivot = m_controller.pivot();
   std::fprintf(stderr,
                "flashgs-viewer: frame %d held:%s at %.0f,%.0f | camera %.6f %.6f %.6f forward %.6f %.6f %.6f "
-               "right %.6f %.6f %.6f pivot %.6f %.6f %.6f%s, HUD %.1f FPS\n",
+               "right %.6f %.6f %.6f pivot %.6f %.6f %.6f fov %.2f%s, HUD %.1f FPS\n",
                m_presented, held.c_str(), x, y, p.position.x, p.position.y, p.position.z, f.x, f.y, f.z, r.x, r.y, r.z,
-               pivot.x, pivot.y, pivot.z,
+               pivot.x, pivot.y, pivot.z, m_settings.fov_x_degrees,
                comparing()          ? " (comparing)"
                : m_export_job.busy() ? " (exporting)"
                : m_path->busy()      ? " (a frame is rendering)"

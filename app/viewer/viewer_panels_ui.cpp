@@ -215,6 +215,7 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
     ImGui::TextDisabled("no cameras.json: free navigation");
   }
   ImGui::SliderFloat("FOV (deg)", &s.fov_x_degrees, kFovRange.min, kFovRange.max, "%.1f", kClamp);
+  note_widget_place("FOV (deg)");
   ImGui::SliderFloat("Speed", &s.move_speed, kMoveSpeedRange.min, kMoveSpeedRange.max, "%.3g extents/s",
                      kClamp | ImGuiSliderFlags_Logarithmic);
   ImGui::SliderFloat("Render scale", &s.render_scale, kRenderScaleRange.min, kRenderScaleRange.max, "%.2f", kClamp);
