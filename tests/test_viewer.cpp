@@ -1110,7 +1110,7 @@ std::string expect_continuous_change_keeps_frame(const std::string& prefix, cons
                                       steps, 15);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 first frame, 11 press, 12 no frame at the gate, 13 moves not taken, "
-                               "14 no frame shown, 15 crash, 16 close)\n"
+                               "14 no frame shown, 15 crash, 16 close, 17 start not found)\n"
                             << r.output;
   EXPECT_EQ(r.output.find("render gate: the waiting frame was cancelled"), std::string::npos)
       << "a newer request cancelled the frame in flight\n" << r.output;
