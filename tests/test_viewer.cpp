@@ -1159,16 +1159,20 @@ TEST(Viewer, DraggingASliderDoesNotCancelTheFrameInFlight) {
       "\"$input\" move $x $y\n";
   const std::string log =
       expect_continuous_change_keeps_frame(prefix, "slider_keeps_frame", "--size 1024x600 --camera 1", to_start);
-  // Each move changed the field of view.
-  const auto at_move = [&](int k) {
-    const auto first = log.find("held: mouse0 at ");
-    if (first == std::string::npos) return std::string();
-    const std::string x = field_after(log, first, " at ", ",").substr(4);
-    const int moved = std::atoi(x.c_str()) + 10 * k;
-    return field_after(log, log.find("held: mouse0 at " + std::to_string(moved) + ","), " fov ", ",");
-  };
-  EXPECT_NE(at_move(1), at_move(2)) << log;
-  EXPECT_NE(at_move(2), at_move(3)) << log;
+  // Each move changed the field of view: the FOV of the first held-input line at each point.
+  const auto first = log.find("held: mouse0 at ");
+  ASSERT_NE(first, std::string::npos) << log;
+  const int x = std::atoi(log.c_str() + first + std::string("held: mouse0 at ").size());
+  double fov[4];
+  for (int k = 1; k <= 3; ++k) {
+    const auto line = log.find("held: mouse0 at " + std::to_string(x + 10 * k) + ",");
+    ASSERT_NE(line, std::string::npos) << "no held-input line at the move " << k << "\n" << log;
+    const auto at = log.find(" fov ", line);
+    ASSERT_NE(at, std::string::npos) << log;
+    fov[k] = std::atof(log.c_str() + at + 5);
+  }
+  EXPECT_NE(fov[1], fov[2]) << log;
+  EXPECT_NE(fov[2], fov[3]) << log;
 #endif
 }
 
