@@ -366,8 +366,10 @@ TEST(CudaDeferredEmission, WhereAndInWhatPiecesABoxIsEmittedChangesNoByte) {
 // pair, whether a bin is sorted in shared memory or in global memory
 // (FLASHGS_BIN_SORT_SHARED_PAIRS=0: every bin; 64: most of them), with 16-bit keys, whose runs of
 // equal depth bins the bin sort puts in order itself, with the blend beside the bin blocks (the
-// default on sm_90) or after them (FLASHGS_BIN_OVERLAP=0), and with the bins in the dense-first
-// order (FLASHGS_DENSE_TILES_FIRST=1: the bin blocks and the blend both take it).
+// default on sm_90) or after them (FLASHGS_BIN_OVERLAP=0), with the bins in the dense-first
+// order (FLASHGS_DENSE_TILES_FIRST=1: the bin blocks and the blend both take it, and the
+// counting pass counts the pairs), and with the pairs counted per bin by emission (the default
+// at 1080p and below; FLASHGS_EMIT_BIN_COUNTS=1 at every size) or by the counting pass (=0).
 // Its frames are queued before the host knows the pair count: each renderer's first frame, and
 // a first 4K frame after 1080p ones, overflow the pair buffers (and with FLASHGS_INITIAL_RECORDS
 // the blend records), blend nothing, and run again.
@@ -380,6 +382,7 @@ TEST(CudaBinSort, SortsEachBinAsTheWholeFrameSortDoes) {
     const char* initial_records;
     const char* overlap = "";
     const char* dense = "";
+    const char* emit_counts = "";
   };
   for (const std::string& name : {std::string("pc_biker"), std::string("pc_playbot")}) {
     const auto scene = test::load_shared_scene(name);
@@ -390,13 +393,16 @@ TEST(CudaBinSort, SortsEachBinAsTheWholeFrameSortDoes) {
     whole_frame->set_scene(scene);
     for (const Setting& s : {Setting{"", "", ""}, Setting{"0", "", ""}, Setting{"64", "", ""}, Setting{"", "16", ""},
                              Setting{"0", "16", ""}, Setting{"", "", "1000"}, Setting{"", "", "", "0"},
-                             Setting{"", "", "", "", "1"}, Setting{"0", "", "1000", "", "1"}}) {
+                             Setting{"", "", "", "", "1"}, Setting{"0", "", "1000", "", "1"},
+                             Setting{"", "", "", "", "", "0"}, Setting{"0", "", "1000", "", "", "0"},
+                             Setting{"", "", "", "", "", "1"}, Setting{"0", "16", "1000", "", "", "1"}}) {
       setenv("FLASHGS_BIN_SORT", "1", 1);  // every frame, whether it pays or not
       if (*s.shared_pairs) setenv("FLASHGS_BIN_SORT_SHARED_PAIRS", s.shared_pairs, 1);
       if (*s.key_bits) setenv("FLASHGS_SORT_KEY_BITS", s.key_bits, 1);
       if (*s.initial_records) setenv("FLASHGS_INITIAL_RECORDS", s.initial_records, 1);
       if (*s.overlap) setenv("FLASHGS_BIN_OVERLAP", s.overlap, 1);
       if (*s.dense) setenv("FLASHGS_DENSE_TILES_FIRST", s.dense, 1);
+      if (*s.emit_counts) setenv("FLASHGS_EMIT_BIN_COUNTS", s.emit_counts, 1);
       auto per_bin = make_cuda_renderer();
       unsetenv("FLASHGS_BIN_SORT");
       unsetenv("FLASHGS_BIN_SORT_SHARED_PAIRS");
@@ -404,6 +410,7 @@ TEST(CudaBinSort, SortsEachBinAsTheWholeFrameSortDoes) {
       unsetenv("FLASHGS_INITIAL_RECORDS");
       unsetenv("FLASHGS_BIN_OVERLAP");
       unsetenv("FLASHGS_DENSE_TILES_FIRST");
+      unsetenv("FLASHGS_EMIT_BIN_COUNTS");
       per_bin->set_scene(scene);
       for (int index : {0, 10})
         for (const Camera& camera : {cameras[index].resized(1920, 1080), cameras[index].resized(3840, 2160),
@@ -411,7 +418,8 @@ TEST(CudaBinSort, SortsEachBinAsTheWholeFrameSortDoes) {
           const std::string what = name + " camera " + std::to_string(index) + " " + std::to_string(camera.width) +
                                    "x" + std::to_string(camera.height) + ", shared pairs '" + s.shared_pairs +
                                    "', key bits '" + s.key_bits + "', initial records '" + s.initial_records +
-                                   "', overlap '" + s.overlap + "', dense first '" + s.dense + "'";
+                                   "', overlap '" + s.overlap + "', dense first '" + s.dense +
+                                   "', emission counts '" + s.emit_counts + "'";
           const Result a = render(*whole_frame, camera, RenderOptions{});
           const Result b = render(*per_bin, camera, RenderOptions{});
           expect_same_counts(what, a.stats, b.stats);

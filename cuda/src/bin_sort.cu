@@ -220,6 +220,78 @@ __global__ void __launch_bounds__(kPassBlock) bin_scatter_kernel(const FrameCoun
   }
 }
 
+// A bin's word in bin_scatter_counted_kernel's shared places: each thread of its scan walks a
+// run of consecutive bins, and unskewed, a warp's runs would begin on the same bank.
+__device__ __forceinline__ unsigned skewed(unsigned bin) { return bin + (bin >> 5); }
+constexpr std::size_t counted_scatter_shared_bytes(unsigned bins) {
+  return (static_cast<std::size_t>(bins) + bins / 32 + 1) * sizeof(unsigned);
+}
+
+// The scatter pass of frames whose emission counted the pairs per bin (bin_tally.cuh): no
+// counting pass, and no block that runs after all others to turn the counts into places (a
+// chain of loads and barriers on one block that took 6-10 us at 1080p, docs/PERFORMANCE.md v30
+// and v33). Each block scans the counts of every bin itself, block 0 writes the bin ranges,
+// and each chunk goes out as in bin_scatter_kernel, its places in a bin reserved with one
+// global atomic on the bin's fill (zero at the start).
+__global__ void __launch_bounds__(kPassBlock) bin_scatter_counted_kernel(
+    const FrameCounters* counters, std::uint64_t pair_capacity, std::uint32_t record_capacity,
+    const std::uint32_t* __restrict__ keys, const std::uint32_t* __restrict__ values, int depth_bits, unsigned bins,
+    const std::uint32_t* __restrict__ counts, std::uint32_t* fill, uint2* __restrict__ bin_ranges,
+    uint2* __restrict__ bin_pairs) {
+  extern __shared__ unsigned place[];  // [skewed(bins) + 1]
+  __shared__ unsigned warp_totals[kPassBlock / kWarp];
+  const std::uint64_t pairs = frame_pairs(counters, pair_capacity, record_capacity);
+  if (pairs == 0) {  // block-uniform: nothing stored, or an overflowed frame; every bin empty
+    if (blockIdx.x == 0)
+      for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) bin_ranges[b] = make_uint2(0u, 0u);
+    return;
+  }
+  // Thread t scans bins [first_bin, end_bin); `start` is its first bin's first place.
+  const unsigned per_thread = (bins + kPassBlock - 1) / kPassBlock;
+  const unsigned first_bin = min(bins, threadIdx.x * per_thread), end_bin = min(bins, first_bin + per_thread);
+  unsigned sum = 0;
+  for (unsigned b = first_bin; b < end_bin; ++b) sum += __ldg(counts + b);
+  unsigned total = 0;
+  const unsigned start = block_exclusive_sum<kPassBlock / kWarp>(sum, warp_totals, total);
+  if (blockIdx.x == 0) {
+    unsigned at = start;
+    for (unsigned b = first_bin; b < end_bin; ++b) {
+      const unsigned n = __ldg(counts + b);
+      bin_ranges[b] = make_uint2(at, at + n);
+      at += n;
+    }
+  }
+  const std::uint64_t chunks = (pairs + kChunkPairs - 1) / kChunkPairs;
+  for (std::uint64_t chunk = blockIdx.x; chunk < chunks; chunk += gridDim.x) {  // block-uniform
+    for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) place[skewed(b)] = 0;
+    std::uint32_t key[kChunkItems], value[kChunkItems];
+    unsigned bin[kChunkItems];
+    load_chunk(chunk, pairs, keys, depth_bits, key, bin);
+    const std::uint64_t first = chunk * kChunkPairs + threadIdx.x;
+#pragma unroll
+    for (int k = 0; k < kChunkItems; ++k) value[k] = bin[k] != kNoBin ? values[first + k * kPassBlock] : 0u;
+    __syncthreads();
+#pragma unroll
+    for (int k = 0; k < kChunkItems; ++k)
+      if (bin[k] != kNoBin) atomicAdd(&place[skewed(bin[k])], 1u);
+    __syncthreads();
+    unsigned at = start;
+    for (unsigned b = first_bin; b < end_bin; ++b) {
+      const unsigned n = place[skewed(b)];
+      if (n != 0) place[skewed(b)] = at + atomicAdd(&fill[b], n);
+      at += __ldg(counts + b);
+    }
+    __syncthreads();
+#pragma unroll
+    for (int k = 0; k < kChunkItems; ++k)
+      if (bin[k] != kNoBin) {
+        const unsigned to = atomicAdd(&place[skewed(bin[k])], 1u);
+        if (to < total) bin_pairs[to] = make_uint2(key[k], value[k]);  // (counts that disagreed with the pairs)
+      }
+    __syncthreads();  // the places are cleared for the next chunk
+  }
+}
+
 // One bin's pairs: keys and values at the same index, in shared or global memory.
 struct PairSpan {
   std::uint32_t* keys;
@@ -236,6 +308,7 @@ struct BinSortArgs {
   std::uint32_t* values;    // and values, values[0]
   std::uint32_t* scratch;   // keys[1] as 32-bit words: bin [s, e) may use [2s, 2e) once read
   std::uint32_t* fill;      // the counting passes' per-bin counts, zeroed here for the next frame
+  std::uint32_t* counts;    // FrameBuffers::emitted_bin_counts (or null), likewise zeroed here
   std::uint32_t* top_lists;     // tile_values[0]
   std::uint32_t* bottom_lists;  // tile_values[1]
   uint2* tile_lists;
@@ -516,7 +589,10 @@ __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
 #endif
   __shared__ SortShared sh;
   const unsigned bin = a.order ? a.order[blockIdx.x] : blockIdx.x;
-  if (threadIdx.x == 0) a.fill[bin] = 0;  // the scatter pass was its last user this frame
+  if (threadIdx.x == 0) {  // the scatter pass was their last user this frame
+    a.fill[bin] = 0;
+    if (a.counts) a.counts[bin] = 0;
+  }
   const uint2 range = a.bin_ranges[bin];
   const unsigned n = range.y - range.x;
   const BinLists lists{a.top_lists, a.bottom_lists, range.x, n};
@@ -551,7 +627,7 @@ __global__ void __launch_bounds__(kSortBlock) bin_sort_kernel(BinSortArgs a) {
 constexpr unsigned kScatterBlocks = 2048;
 constexpr unsigned kCountBlocks = 512;
 
-void launch_bin_pairs(const FrameBuffers& b, bool fill_is_zero, std::uint32_t* order, cudaStream_t stream) {
+void launch_bin_pairs(const FrameBuffers& b, std::uint32_t* order, cudaStream_t stream) {
   const unsigned bins = static_cast<unsigned>(b.bins.x) * static_cast<unsigned>(b.bins.y);
   if (bins == 0) return;
   if (bins > kBinSortMaxBins)
@@ -561,7 +637,22 @@ void launch_bin_pairs(const FrameBuffers& b, bool fill_is_zero, std::uint32_t* o
   const std::size_t hist_bytes = bins * sizeof(unsigned);
   const std::uint32_t* keys = reinterpret_cast<const std::uint32_t*>(b.keys[0]);
   const int depth_bits = b.key_format.depth_bits;
-  if (!fill_is_zero) check_cuda(cudaMemsetAsync(b.bin_fill, 0, bins * sizeof(std::uint32_t), stream), "bin count reset");
+  if (b.emitted_bin_counts) {
+    if (order) throw Error("cuda renderer: internal error, a bin order asked of counts the emission took");
+    static const bool allowed = [] {
+      check_cuda(cudaFuncSetAttribute(bin_scatter_counted_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                      static_cast<int>(counted_scatter_shared_bytes(kBinSortMaxBins))),
+                 "bin scatter shared memory");
+      return true;
+    }();
+    (void)allowed;
+    bin_scatter_counted_kernel<<<static_cast<unsigned>(std::min<std::uint64_t>(kScatterBlocks, most_chunks)),
+                                 kPassBlock, counted_scatter_shared_bytes(bins), stream>>>(
+        b.counters, b.pair_capacity, b.record_capacity, keys, b.pair_values, depth_bits, bins, b.emitted_bin_counts,
+        b.bin_fill, b.tile_ranges, reinterpret_cast<uint2*>(b.keys[1]));
+    check_cuda(cudaGetLastError(), "bin scatter kernel launch");
+    return;
+  }
   bin_count_kernel<<<static_cast<unsigned>(std::min<std::uint64_t>(kCountBlocks, most_chunks)), kPassBlock, hist_bytes,
                      stream>>>(b.counters, b.pair_capacity, b.record_capacity, keys, depth_bits, bins, b.bin_fill,
                                b.tile_ranges, order);
@@ -586,6 +677,7 @@ void launch_bin_blocks(int tiles_x, int tiles_y, const FrameBuffers& b, unsigned
   args.values = b.values[0];
   args.scratch = reinterpret_cast<std::uint32_t*>(b.keys[1]);
   args.fill = b.bin_fill;
+  args.counts = b.emitted_bin_counts;
   args.top_lists = b.tile_values[0];
   args.bottom_lists = b.tile_values[1];
   args.tile_lists = b.tile_lists;

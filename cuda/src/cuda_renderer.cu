@@ -226,6 +226,11 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaDeviceGetAttribute(&major, cudaDevAttrComputeCapabilityMajor, device), "device query");
     bin_overlap_ = major >= 9;
     if (const char* overlap = std::getenv("FLASHGS_BIN_OVERLAP")) bin_overlap_ = bin_overlap_ && std::atoi(overlap) != 0;
+    // FLASHGS_EMIT_BIN_COUNTS=1 has every bin-sort frame count its pairs per bin as it emits
+    // them (FrameBuffers::emitted_bin_counts) unless it orders its bins, =0 none (the counting
+    // pass counts; unset: where it pays, see emit_bin_counts_pays).
+    if (const char* counts = std::getenv("FLASHGS_EMIT_BIN_COUNTS"))
+      emit_bin_counts_ = std::atoi(counts) != 0 ? kAlways : kNever;
     // FLASHGS_INITIAL_RECORDS: the blend records a first frame starts with (tests of growth).
     if (const char* records = std::getenv("FLASHGS_INITIAL_RECORDS"))
       initial_records_ = std::max<long long>(1, std::atoll(records));
@@ -560,6 +565,7 @@ class CudaRendererImpl final : public CudaRenderer {
     b.pair_capacity = pair_capacity_;
     b.pair_values = bin_sort_frame_ ? keys_[0].as<std::uint32_t>() + pair_capacity_ : b.values[0];
     b.bin_fill = bin_fill_.as<std::uint32_t>();
+    b.emitted_bin_counts = emitted_counts_frame_ ? b.bin_fill + static_cast<std::uint64_t>(bins_.x) * bins_.y : nullptr;
     b.deferred = deferred_list();
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
@@ -606,6 +612,19 @@ class CudaRendererImpl final : public CudaRenderer {
   // pairs than the mean per resident block. Judged on the latest finished frame (settled_), if
   // of the same size (the view moves little between frames); the first frame blends in image
   // order.
+  // Whether counting the pairs per bin in emission (FrameBuffers::emitted_bin_counts) pays over
+  // the counting pass. Measured on an H200 (docs/PERFORMANCE.md, v35): at 1080p (2,040 bins)
+  // pc_playbot 0.280 -> 0.277-0.278 ms and pc_biker 0.190-0.192 -> 0.188-0.189; at 4K (8,160
+  // bins) 0.589 -> 0.644-0.648 and 0.371-0.372 -> 0.391-0.392, where every scatter block scans
+  // four times as many counts and every preprocess block clears and flushes four times as many.
+  bool emit_bin_counts_pays(std::uint64_t bins) const {
+    if (emit_bin_counts_ != kAuto) return emit_bin_counts_ == kAlways;
+    return bins <= kBinSortAnyCoverageBins;
+  }
+
+  bool dense_order(const RenderOptions& options, bool baseline, std::uint64_t tiles) const {
+    return !baseline && options.dense_tiles_first && dense_order_pays(tiles);
+  }
   bool dense_order_pays(std::uint64_t tiles) const {
     if (dense_tiles_mode_ != kAuto) return dense_tiles_mode_ == kAlways;
     if (!settled_.known || tiles != settled_.tiles || settled_.tile_pairs == 0) return false;
@@ -721,8 +740,9 @@ class CudaRendererImpl final : public CudaRenderer {
     cudaEvent_t* events = events_[event_set_];
     const gm::CameraParams& cam = *f.cam;
     const RenderOptions& options = *f.options;
-    const bool dense_tiles_first =
-        !f.baseline && options.dense_tiles_first && dense_order_pays(f.tiles);
+    const bool dense_tiles_first = dense_order(options, f.baseline, f.tiles);
+    if (dense_tiles_first && emitted_counts_frame_)
+      throw Error("cuda renderer: internal error, the bin order changed between emission and sort");
     if (dense_tiles_first) {
       tile_order_.reserve(std::max<std::uint64_t>(f.bins, 1) * sizeof(std::uint32_t), "bin order");
       if (!bin_sort_frame_)  // the bin sort's counting pass orders the bins without it
@@ -757,9 +777,7 @@ class CudaRendererImpl final : public CudaRenderer {
       if (++bin_frame_tag_ == 0) ++bin_frame_tag_;  // 0 is a fresh buffer's
     }
     if (bin_sort_frame_) {
-      const bool fill_is_zero = f.bins <= zeroed_fill_bins_;
-      zeroed_fill_bins_ = 0;  // until the bin blocks are queued
-      cuda::launch_bin_pairs(b, fill_is_zero, order, stream_);
+      cuda::launch_bin_pairs(b, order, stream_);
       if (!overlap)
         cuda::launch_bin_blocks(cam.tiles_x, cam.tiles_y, b, bin_sort_shared_pairs_, order, nullptr, 0, stream_);
       zeroed_fill_bins_ = f.bins;
@@ -864,7 +882,8 @@ class CudaRendererImpl final : public CudaRenderer {
     bin_sort_frame_ = binned && key_format_.depth_bits > 0 && bin_sort_pays(bins);
     if (bin_sort_frame_) {
       const std::size_t fill_bytes = bin_fill_.bytes();
-      bin_fill_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "bin fill");
+      // Each bin's fill, then its count when emission counts (FrameBuffers::emitted_bin_counts).
+      bin_fill_.reserve(std::max<std::uint64_t>(2 * bins, 1) * sizeof(std::uint32_t), "bin fill");
       if (bin_fill_.bytes() != fill_bytes) zeroed_fill_bins_ = 0;
       if (bin_overlap_) {  // flags of earlier frames' tags: a new buffer starts with none
         const std::size_t ready_bytes = bin_ready_.bytes();
@@ -946,6 +965,16 @@ class CudaRendererImpl final : public CudaRenderer {
                           float_image, tiles, bins, pixels, baseline, fused, binned, count_at_end};
     std::uint64_t pairs = 0;
     for (int attempt = 0;; ++attempt) {
+      // Emission counts the pairs per bin where it pays and the counting pass would not also
+      // order the bins.
+      emitted_counts_frame_ = bin_sort_frame_ && fused && emit_bin_counts_pays(bins) &&
+                              !dense_order(options, baseline, tiles);
+      if (bin_sort_frame_) {
+        if (bins > zeroed_fill_bins_)
+          check_cuda(cudaMemsetAsync(bin_fill_.as<void>(), 0, 2 * bins * sizeof(std::uint32_t), stream_),
+                     "bin count reset");
+        zeroed_fill_bins_ = 0;  // until the bin blocks are queued
+      }
       const cuda::FrameBuffers b = frame_buffers();
       check_cuda(cudaMemsetAsync(b.counters, 0, sizeof(cuda::FrameCounters), stream_), "counter reset");
       check_cuda(cudaEventRecord(events[kBegin], stream_), "event record");
@@ -1088,9 +1117,11 @@ class CudaRendererImpl final : public CudaRenderer {
   bool sort_in_blend_[2] = {false, false};  // per event set: the bin blocks ran beside the blend
   bool sort_follows_project_[2] = {false, false};  // per event set: no kSortBegin, the sort began at kProjected
   bool ranges_in_sort_[2] = {false, false};        // per event set: no kRanged, no ranges stage
-  // bin_fill_'s first zeroed_fill_bins_ words are zero (the bin blocks zero them for the next
-  // frame; a new allocation has none).
+  // bin_fill_'s fills and counts of the first zeroed_fill_bins_ bins are zero (the bin blocks
+  // zero them for the next frame; a new allocation has none).
   std::uint64_t zeroed_fill_bins_ = 0;
+  Mode emit_bin_counts_ = kAuto;       // bin-sort frames count pairs per bin in emission
+  bool emitted_counts_frame_ = false;  // this frame does (FrameBuffers::emitted_bin_counts)
   std::uint64_t last_bin_pairs_ = 0;  // the last frame's pairs if it was binned
   static constexpr std::uint64_t kBinSortMostPairsPerBin = 512;
   static constexpr std::uint64_t kBinSortAnyCoverageBins = 4096;     // 1080p-class frames

@@ -198,6 +198,10 @@ struct FrameBuffers {
   // The bin sort's per-bin counts, then each bin's next free place; the bin blocks leave it
   // zeroed for the next frame.
   std::uint32_t* bin_fill = nullptr;  // [bins]
+  // Bin-sort frames without the dense-first order: the pairs per bin, counted by the emission
+  // kernels (bin_tally.cuh), so that no counting pass runs and each scatter block finds the bins'
+  // places itself (null: the counting pass counts). The bin blocks leave it zeroed.
+  std::uint32_t* emitted_bin_counts = nullptr;  // [bins]
   // Per bin: [start, end) of its pairs in the sorted list.
   uint2* tile_ranges = nullptr;  // [tile_capacity]
   std::uint64_t tile_capacity = 0;
@@ -268,13 +272,14 @@ int launch_sort(std::uint64_t pairs, int end_bit, const FrameBuffers& buffers, c
 // blend's order) or, with a null `order`, bin b. Fills tile_ranges (per bin), tile_lists and
 // tile_values from keys[0] and pair_values. The pair count is read on the device, so the host
 // may queue this before it knows the count; a frame whose emission overflowed a capacity comes
-// out empty. `fill_is_zero`: bin_fill's first `bins` words are zero (the last bin sort over as
-// many bins or more left them so), and the reset is skipped.
+// out empty. bin_fill (and emitted_bin_counts) must be zero for the frame's bins; the bin
+// blocks leave them so. Where emission counted the pairs (emitted_bin_counts), no counting
+// pass runs: the scatter pass finds the bins' places itself, and `order` must be null.
 // With `ready`, each bin block stores `frame_tag` in ready[bin] once its lists are written and
 // lets the next kernel start early (programmatic dependent launch, sm_90): a blend launched
 // with BlendArgs::bins_ready then runs beside the bin blocks, each of its blocks waiting for
 // its own bin, instead of after the last of them.
-void launch_bin_pairs(const FrameBuffers& buffers, bool fill_is_zero, std::uint32_t* order, cudaStream_t stream);
+void launch_bin_pairs(const FrameBuffers& buffers, std::uint32_t* order, cudaStream_t stream);
 void launch_bin_blocks(int tiles_x, int tiles_y, const FrameBuffers& buffers, unsigned shared_pairs,
                        const std::uint32_t* order, std::uint32_t* ready, std::uint32_t frame_tag, cudaStream_t stream);
 // Bins a frame may have for the bin sort: its passes count pairs per bin in shared memory (48

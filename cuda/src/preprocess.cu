@@ -4,9 +4,11 @@
 
 #include <algorithm>
 
+#include "bin_tally.cuh"
 #include "bins.cuh"
 #include "chunk_cull.cuh"
 #include "device_common.cuh"
+#include "flashgs/error.h"
 #include "flashgs/gaussian_math.h"
 #include "pipeline.h"
 #include "scene_access.cuh"
@@ -20,6 +22,22 @@ constexpr int kBlock = 256;
 // the frame's deferred count return at once.
 constexpr unsigned kDeferredEmitBlocks = 1024;
 constexpr float kLog2e = 1.4426950408889634f;
+// Preprocess counts its pairs per bin in 16-bit halves (its shared memory holds the small
+// boxes' scratch too); a block flushes them after this many chunks, each adding at most one
+// pair per Gaussian to a bin, so that no count passes 65,535.
+constexpr unsigned kChunksPerTallyFlush = 255;
+static_assert(kChunksPerTallyFlush * kChunkSize <= 0xffffu, "a packed count holds a flush's pairs");
+using PreprocessTally = BinTally<true>;
+// The deferred boxes' kernel: a word per bin (its blocks may take any number of items).
+using DeferredTally = BinTally<false>;
+
+// Stores one pair and counts it in its bin (bin_tally.cuh).
+template <typename Tally>
+__device__ __forceinline__ void emit_pair(const FrameBuffers& buf, unsigned long long offset, std::uint32_t bin,
+                                          std::uint32_t depth, std::uint32_t value) {
+  store_pair(buf, offset, bin, depth, value);
+  Tally::add(buf, bin);
+}
 
 // Higher SH bands of Gaussian i into registers: only the float4s that DEGREE needs are read,
 // whatever degree the scene was stored with.
@@ -136,9 +154,11 @@ __device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& wal
 // Writes the segment's passing bins; lane c holds chunk c's ballot and its first offset. With
 // bins larger than a tile, a passing bin's tiles are tested again for its value (the test
 // kept no more than a bit per bin).
-__device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
-                                   unsigned max_chunks, unsigned my_ballot, unsigned long long my_base,
-                                   std::uint32_t depth_bits, unsigned record, const gm::CameraParams& cam, bool exact) {
+template <typename Tally>
+__device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint& g,
+                                   const BoxWalk& walk, unsigned s0, unsigned max_chunks, unsigned my_ballot,
+                                   unsigned long long my_base, std::uint32_t depth_bits, unsigned record,
+                                   const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
   const unsigned lanes_below = (1u << lane) - 1u;
   const unsigned chunks = walk.chunks(s0, max_chunks);
@@ -149,8 +169,8 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
     const unsigned long long chunk_base = __shfl_sync(kFullMask, my_base, c);
     if (ballot & (1u << lane)) {
       const unsigned tiles = buf.bins.shift ? walk_bin_tiles(g, walk, buf.bins.shift, x, y, cam, exact) : 1u;
-      store_pair(buf, chunk_base + __popc(ballot & lanes_below), walk.bin(x, y, buf.bins), depth_bits,
-                 pair_value(buf.bins, record, tiles));
+      emit_pair<Tally>(buf, chunk_base + __popc(ballot & lanes_below), walk.bin(x, y, buf.bins), depth_bits,
+                pair_value(buf.bins, record, tiles));
     }
     walk.advance(x, y);
   }
@@ -158,8 +178,8 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
 
 // The pairs of one Gaussian's box, emitted by the whole warp (all lanes call with the same
 // footprint), one atomic per segment; returns how many were wanted.
-__device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g, std::uint32_t depth_bits,
-                                  unsigned record, const gm::CameraParams& cam, bool exact) {
+__device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g,
+                                  std::uint32_t depth_bits, unsigned record, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
   const BoxWalk walk(g, buf.bins.shift);
   unsigned total = 0;
@@ -172,7 +192,7 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
     unsigned long long base = 0;
     if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
     base = __shfl_sync(kFullMask, base, 0) + (inclusive - my_count);  // lane c: chunk c's offset
-    warp_write_segment(buf, g, walk, s0, kWarp, my_ballot, base, depth_bits, record, cam, exact);
+    warp_write_segment<PreprocessTally>(buf, g, walk, s0, kWarp, my_ballot, base, depth_bits, record, cam, exact);
     total += segment_total;
   }
   return total;
@@ -218,9 +238,8 @@ __device__ __forceinline__ void small_box_bin(const SmallBox& b, int shift, unsi
 
 // All lanes call; my_box: this lane's box size (0: nothing to emit here). Returns this lane's
 // pair count.
-__device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers& buf, const gm::Footprint& f,
-                                          unsigned my_box, std::uint32_t depth_bits, unsigned record,
-                                          const gm::CameraParams& cam) {
+__device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers& buf, const gm::Footprint& f, unsigned my_box, std::uint32_t depth_bits,
+                                          unsigned record, const gm::CameraParams& cam) {
   const unsigned lane = lane_id();
   const unsigned inclusive = warp_inclusive_sum(my_box);
   const unsigned start = inclusive - my_box, total_tiles = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -294,9 +313,9 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
       const SmallBox& b = s.boxes[s.owner[g]].box;
       int bx, by;
       small_box_bin(b, shift, g - b.start, bx, by);
-      store_pair(buf, step_base + __popc(ballot & lanes_below),
-                 static_cast<unsigned>(by) * static_cast<unsigned>(buf.bins.x) + static_cast<unsigned>(bx),
-                 b.depth_bits, pair_value(buf.bins, b.record, s.tiles[g]));
+      emit_pair<PreprocessTally>(buf, step_base + __popc(ballot & lanes_below),
+                static_cast<unsigned>(by) * static_cast<unsigned>(buf.bins.x) + static_cast<unsigned>(bx),
+                b.depth_bits, pair_value(buf.bins, b.record, s.tiles[g]));
     }
   }
   __syncwarp();  // the scratch is free again
@@ -434,8 +453,8 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
       unsigned long long offset = base + inclusive - count;
       const BinBox bins(f, shift);
       auto store = [&](int bx, int by, unsigned tiles) {
-        store_pair(buf, offset++, static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits,
-                   pair_value(buf.bins, record, tiles));
+        emit_pair<PreprocessTally>(buf, offset++, static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits,
+                  pair_value(buf.bins, record, tiles));
       };
       if (args.exact_tile_test && bins.count() <= 32) {
         for (unsigned m = passed_mask; m; m &= m - 1) {
@@ -529,34 +548,41 @@ template <int DEGREE, bool FUSED>
 __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
     preprocess_kernel(DeviceScene scene, FrameBuffers buf, PreprocessArgs args) {
   static_assert(kBlock == kChunkSize, "a block is one chunk");
+  __shared__ int chunk;  // ChunkVerdict of the block's own chunk (no chunk list)
+  // The chunks to preprocess: listed ones, every gridDim-th, or the block's own.
+  unsigned first = blockIdx.x, end = blockIdx.x + 1, step = 1;
   if (buf.chunk_list) {
-    const unsigned listed = buf.counters->listed_chunks;
-    for (unsigned k = blockIdx.x; k < listed; k += gridDim.x) {
-      const unsigned entry = buf.chunk_list[k];
-      preprocess_chunk<DEGREE, FUSED>(scene, buf, args, entry >> 1, (entry & 1u) ? kChunkClassify : kChunkProject);
-      __syncthreads();  // the chunk's shared counts are reset by the next one
+    end = buf.counters->listed_chunks;
+    step = gridDim.x;
+  } else {
+    if (threadIdx.x == 0) {
+      chunk = args.chunk_cull ? chunk_verdict(scene.chunks[blockIdx.x], args.camera, args.geometry, args.chunk_frame)
+                              : kChunkProject;
+      if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {  // counted without reading a Gaussian
+        const unsigned members = scene.chunks[blockIdx.x].members;
+        atomicAdd(&buf.counters->by_reason[chunk == kChunkAllNear ? gm::kCulledNear : gm::kCulledOffscreen], members);
+        atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(members));
+      }
     }
-    return;
-  }
-  __shared__ int chunk;  // ChunkVerdict
-  if (threadIdx.x == 0) {
-    chunk = args.chunk_cull ? chunk_verdict(scene.chunks[blockIdx.x], args.camera, args.geometry, args.chunk_frame)
-                            : kChunkProject;
-    if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {  // counted without reading a Gaussian
-      const unsigned members = scene.chunks[blockIdx.x].members;
-      atomicAdd(&buf.counters->by_reason[chunk == kChunkAllNear ? gm::kCulledNear : gm::kCulledOffscreen], members);
-      atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(members));
+    __syncthreads();
+    if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {
+      if constexpr (!FUSED) {
+        const unsigned i = blockIdx.x * kBlock + threadIdx.x;
+        if (i < scene.count) buf.pair_counts[i] = 0;
+      }
+      return;
     }
   }
-  __syncthreads();
-  if (chunk == kChunkAllNear || chunk == kChunkAllOffscreen) {
-    if constexpr (!FUSED) {
-      const unsigned i = blockIdx.x * kBlock + threadIdx.x;
-      if (i < scene.count) buf.pair_counts[i] = 0;
-    }
-    return;
+  // Counted pairs (fused emission only): preprocess_chunk's first barrier comes before its
+  // first pair, and its last after its last.
+  PreprocessTally::clear(buf);
+  for (unsigned k = first; k < end; k += step) {  // one instance of the chunk's code
+    const unsigned entry = buf.chunk_list ? buf.chunk_list[k] : (k << 1 | (chunk == kChunkClassify ? 1u : 0u));
+    preprocess_chunk<DEGREE, FUSED>(scene, buf, args, entry >> 1, (entry & 1u) ? kChunkClassify : kChunkProject);
+    __syncthreads();  // the chunk's shared counts are reset by the next one
+    if ((k - first) / step % kChunksPerTallyFlush == kChunksPerTallyFlush - 1) PreprocessTally::flush(buf);
   }
-  preprocess_chunk<DEGREE, FUSED>(scene, buf, args, blockIdx.x, chunk);
+  PreprocessTally::flush(buf);
 }
 
 // The deferred Gaussians' work items: a warp per item, spread over every warp of the grid. A
@@ -573,6 +599,8 @@ __global__ void __launch_bounds__(kBlock) deferred_emit_kernel(FrameBuffers buf,
   const unsigned lane = lane_id();
   const unsigned stride = gridDim.x * kWarps;
   const int shift = buf.bins.shift;
+  DeferredTally::clear(buf);
+  __syncthreads();
   unsigned newly_visible = 0;
   for (unsigned k0 = blockIdx.x * kWarps + threadIdx.x / kWarp; k0 < count; k0 += kItemBatch * stride) {
     uint2 items[kItemBatch];
@@ -601,7 +629,7 @@ __global__ void __launch_bounds__(kBlock) deferred_emit_kernel(FrameBuffers buf,
       if (!__any_sync(kFullMask, my_ballot[j] != 0)) continue;  // nothing passed, or no item
       const unsigned entry = items[j].x;
       const gm::Footprint f = list.footprints[entry];
-      warp_write_segment(buf, f, BoxWalk(f, shift), items[j].y * kWarp, item_chunks, my_ballot[j],
+      warp_write_segment<DeferredTally>(buf, f, BoxWalk(f, shift), items[j].y * kWarp, item_chunks, my_ballot[j],
                          base + my_offset[j], sort_depth(buf.key_format, f.depth), list.records[entry], cam, exact);
       if (lane == 0 && atomicExch(&list.hits[entry], 1u) == 0) ++newly_visible;
     }
@@ -610,6 +638,8 @@ __global__ void __launch_bounds__(kBlock) deferred_emit_kernel(FrameBuffers buf,
     atomicAdd(&buf.counters->by_reason[gm::kVisible], newly_visible);
     atomicSub(&buf.counters->by_reason[gm::kCulledOffscreen], newly_visible);
   }
+  __syncthreads();
+  DeferredTally::flush(buf);
 }
 
 // Blocks of a preprocess grid over a chunk list: a few waves' worth (the list's length is
@@ -624,16 +654,32 @@ unsigned list_grid_blocks() {
   return blocks;
 }
 
+// Launches `kernel` with the shared memory of a bin tally (bin_tally.cuh) when the frame counts
+// its pairs per bin. The first launch of each kernel allows it the most a tally may take:
+// preprocess's static scratch and a 4K frame's tally together pass the 48 KB of the default.
+template <typename Tally, auto Kernel, typename... Args>
+void launch_with_tally(unsigned blocks, const FrameBuffers& buffers, cudaStream_t stream, Args... args) {
+  static const bool allowed = [] {
+    check_cuda(cudaFuncSetAttribute(Kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                    static_cast<int>(Tally::bytes(kBinSortMaxBins))),
+               "bin tally shared memory");
+    return true;
+  }();
+  (void)allowed;
+  const std::size_t shared = buffers.emitted_bin_counts ? Tally::bytes(Tally::bins(buffers)) : 0;
+  Kernel<<<blocks, kBlock, shared, stream>>>(args...);
+}
+
 template <bool FUSED>
 void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
                        cudaStream_t stream) {
   const unsigned chunks = static_cast<unsigned>((scene.count + kBlock - 1) / kBlock);
   const unsigned blocks = buffers.chunk_list ? std::min(chunks, list_grid_blocks()) : chunks;
   switch (args.sh_degree) {
-    case 0: preprocess_kernel<0, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
-    case 1: preprocess_kernel<1, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
-    case 2: preprocess_kernel<2, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
-    default: preprocess_kernel<3, FUSED><<<blocks, kBlock, 0, stream>>>(scene, buffers, args); break;
+    case 0: launch_with_tally<PreprocessTally, preprocess_kernel<0, FUSED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 1: launch_with_tally<PreprocessTally, preprocess_kernel<1, FUSED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 2: launch_with_tally<PreprocessTally, preprocess_kernel<2, FUSED>>(blocks, buffers, stream, scene, buffers, args); break;
+    default: launch_with_tally<PreprocessTally, preprocess_kernel<3, FUSED>>(blocks, buffers, stream, scene, buffers, args); break;
   }
 }
 
@@ -642,12 +688,15 @@ void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, co
 void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
                        bool fused, cudaStream_t stream) {
   if (scene.count == 0) return;
+  if (!fused && buffers.emitted_bin_counts)
+    throw Error("cuda renderer: internal error, pairs counted per bin without fused emission");
   if (fused) {
     if (buffers.chunk_list) launch_chunk_list(scene, buffers, args, stream);
     launch_for_degree<true>(scene, buffers, args, stream);
     if (args.warp_cooperative && buffers.deferred.capacity > 0 && buffers.deferred.item_capacity > 0)
-      deferred_emit_kernel<<<kDeferredEmitBlocks, kBlock, 0, stream>>>(buffers, args.camera, args.exact_tile_test,
-                                                                        static_cast<unsigned>(args.item_chunks));
+      launch_with_tally<DeferredTally, deferred_emit_kernel>(kDeferredEmitBlocks, buffers, stream, buffers, args.camera,
+                                                             args.exact_tile_test,
+                                                             static_cast<unsigned>(args.item_chunks));
   } else {
     launch_for_degree<false>(scene, buffers, args, stream);
   }
