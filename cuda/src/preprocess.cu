@@ -542,19 +542,31 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
 template <int DEGREE, bool FUSED>
 constexpr int kPreprocessBlocksPerSm = FUSED && DEGREE < 3 ? 4 : 1;
 
-// A block per chunk (kChunkSize Gaussians). With a chunk list (launch_chunk_list ran first)
-// the grid walks only the listed chunks; otherwise each block tests its own chunk.
-template <int DEGREE, bool FUSED>
+// A block per chunk (kChunkSize Gaussians), which tests its own chunk; LISTED (launch_chunk_list
+// ran first): a grid over the listed chunks, every gridDim-th. One instance of the chunk's code
+// per kernel: with both in one kernel, the compiler spilled more of either.
+template <int DEGREE, bool FUSED, bool LISTED>
 __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
     preprocess_kernel(DeviceScene scene, FrameBuffers buf, PreprocessArgs args) {
   static_assert(kBlock == kChunkSize, "a block is one chunk");
-  __shared__ int chunk;  // ChunkVerdict of the block's own chunk (no chunk list)
-  // The chunks to preprocess: listed ones, every gridDim-th, or the block's own.
-  unsigned first = blockIdx.x, end = blockIdx.x + 1, step = 1;
-  if (buf.chunk_list) {
-    end = buf.counters->listed_chunks;
-    step = gridDim.x;
+  // Counted pairs (fused emission only): preprocess_chunk's first barrier comes before its
+  // first pair, and its last after its last.
+  if constexpr (LISTED) {
+    PreprocessTally::clear(buf);
+    const unsigned listed = buf.counters->listed_chunks;
+    unsigned since_flush = 0;
+    for (unsigned k = blockIdx.x; k < listed; k += gridDim.x) {
+      const unsigned entry = buf.chunk_list[k];
+      preprocess_chunk<DEGREE, FUSED>(scene, buf, args, entry >> 1, (entry & 1u) ? kChunkClassify : kChunkProject);
+      __syncthreads();  // the chunk's shared counts are reset by the next one
+      if (++since_flush == kChunksPerTallyFlush) {
+        PreprocessTally::flush(buf);
+        since_flush = 0;
+      }
+    }
+    PreprocessTally::flush(buf);
   } else {
+    __shared__ int chunk;  // ChunkVerdict
     if (threadIdx.x == 0) {
       chunk = args.chunk_cull ? chunk_verdict(scene.chunks[blockIdx.x], args.camera, args.geometry, args.chunk_frame)
                               : kChunkProject;
@@ -572,17 +584,10 @@ __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
       }
       return;
     }
+    PreprocessTally::clear(buf);
+    preprocess_chunk<DEGREE, FUSED>(scene, buf, args, blockIdx.x, chunk);
+    PreprocessTally::flush(buf);
   }
-  // Counted pairs (fused emission only): preprocess_chunk's first barrier comes before its
-  // first pair, and its last after its last.
-  PreprocessTally::clear(buf);
-  for (unsigned k = first; k < end; k += step) {  // one instance of the chunk's code
-    const unsigned entry = buf.chunk_list ? buf.chunk_list[k] : (k << 1 | (chunk == kChunkClassify ? 1u : 0u));
-    preprocess_chunk<DEGREE, FUSED>(scene, buf, args, entry >> 1, (entry & 1u) ? kChunkClassify : kChunkProject);
-    __syncthreads();  // the chunk's shared counts are reset by the next one
-    if ((k - first) / step % kChunksPerTallyFlush == kChunksPerTallyFlush - 1) PreprocessTally::flush(buf);
-  }
-  PreprocessTally::flush(buf);
 }
 
 // The deferred Gaussians' work items: a warp per item, spread over every warp of the grid. A
@@ -670,16 +675,16 @@ void launch_with_tally(unsigned blocks, const FrameBuffers& buffers, cudaStream_
   Kernel<<<blocks, kBlock, shared, stream>>>(args...);
 }
 
-template <bool FUSED>
+template <bool FUSED, bool LISTED>
 void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
                        cudaStream_t stream) {
   const unsigned chunks = static_cast<unsigned>((scene.count + kBlock - 1) / kBlock);
-  const unsigned blocks = buffers.chunk_list ? std::min(chunks, list_grid_blocks()) : chunks;
+  const unsigned blocks = LISTED ? std::min(chunks, list_grid_blocks()) : chunks;
   switch (args.sh_degree) {
-    case 0: launch_with_tally<PreprocessTally, preprocess_kernel<0, FUSED>>(blocks, buffers, stream, scene, buffers, args); break;
-    case 1: launch_with_tally<PreprocessTally, preprocess_kernel<1, FUSED>>(blocks, buffers, stream, scene, buffers, args); break;
-    case 2: launch_with_tally<PreprocessTally, preprocess_kernel<2, FUSED>>(blocks, buffers, stream, scene, buffers, args); break;
-    default: launch_with_tally<PreprocessTally, preprocess_kernel<3, FUSED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 0: launch_with_tally<PreprocessTally, preprocess_kernel<0, FUSED, LISTED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 1: launch_with_tally<PreprocessTally, preprocess_kernel<1, FUSED, LISTED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 2: launch_with_tally<PreprocessTally, preprocess_kernel<2, FUSED, LISTED>>(blocks, buffers, stream, scene, buffers, args); break;
+    default: launch_with_tally<PreprocessTally, preprocess_kernel<3, FUSED, LISTED>>(blocks, buffers, stream, scene, buffers, args); break;
   }
 }
 
@@ -688,17 +693,21 @@ void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, co
 void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
                        bool fused, cudaStream_t stream) {
   if (scene.count == 0) return;
-  if (!fused && buffers.emitted_bin_counts)
-    throw Error("cuda renderer: internal error, pairs counted per bin without fused emission");
+  if (!fused && (buffers.emitted_bin_counts || buffers.chunk_list))
+    throw Error("cuda renderer: internal error, a chunk list or pairs counted per bin without fused emission");
   if (fused) {
-    if (buffers.chunk_list) launch_chunk_list(scene, buffers, args, stream);
-    launch_for_degree<true>(scene, buffers, args, stream);
+    if (buffers.chunk_list) {
+      launch_chunk_list(scene, buffers, args, stream);
+      launch_for_degree<true, true>(scene, buffers, args, stream);
+    } else {
+      launch_for_degree<true, false>(scene, buffers, args, stream);
+    }
     if (args.warp_cooperative && buffers.deferred.capacity > 0 && buffers.deferred.item_capacity > 0)
       launch_with_tally<DeferredTally, deferred_emit_kernel>(kDeferredEmitBlocks, buffers, stream, buffers, args.camera,
                                                              args.exact_tile_test,
                                                              static_cast<unsigned>(args.item_chunks));
   } else {
-    launch_for_degree<false>(scene, buffers, args, stream);
+    launch_for_degree<false, false>(scene, buffers, args, stream);
   }
   check_cuda(cudaGetLastError(), "preprocess kernel launch");
 }
