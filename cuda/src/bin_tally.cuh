@@ -15,30 +15,27 @@ namespace cuda {
 // The counts live in the kernel's dynamic shared memory. PACKED: two 16-bit counts per word,
 // bins [0, half) in the low halves and [half, 2 half) in the high ones, half = (bins + 1) / 2
 // (neighbouring bins in neighbouring words, so lanes storing a row of bins do not meet on a
-// word), for a kernel whose shared memory is tight; a block then adds at most 65,535 pairs to a
-// bin between flushes. Otherwise a word per bin. Everything is read from the kernel's
-// FrameBuffers parameter, so that no register holds the tally across the emission code.
+// word), for a kernel whose shared memory is tight; a block may then add at most 65,535 pairs
+// to a bin. Otherwise a word per bin. Everything is read from the kernel's
+// FrameBuffers parameter, so that no register holds the tally across the emission code. A
+// kernel of a frame that does not count takes NoBinTally instead: the same code, no counts.
 template <bool PACKED>
 struct BinTally {
   __device__ static unsigned* words() {
     extern __shared__ unsigned bin_tally_words[];
     return bin_tally_words;
   }
-  __host__ __device__ static unsigned bins(const FrameBuffers& buf) {
-    return static_cast<unsigned>(buf.bins.x) * static_cast<unsigned>(buf.bins.y);
-  }
-  __host__ __device__ static unsigned word_count(const FrameBuffers& buf) {
-    return PACKED ? (bins(buf) + 1) / 2 : bins(buf);
+  __device__ static unsigned word_count(const FrameBuffers& buf) {
+    const unsigned bins = static_cast<unsigned>(buf.bins.x) * static_cast<unsigned>(buf.bins.y);
+    return PACKED ? (bins + 1) / 2 : bins;
   }
 
   // Every thread of the block calls; a barrier must follow before the first add.
   __device__ static void clear(const FrameBuffers& buf) {
-    if (!buf.emitted_bin_counts) return;
     for (unsigned w = threadIdx.x; w < word_count(buf); w += blockDim.x) words()[w] = 0;
   }
 
   __device__ static __forceinline__ void add(const FrameBuffers& buf, unsigned bin) {
-    if (!buf.emitted_bin_counts) return;
     if (!PACKED) {
       atomicAdd(words() + bin, 1u);
     } else {
@@ -51,7 +48,6 @@ struct BinTally {
   // block calls, after a barrier that follows its last add; a barrier must follow before the
   // next add.
   __device__ static void flush(const FrameBuffers& buf) {
-    if (!buf.emitted_bin_counts) return;
     const unsigned half = word_count(buf);
     for (unsigned w = threadIdx.x; w < half; w += blockDim.x) {
       const unsigned v = words()[w];
@@ -70,6 +66,13 @@ struct BinTally {
   static std::size_t bytes(unsigned bins) {
     return static_cast<std::size_t>(PACKED ? (bins + 1) / 2 : bins) * sizeof(unsigned);
   }
+};
+
+struct NoBinTally {
+  __device__ static void clear(const FrameBuffers&) {}
+  __device__ static void add(const FrameBuffers&, unsigned) {}
+  __device__ static void flush(const FrameBuffers&) {}
+  static std::size_t bytes(unsigned) { return 0; }
 };
 
 }  // namespace cuda

@@ -227,8 +227,8 @@ class CudaRendererImpl final : public CudaRenderer {
     bin_overlap_ = major >= 9;
     if (const char* overlap = std::getenv("FLASHGS_BIN_OVERLAP")) bin_overlap_ = bin_overlap_ && std::atoi(overlap) != 0;
     // FLASHGS_EMIT_BIN_COUNTS=1 has every bin-sort frame count its pairs per bin as it emits
-    // them (FrameBuffers::emitted_bin_counts) unless it orders its bins, =0 none (the counting
-    // pass counts; unset: where it pays, see emit_bin_counts_pays).
+    // them (FrameBuffers::emitted_bin_counts) unless it orders its bins or culls by chunk list,
+    // =0 none (the counting pass counts; unset: where it pays, see emit_bin_counts_pays).
     if (const char* counts = std::getenv("FLASHGS_EMIT_BIN_COUNTS"))
       emit_bin_counts_ = std::atoi(counts) != 0 ? kAlways : kNever;
     // FLASHGS_INITIAL_RECORDS: the blend records a first frame starts with (tests of growth).
@@ -965,9 +965,9 @@ class CudaRendererImpl final : public CudaRenderer {
                           float_image, tiles, bins, pixels, baseline, fused, binned, count_at_end};
     std::uint64_t pairs = 0;
     for (int attempt = 0;; ++attempt) {
-      // Emission counts the pairs per bin where it pays and the counting pass would not also
-      // order the bins.
-      emitted_counts_frame_ = bin_sort_frame_ && fused && emit_bin_counts_pays(bins) &&
+      // Emission counts the pairs per bin where it pays, each preprocess block takes its own
+      // chunk and the counting pass would not also order the bins.
+      emitted_counts_frame_ = bin_sort_frame_ && fused && !list_chunks_ && emit_bin_counts_pays(bins) &&
                               !dense_order(options, baseline, tiles);
       if (bin_sort_frame_) {
         if (bins > zeroed_fill_bins_)

@@ -198,7 +198,8 @@ struct FrameBuffers {
   // The bin sort's per-bin counts, then each bin's next free place; the bin blocks leave it
   // zeroed for the next frame.
   std::uint32_t* bin_fill = nullptr;  // [bins]
-  // Bin-sort frames without the dense-first order: the pairs per bin, counted by the emission
+  // Bin-sort frames without the dense-first order or a chunk list (where it pays, see
+  // CudaRenderer's emit_bin_counts_pays): the pairs per bin, counted by the emission
   // kernels (bin_tally.cuh), so that no counting pass runs and each scatter block finds the bins'
   // places itself (null: the counting pass counts). The bin blocks leave it zeroed.
   std::uint32_t* emitted_bin_counts = nullptr;  // [bins]

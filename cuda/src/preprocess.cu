@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include <algorithm>
+#include <type_traits>
 
 #include "bin_tally.cuh"
 #include "bins.cuh"
@@ -23,13 +24,14 @@ constexpr int kBlock = 256;
 constexpr unsigned kDeferredEmitBlocks = 1024;
 constexpr float kLog2e = 1.4426950408889634f;
 // Preprocess counts its pairs per bin in 16-bit halves (its shared memory holds the small
-// boxes' scratch too); a block flushes them after this many chunks, each adding at most one
-// pair per Gaussian to a bin, so that no count passes 65,535.
-constexpr unsigned kChunksPerTallyFlush = 255;
-static_assert(kChunksPerTallyFlush * kChunkSize <= 0xffffu, "a packed count holds a flush's pairs");
-using PreprocessTally = BinTally<true>;
+// boxes' scratch too): a block counting pairs takes one chunk, which adds at most one pair per
+// Gaussian to a bin.
+static_assert(kChunkSize <= 0xffff, "a packed count holds a chunk's pairs");
+template <bool COUNTED>
+using PreprocessTally = std::conditional_t<COUNTED, BinTally<true>, NoBinTally>;
 // The deferred boxes' kernel: a word per bin (its blocks may take any number of items).
-using DeferredTally = BinTally<false>;
+template <bool COUNTED>
+using DeferredTally = std::conditional_t<COUNTED, BinTally<false>, NoBinTally>;
 
 // Stores one pair and counts it in its bin (bin_tally.cuh).
 template <typename Tally>
@@ -178,6 +180,7 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
 
 // The pairs of one Gaussian's box, emitted by the whole warp (all lanes call with the same
 // footprint), one atomic per segment; returns how many were wanted.
+template <typename Tally>
 __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g,
                                   std::uint32_t depth_bits, unsigned record, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
@@ -192,7 +195,7 @@ __device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& 
     unsigned long long base = 0;
     if (lane == 0) base = atomicAdd(&buf.counters->pairs, static_cast<unsigned long long>(segment_total));
     base = __shfl_sync(kFullMask, base, 0) + (inclusive - my_count);  // lane c: chunk c's offset
-    warp_write_segment<PreprocessTally>(buf, g, walk, s0, kWarp, my_ballot, base, depth_bits, record, cam, exact);
+    warp_write_segment<Tally>(buf, g, walk, s0, kWarp, my_ballot, base, depth_bits, record, cam, exact);
     total += segment_total;
   }
   return total;
@@ -238,6 +241,7 @@ __device__ __forceinline__ void small_box_bin(const SmallBox& b, int shift, unsi
 
 // All lanes call; my_box: this lane's box size (0: nothing to emit here). Returns this lane's
 // pair count.
+template <typename Tally>
 __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers& buf, const gm::Footprint& f, unsigned my_box, std::uint32_t depth_bits,
                                           unsigned record, const gm::CameraParams& cam) {
   const unsigned lane = lane_id();
@@ -313,7 +317,7 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
       const SmallBox& b = s.boxes[s.owner[g]].box;
       int bx, by;
       small_box_bin(b, shift, g - b.start, bx, by);
-      emit_pair<PreprocessTally>(buf, step_base + __popc(ballot & lanes_below),
+      emit_pair<Tally>(buf, step_base + __popc(ballot & lanes_below),
                 static_cast<unsigned>(by) * static_cast<unsigned>(buf.bins.x) + static_cast<unsigned>(bx),
                 b.depth_bits, pair_value(buf.bins, b.record, s.tiles[g]));
     }
@@ -326,7 +330,7 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
 // kChunkClassify (the same for the whole block). FUSED: keys are written here (FlashGS);
 // otherwise the footprint and the pair count are stored for the separate prefix sum +
 // duplicate pass (3DGS).
-template <int DEGREE, bool FUSED>
+template <int DEGREE, bool FUSED, typename Tally>
 __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& buf, const PreprocessArgs& args,
                                  unsigned chunk_index, int chunk) {
   __shared__ unsigned block_counts[gm::kCullReasonCount];  // by gm::CullReason
@@ -442,7 +446,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
     __shared__ SmallBoxScratch small_scratch[kBlock / kWarp];
     if (balanced)
-      count = warp_emit_small_boxes(small_scratch[threadIdx.x / kWarp], buf, f, small_box, depth_bits, record, cam);
+      count = warp_emit_small_boxes<Tally>(small_scratch[threadIdx.x / kWarp], buf, f, small_box, depth_bits, record, cam);
     // Thread-emitted Gaussians: one atomic per warp reserves all their pairs.
     const unsigned inclusive = warp_inclusive_sum(balanced ? 0u : count);
     const unsigned warp_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -453,7 +457,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
       unsigned long long offset = base + inclusive - count;
       const BinBox bins(f, shift);
       auto store = [&](int bx, int by, unsigned tiles) {
-        emit_pair<PreprocessTally>(buf, offset++, static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits,
+        emit_pair<Tally>(buf, offset++, static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits,
                   pair_value(buf.bins, record, tiles));
       };
       if (args.exact_tile_test && bins.count() <= 32) {
@@ -511,7 +515,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
       const gm::Footprint g = shfl_footprint(f, src);
       const std::uint32_t g_depth = __shfl_sync(kFullMask, depth_bits, src);
       const unsigned g_record = __shfl_sync(kFullMask, record, src);
-      const unsigned total = warp_emit_box(buf, g, g_depth, g_record, cam, args.exact_tile_test);
+      const unsigned total = warp_emit_box<Tally>(buf, g, g_depth, g_record, cam, args.exact_tile_test);
       if (static_cast<int>(lane) == src) count = total;
     }
   } else {
@@ -543,28 +547,25 @@ template <int DEGREE, bool FUSED>
 constexpr int kPreprocessBlocksPerSm = FUSED && DEGREE < 3 ? 4 : 1;
 
 // A block per chunk (kChunkSize Gaussians), which tests its own chunk; LISTED (launch_chunk_list
-// ran first): a grid over the listed chunks, every gridDim-th. One instance of the chunk's code
-// per kernel: with both in one kernel, the compiler spilled more of either.
-template <int DEGREE, bool FUSED, bool LISTED>
+// ran first): a grid over the listed chunks, every gridDim-th. COUNTED: the frame's pairs are
+// counted per bin (bin_tally.cuh; fused emission of a block's own chunk only). One instance of the chunk's code per
+// kernel: with both in one kernel, the compiler spilled more of either, and the project stage
+// took 7 us longer at pc_playbot 1080p (docs/PERFORMANCE.md, v35).
+template <int DEGREE, bool FUSED, bool LISTED, bool COUNTED>
 __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
     preprocess_kernel(DeviceScene scene, FrameBuffers buf, PreprocessArgs args) {
   static_assert(kBlock == kChunkSize, "a block is one chunk");
-  // Counted pairs (fused emission only): preprocess_chunk's first barrier comes before its
+  static_assert((FUSED && !LISTED) || !COUNTED, "pairs are counted per bin by fused emission of a block's chunk");
+  using Tally = PreprocessTally<COUNTED>;
+  // Counted pairs: preprocess_chunk's first barrier comes before its
   // first pair, and its last after its last.
   if constexpr (LISTED) {
-    PreprocessTally::clear(buf);
     const unsigned listed = buf.counters->listed_chunks;
-    unsigned since_flush = 0;
     for (unsigned k = blockIdx.x; k < listed; k += gridDim.x) {
       const unsigned entry = buf.chunk_list[k];
-      preprocess_chunk<DEGREE, FUSED>(scene, buf, args, entry >> 1, (entry & 1u) ? kChunkClassify : kChunkProject);
+      preprocess_chunk<DEGREE, FUSED, Tally>(scene, buf, args, entry >> 1, (entry & 1u) ? kChunkClassify : kChunkProject);
       __syncthreads();  // the chunk's shared counts are reset by the next one
-      if (++since_flush == kChunksPerTallyFlush) {
-        PreprocessTally::flush(buf);
-        since_flush = 0;
-      }
     }
-    PreprocessTally::flush(buf);
   } else {
     __shared__ int chunk;  // ChunkVerdict
     if (threadIdx.x == 0) {
@@ -584,9 +585,9 @@ __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
       }
       return;
     }
-    PreprocessTally::clear(buf);
-    preprocess_chunk<DEGREE, FUSED>(scene, buf, args, blockIdx.x, chunk);
-    PreprocessTally::flush(buf);
+    Tally::clear(buf);
+    preprocess_chunk<DEGREE, FUSED, Tally>(scene, buf, args, blockIdx.x, chunk);
+    Tally::flush(buf);
   }
 }
 
@@ -595,6 +596,7 @@ __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
 // wait on the contended pair counter for each item held the kernel back. The first item of
 // an entry to emit a pair moves its Gaussian from off screen (preprocess's count) to visible.
 constexpr int kItemBatch = 4;
+template <bool COUNTED>
 __global__ void __launch_bounds__(kBlock) deferred_emit_kernel(FrameBuffers buf, gm::CameraParams cam, bool exact,
                                                                unsigned item_chunks) {
   const DeferredList& list = buf.deferred;
@@ -604,8 +606,9 @@ __global__ void __launch_bounds__(kBlock) deferred_emit_kernel(FrameBuffers buf,
   const unsigned lane = lane_id();
   const unsigned stride = gridDim.x * kWarps;
   const int shift = buf.bins.shift;
-  DeferredTally::clear(buf);
-  __syncthreads();
+  using Tally = DeferredTally<COUNTED>;
+  Tally::clear(buf);
+  if constexpr (COUNTED) __syncthreads();
   unsigned newly_visible = 0;
   for (unsigned k0 = blockIdx.x * kWarps + threadIdx.x / kWarp; k0 < count; k0 += kItemBatch * stride) {
     uint2 items[kItemBatch];
@@ -634,7 +637,7 @@ __global__ void __launch_bounds__(kBlock) deferred_emit_kernel(FrameBuffers buf,
       if (!__any_sync(kFullMask, my_ballot[j] != 0)) continue;  // nothing passed, or no item
       const unsigned entry = items[j].x;
       const gm::Footprint f = list.footprints[entry];
-      warp_write_segment<DeferredTally>(buf, f, BoxWalk(f, shift), items[j].y * kWarp, item_chunks, my_ballot[j],
+      warp_write_segment<Tally>(buf, f, BoxWalk(f, shift), items[j].y * kWarp, item_chunks, my_ballot[j],
                          base + my_offset[j], sort_depth(buf.key_format, f.depth), list.records[entry], cam, exact);
       if (lane == 0 && atomicExch(&list.hits[entry], 1u) == 0) ++newly_visible;
     }
@@ -643,8 +646,10 @@ __global__ void __launch_bounds__(kBlock) deferred_emit_kernel(FrameBuffers buf,
     atomicAdd(&buf.counters->by_reason[gm::kVisible], newly_visible);
     atomicSub(&buf.counters->by_reason[gm::kCulledOffscreen], newly_visible);
   }
-  __syncthreads();
-  DeferredTally::flush(buf);
+  if constexpr (COUNTED) {
+    __syncthreads();
+    Tally::flush(buf);
+  }
 }
 
 // Blocks of a preprocess grid over a chunk list: a few waves' worth (the list's length is
@@ -659,32 +664,34 @@ unsigned list_grid_blocks() {
   return blocks;
 }
 
-// Launches `kernel` with the shared memory of a bin tally (bin_tally.cuh) when the frame counts
-// its pairs per bin. The first launch of each kernel allows it the most a tally may take:
-// preprocess's static scratch and a 4K frame's tally together pass the 48 KB of the default.
+// Launches Kernel with the shared memory of its bin tally (bin_tally.cuh). The first launch of
+// a counting kernel allows it the most a tally may take: preprocess's static scratch and a 4K
+// frame's tally together pass the 48 KB of the default.
 template <typename Tally, auto Kernel, typename... Args>
 void launch_with_tally(unsigned blocks, const FrameBuffers& buffers, cudaStream_t stream, Args... args) {
-  static const bool allowed = [] {
-    check_cuda(cudaFuncSetAttribute(Kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
-                                    static_cast<int>(Tally::bytes(kBinSortMaxBins))),
-               "bin tally shared memory");
-    return true;
-  }();
-  (void)allowed;
-  const std::size_t shared = buffers.emitted_bin_counts ? Tally::bytes(Tally::bins(buffers)) : 0;
-  Kernel<<<blocks, kBlock, shared, stream>>>(args...);
+  if constexpr (!std::is_same_v<Tally, NoBinTally>) {
+    static const bool allowed = [] {
+      check_cuda(cudaFuncSetAttribute(Kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                      static_cast<int>(Tally::bytes(kBinSortMaxBins))),
+                 "bin tally shared memory");
+      return true;
+    }();
+    (void)allowed;
+  }
+  const unsigned bins = static_cast<unsigned>(buffers.bins.x) * static_cast<unsigned>(buffers.bins.y);
+  Kernel<<<blocks, kBlock, Tally::bytes(bins), stream>>>(args...);
 }
 
-template <bool FUSED, bool LISTED>
+template <bool FUSED, bool LISTED, bool COUNTED>
 void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
                        cudaStream_t stream) {
   const unsigned chunks = static_cast<unsigned>((scene.count + kBlock - 1) / kBlock);
   const unsigned blocks = LISTED ? std::min(chunks, list_grid_blocks()) : chunks;
   switch (args.sh_degree) {
-    case 0: launch_with_tally<PreprocessTally, preprocess_kernel<0, FUSED, LISTED>>(blocks, buffers, stream, scene, buffers, args); break;
-    case 1: launch_with_tally<PreprocessTally, preprocess_kernel<1, FUSED, LISTED>>(blocks, buffers, stream, scene, buffers, args); break;
-    case 2: launch_with_tally<PreprocessTally, preprocess_kernel<2, FUSED, LISTED>>(blocks, buffers, stream, scene, buffers, args); break;
-    default: launch_with_tally<PreprocessTally, preprocess_kernel<3, FUSED, LISTED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 0: launch_with_tally<PreprocessTally<COUNTED>, preprocess_kernel<0, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 1: launch_with_tally<PreprocessTally<COUNTED>, preprocess_kernel<1, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 2: launch_with_tally<PreprocessTally<COUNTED>, preprocess_kernel<2, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args); break;
+    default: launch_with_tally<PreprocessTally<COUNTED>, preprocess_kernel<3, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args); break;
   }
 }
 
@@ -693,21 +700,29 @@ void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, co
 void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,
                        bool fused, cudaStream_t stream) {
   if (scene.count == 0) return;
-  if (!fused && (buffers.emitted_bin_counts || buffers.chunk_list))
-    throw Error("cuda renderer: internal error, a chunk list or pairs counted per bin without fused emission");
+  const bool counted = buffers.emitted_bin_counts != nullptr;
+  if ((!fused && buffers.chunk_list) || (counted && (!fused || buffers.chunk_list)))
+    throw Error("cuda renderer: internal error, a chunk list or pairs counted per bin where preprocess takes none");
   if (fused) {
     if (buffers.chunk_list) {
       launch_chunk_list(scene, buffers, args, stream);
-      launch_for_degree<true, true>(scene, buffers, args, stream);
+      launch_for_degree<true, true, false>(scene, buffers, args, stream);
+    } else if (counted) {
+      launch_for_degree<true, false, true>(scene, buffers, args, stream);
     } else {
-      launch_for_degree<true, false>(scene, buffers, args, stream);
+      launch_for_degree<true, false, false>(scene, buffers, args, stream);
     }
-    if (args.warp_cooperative && buffers.deferred.capacity > 0 && buffers.deferred.item_capacity > 0)
-      launch_with_tally<DeferredTally, deferred_emit_kernel>(kDeferredEmitBlocks, buffers, stream, buffers, args.camera,
-                                                             args.exact_tile_test,
-                                                             static_cast<unsigned>(args.item_chunks));
+    if (args.warp_cooperative && buffers.deferred.capacity > 0 && buffers.deferred.item_capacity > 0) {
+      const unsigned item_chunks = static_cast<unsigned>(args.item_chunks);
+      if (counted)
+        launch_with_tally<DeferredTally<true>, deferred_emit_kernel<true>>(
+            kDeferredEmitBlocks, buffers, stream, buffers, args.camera, args.exact_tile_test, item_chunks);
+      else
+        launch_with_tally<DeferredTally<false>, deferred_emit_kernel<false>>(
+            kDeferredEmitBlocks, buffers, stream, buffers, args.camera, args.exact_tile_test, item_chunks);
+    }
   } else {
-    launch_for_degree<false, false>(scene, buffers, args, stream);
+    launch_for_degree<false, false, false>(scene, buffers, args, stream);
   }
   check_cuda(cudaGetLastError(), "preprocess kernel launch");
 }
