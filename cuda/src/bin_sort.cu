@@ -1,6 +1,7 @@
 // Stage `sort` of binned frames with compact keys, shaped for the problem: pairs fall into a
 // few thousand bins of a few hundred pairs each, so instead of four radix passes over the
-// whole frame (CUB: about 12 us each, latency-bound), a counting pass puts every pair in its
+// whole frame (CUB: about 12 us each, latency-bound), the pairs are counted per bin (by a
+// counting pass, or by emission itself: bin_tally.cuh), a scatter pass puts every pair in its
 // bin, and a block per bin sorts the bin by key where it is, in shared memory when it fits.
 // The same block then puts runs of equal keys in the exact blend order and writes its four
 // tiles' lists, which the ranges pass and the tile-list kernels do on the other paths.

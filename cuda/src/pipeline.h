@@ -195,8 +195,8 @@ struct FrameBuffers {
   // keys[0] (as 32-bit words from pair_capacity), which leaves keys[1] and values[] free for
   // the pairs in bin order (launch_bin_pairs).
   std::uint32_t* pair_values = nullptr;
-  // The bin sort's per-bin counts, then each bin's next free place; the bin blocks leave it
-  // zeroed for the next frame.
+  // The bin sort's per-bin counts, then each bin's next free place (with emitted_bin_counts:
+  // the places taken so far, from zero); the bin blocks leave it zeroed for the next frame.
   std::uint32_t* bin_fill = nullptr;  // [bins]
   // Bin-sort frames without the dense-first order or a chunk list (where it pays, see
   // CudaRenderer's emit_bin_counts_pays): the pairs per bin, counted by the emission

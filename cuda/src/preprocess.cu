@@ -157,10 +157,9 @@ __device__ unsigned warp_test_segment(const gm::Footprint& g, const BoxWalk& wal
 // bins larger than a tile, a passing bin's tiles are tested again for its value (the test
 // kept no more than a bit per bin).
 template <typename Tally>
-__device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint& g,
-                                   const BoxWalk& walk, unsigned s0, unsigned max_chunks, unsigned my_ballot,
-                                   unsigned long long my_base, std::uint32_t depth_bits, unsigned record,
-                                   const gm::CameraParams& cam, bool exact) {
+__device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint& g, const BoxWalk& walk, unsigned s0,
+                                   unsigned max_chunks, unsigned my_ballot, unsigned long long my_base,
+                                   std::uint32_t depth_bits, unsigned record, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
   const unsigned lanes_below = (1u << lane) - 1u;
   const unsigned chunks = walk.chunks(s0, max_chunks);
@@ -172,7 +171,7 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
     if (ballot & (1u << lane)) {
       const unsigned tiles = buf.bins.shift ? walk_bin_tiles(g, walk, buf.bins.shift, x, y, cam, exact) : 1u;
       emit_pair<Tally>(buf, chunk_base + __popc(ballot & lanes_below), walk.bin(x, y, buf.bins), depth_bits,
-                pair_value(buf.bins, record, tiles));
+                       pair_value(buf.bins, record, tiles));
     }
     walk.advance(x, y);
   }
@@ -181,8 +180,8 @@ __device__ void warp_write_segment(const FrameBuffers& buf, const gm::Footprint&
 // The pairs of one Gaussian's box, emitted by the whole warp (all lanes call with the same
 // footprint), one atomic per segment; returns how many were wanted.
 template <typename Tally>
-__device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g,
-                                  std::uint32_t depth_bits, unsigned record, const gm::CameraParams& cam, bool exact) {
+__device__ unsigned warp_emit_box(const FrameBuffers& buf, const gm::Footprint& g, std::uint32_t depth_bits,
+                                  unsigned record, const gm::CameraParams& cam, bool exact) {
   const unsigned lane = lane_id();
   const BoxWalk walk(g, buf.bins.shift);
   unsigned total = 0;
@@ -242,8 +241,9 @@ __device__ __forceinline__ void small_box_bin(const SmallBox& b, int shift, unsi
 // All lanes call; my_box: this lane's box size (0: nothing to emit here). Returns this lane's
 // pair count.
 template <typename Tally>
-__device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers& buf, const gm::Footprint& f, unsigned my_box, std::uint32_t depth_bits,
-                                          unsigned record, const gm::CameraParams& cam) {
+__device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers& buf, const gm::Footprint& f,
+                                          unsigned my_box, std::uint32_t depth_bits, unsigned record,
+                                          const gm::CameraParams& cam) {
   const unsigned lane = lane_id();
   const unsigned inclusive = warp_inclusive_sum(my_box);
   const unsigned start = inclusive - my_box, total_tiles = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -318,8 +318,8 @@ __device__ unsigned warp_emit_small_boxes(SmallBoxScratch& s, const FrameBuffers
       int bx, by;
       small_box_bin(b, shift, g - b.start, bx, by);
       emit_pair<Tally>(buf, step_base + __popc(ballot & lanes_below),
-                static_cast<unsigned>(by) * static_cast<unsigned>(buf.bins.x) + static_cast<unsigned>(bx),
-                b.depth_bits, pair_value(buf.bins, b.record, s.tiles[g]));
+                       static_cast<unsigned>(by) * static_cast<unsigned>(buf.bins.x) + static_cast<unsigned>(bx),
+                       b.depth_bits, pair_value(buf.bins, b.record, s.tiles[g]));
     }
   }
   __syncwarp();  // the scratch is free again
@@ -446,7 +446,8 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     const std::uint32_t depth_bits = sort_depth(buf.key_format, f.depth);
     __shared__ SmallBoxScratch small_scratch[kBlock / kWarp];
     if (balanced)
-      count = warp_emit_small_boxes<Tally>(small_scratch[threadIdx.x / kWarp], buf, f, small_box, depth_bits, record, cam);
+      count = warp_emit_small_boxes<Tally>(small_scratch[threadIdx.x / kWarp], buf, f, small_box, depth_bits, record,
+                                           cam);
     // Thread-emitted Gaussians: one atomic per warp reserves all their pairs.
     const unsigned inclusive = warp_inclusive_sum(balanced ? 0u : count);
     const unsigned warp_total = __shfl_sync(kFullMask, inclusive, kWarp - 1);
@@ -458,7 +459,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
       const BinBox bins(f, shift);
       auto store = [&](int bx, int by, unsigned tiles) {
         emit_pair<Tally>(buf, offset++, static_cast<unsigned>(by) * buf.bins.x + bx, depth_bits,
-                  pair_value(buf.bins, record, tiles));
+                         pair_value(buf.bins, record, tiles));
       };
       if (args.exact_tile_test && bins.count() <= 32) {
         for (unsigned m = passed_mask; m; m &= m - 1) {
@@ -548,22 +549,21 @@ constexpr int kPreprocessBlocksPerSm = FUSED && DEGREE < 3 ? 4 : 1;
 
 // A block per chunk (kChunkSize Gaussians), which tests its own chunk; LISTED (launch_chunk_list
 // ran first): a grid over the listed chunks, every gridDim-th. COUNTED: the frame's pairs are
-// counted per bin (bin_tally.cuh; fused emission of a block's own chunk only). One instance of the chunk's code per
-// kernel: with both in one kernel, the compiler spilled more of either, and the project stage
-// took 7 us longer at pc_playbot 1080p (docs/PERFORMANCE.md, v35).
+// counted per bin (bin_tally.cuh; fused emission of a block's own chunk only). One instance of
+// the chunk's code per kernel: with both in one kernel the compiler spilled more, and the
+// project stage took 7-9 us longer on pc_playbot (docs/PERFORMANCE.md, v35).
 template <int DEGREE, bool FUSED, bool LISTED, bool COUNTED>
 __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
     preprocess_kernel(DeviceScene scene, FrameBuffers buf, PreprocessArgs args) {
   static_assert(kBlock == kChunkSize, "a block is one chunk");
   static_assert((FUSED && !LISTED) || !COUNTED, "pairs are counted per bin by fused emission of a block's chunk");
   using Tally = PreprocessTally<COUNTED>;
-  // Counted pairs: preprocess_chunk's first barrier comes before its
-  // first pair, and its last after its last.
   if constexpr (LISTED) {
     const unsigned listed = buf.counters->listed_chunks;
     for (unsigned k = blockIdx.x; k < listed; k += gridDim.x) {
       const unsigned entry = buf.chunk_list[k];
-      preprocess_chunk<DEGREE, FUSED, Tally>(scene, buf, args, entry >> 1, (entry & 1u) ? kChunkClassify : kChunkProject);
+      preprocess_chunk<DEGREE, FUSED, Tally>(scene, buf, args, entry >> 1,
+                                             (entry & 1u) ? kChunkClassify : kChunkProject);
       __syncthreads();  // the chunk's shared counts are reset by the next one
     }
   } else {
@@ -585,6 +585,7 @@ __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
       }
       return;
     }
+    // preprocess_chunk's first barrier comes before its first counted pair, its last after them.
     Tally::clear(buf);
     preprocess_chunk<DEGREE, FUSED, Tally>(scene, buf, args, blockIdx.x, chunk);
     Tally::flush(buf);
@@ -687,11 +688,20 @@ void launch_for_degree(const DeviceScene& scene, const FrameBuffers& buffers, co
                        cudaStream_t stream) {
   const unsigned chunks = static_cast<unsigned>((scene.count + kBlock - 1) / kBlock);
   const unsigned blocks = LISTED ? std::min(chunks, list_grid_blocks()) : chunks;
+  using Tally = PreprocessTally<COUNTED>;
   switch (args.sh_degree) {
-    case 0: launch_with_tally<PreprocessTally<COUNTED>, preprocess_kernel<0, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args); break;
-    case 1: launch_with_tally<PreprocessTally<COUNTED>, preprocess_kernel<1, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args); break;
-    case 2: launch_with_tally<PreprocessTally<COUNTED>, preprocess_kernel<2, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args); break;
-    default: launch_with_tally<PreprocessTally<COUNTED>, preprocess_kernel<3, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args); break;
+    case 0:
+      launch_with_tally<Tally, preprocess_kernel<0, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args);
+      break;
+    case 1:
+      launch_with_tally<Tally, preprocess_kernel<1, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args);
+      break;
+    case 2:
+      launch_with_tally<Tally, preprocess_kernel<2, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args);
+      break;
+    default:
+      launch_with_tally<Tally, preprocess_kernel<3, FUSED, LISTED, COUNTED>>(blocks, buffers, stream, scene, buffers, args);
+      break;
   }
 }
 
