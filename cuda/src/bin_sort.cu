@@ -152,6 +152,18 @@ __device__ __forceinline__ void load_chunk(std::uint64_t chunk, std::uint64_t pa
   }
 }
 
+// The same with the pairs' values (the scatter passes).
+__device__ __forceinline__ void load_chunk_pairs(std::uint64_t chunk, std::uint64_t pairs,
+                                                 const std::uint32_t* __restrict__ keys,
+                                                 const std::uint32_t* __restrict__ values, int depth_bits,
+                                                 std::uint32_t (&key)[kChunkItems], std::uint32_t (&value)[kChunkItems],
+                                                 unsigned (&bin)[kChunkItems]) {
+  load_chunk(chunk, pairs, keys, depth_bits, key, bin);
+  const std::uint64_t first = chunk * kChunkPairs + threadIdx.x;
+#pragma unroll
+  for (int k = 0; k < kChunkItems; ++k) value[k] = bin[k] != kNoBin ? values[first + k * kPassBlock] : 0u;
+}
+
 // The counting pass: each block counts its chunks' pairs per bin in shared memory and adds
 // them to the bins with one global atomic per bin it met (hot bins serialise atomics per pair).
 __global__ void __launch_bounds__(kPassBlock) bin_count_kernel(FrameCounters* counters, std::uint64_t pair_capacity,
@@ -200,10 +212,7 @@ __global__ void __launch_bounds__(kPassBlock) bin_scatter_kernel(const FrameCoun
     for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) hist[b] = 0;
     std::uint32_t key[kChunkItems], value[kChunkItems];
     unsigned bin[kChunkItems];
-    load_chunk(chunk, pairs, keys, depth_bits, key, bin);
-    const std::uint64_t first = chunk * kChunkPairs + threadIdx.x;
-#pragma unroll
-    for (int k = 0; k < kChunkItems; ++k) value[k] = bin[k] != kNoBin ? values[first + k * kPassBlock] : 0u;
+    load_chunk_pairs(chunk, pairs, keys, values, depth_bits, key, value, bin);
     __syncthreads();
 #pragma unroll
     for (int k = 0; k < kChunkItems; ++k)
@@ -267,10 +276,7 @@ __global__ void __launch_bounds__(kPassBlock) bin_scatter_counted_kernel(
     for (unsigned b = threadIdx.x; b < bins; b += kPassBlock) place[skewed(b)] = 0;
     std::uint32_t key[kChunkItems], value[kChunkItems];
     unsigned bin[kChunkItems];
-    load_chunk(chunk, pairs, keys, depth_bits, key, bin);
-    const std::uint64_t first = chunk * kChunkPairs + threadIdx.x;
-#pragma unroll
-    for (int k = 0; k < kChunkItems; ++k) value[k] = bin[k] != kNoBin ? values[first + k * kPassBlock] : 0u;
+    load_chunk_pairs(chunk, pairs, keys, values, depth_bits, key, value, bin);
     __syncthreads();
 #pragma unroll
     for (int k = 0; k < kChunkItems; ++k)
