@@ -606,12 +606,6 @@ class CudaRendererImpl final : public CudaRenderer {
     cub_sized_for_pairs_ = pair_capacity_;
   }
 
-  // Whether ordering the tiles fullest first pays this frame. It costs two small kernels and
-  // the locality of neighbouring tiles blending together, and gains when one tile's serial walk
-  // outlasts what the blend's resident blocks do in a wave: when the fullest tile holds more
-  // pairs than the mean per resident block. Judged on the latest finished frame (settled_), if
-  // of the same size (the view moves little between frames); the first frame blends in image
-  // order.
   // Whether counting the pairs per bin in emission (FrameBuffers::emitted_bin_counts) pays over
   // the counting pass. Measured on an H200 (docs/PERFORMANCE.md, v35): at 1080p (2,040 bins)
   // pc_playbot 0.280 -> 0.277-0.278 ms and pc_biker 0.190-0.192 -> 0.188-0.189; at 4K (8,160
@@ -622,9 +616,17 @@ class CudaRendererImpl final : public CudaRenderer {
     return bins <= kBinSortAnyCoverageBins;
   }
 
+  // Whether this frame blends its tiles fullest first (launch_tile_order, or the bin sort's order).
   bool dense_order(const RenderOptions& options, bool baseline, std::uint64_t tiles) const {
     return !baseline && options.dense_tiles_first && dense_order_pays(tiles);
   }
+
+  // Whether ordering the tiles fullest first pays this frame. It costs two small kernels and
+  // the locality of neighbouring tiles blending together, and gains when one tile's serial walk
+  // outlasts what the blend's resident blocks do in a wave: when the fullest tile holds more
+  // pairs than the mean per resident block. Judged on the latest finished frame (settled_), if
+  // of the same size (the view moves little between frames); the first frame blends in image
+  // order.
   bool dense_order_pays(std::uint64_t tiles) const {
     if (dense_tiles_mode_ != kAuto) return dense_tiles_mode_ == kAlways;
     if (!settled_.known || tiles != settled_.tiles || settled_.tile_pairs == 0) return false;
