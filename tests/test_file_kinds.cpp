@@ -104,7 +104,7 @@ TEST(FileKinds, TheSceneLoaderRefusesWhatIsNotAFile) {
       {odd.loop, "cannot open: a loop of symbolic links"},
       {odd.dangling, "cannot open: a symbolic link whose target does not exist"},
       {odd.empty, "not a PLY file (it is empty)"}};
-  for (const auto& [path, fragment] : cases) expect_refused([&] { load_ply(path.string()); }, path, fragment);
+  for (const auto& [path, fragment] : cases) expect_refused([&p = path] { load_ply(p.string()); }, path, fragment);
 }
 
 TEST(FileKinds, TheCameraLoaderRefusesWhatIsNotAFile) {
@@ -115,7 +115,7 @@ TEST(FileKinds, TheCameraLoaderRefusesWhatIsNotAFile) {
       {odd.device, "is a device, not a regular file"},
       {odd.loop, "cannot open: a loop of symbolic links"},
       {odd.empty, "the file is empty"}};
-  for (const auto& [path, fragment] : cases) expect_refused([&] { load_cameras(path.string()); }, path, fragment);
+  for (const auto& [path, fragment] : cases) expect_refused([&p = path] { load_cameras(p.string()); }, path, fragment);
 }
 
 TEST(FileKinds, CameraFileOverTheSizeLimit) {

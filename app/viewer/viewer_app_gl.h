@@ -137,7 +137,6 @@ class ViewerApp {
   FrameRequest m_requested;
   bool m_have_request = false;
   bool m_requested_full = false;  // the last request was at the full render scale
-  int m_requested_width = 0, m_requested_height = 0;
   Camera m_last_camera;
   RenderOptions m_last_options;
   bool m_have_frame = false;

@@ -15,7 +15,7 @@ void append_gaussian(Scene& scene, const DecodedGaussian& g, const float* sh_res
     position[k] = static_cast<float>(g.position[k]);
     scale[k] = static_cast<float>(g.scale[k]);
     dc[k] = static_cast<float>(g.sh_dc[k]);
-    finite &= std::isfinite(position[k]) & std::isfinite(scale[k]) & std::isfinite(dc[k]);
+    finite &= std::isfinite(position[k]) && std::isfinite(scale[k]) && std::isfinite(dc[k]);
   }
   const int rest_n = scene.sh_rest_per_gaussian();
   for (int k = 0; k < rest_n; ++k) finite &= std::isfinite(sh_rest[k]);
