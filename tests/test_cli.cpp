@@ -179,6 +179,7 @@ TEST(CliOptions, CameraListsAreCheckedAgainstTheFile) {
 // the frame is refused before rendering, with the estimate and what is available (it was a
 // std::bad_alloc inside an OpenMP region: std::terminate, SIGABRT).
 TEST(CliMemory, FrameTooLargeForTheAddressSpaceIsRefused) {
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
   const std::string out = scratch_dir("too_large") + "/x.ppm";
   const CliResult r = run_cli("render --backend cpu -r 51200x28800 -o " + out, std::size_t{2} << 30);
   expect_one_line_error(r, "--resolution: a 51200x28800 frame needs about", "51200x28800");
@@ -190,6 +191,7 @@ TEST(CliMemory, FrameTooLargeForTheAddressSpaceIsRefused) {
 // covering all 8192 tiles of a 2048x1024 frame, are 164M pairs (2 GB) that run out of address
 // space inside the emit stage's parallel region. That is an error naming the frame, exit 2.
 TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
   const std::string dir = scratch_dir("pairs_oom");
   test::PlyBuilder b = test::PlyBuilder::inria(0, 20000);
   for (std::size_t i = 0; i < b.vertices.size(); ++i) {
@@ -208,6 +210,7 @@ TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
 // `bench --tile N` renders N copies of the scene (scale runs), reports the upload and the
 // first frame apart, and refuses copies that cannot fit in memory before making any.
 TEST(CliBench, TiledSceneIsBenchedAndTooManyCopiesAreRefused) {
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
   const std::string dir = scratch_dir("bench_tile");
   const std::size_t demo = load_ply(demo_scene_path()).size();
   const std::string quick = " --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 --json ";
@@ -331,6 +334,17 @@ TEST(CliGenerate, RefusesToOverwriteAScene) {
   EXPECT_EQ(load_ply(ply).size(), 4 * 300u);
   for (const auto& entry : fs::directory_iterator(dir))
     EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
+}
+
+// --list lists the stress cases and writes nothing (without a kind it used to write the demo).
+TEST(CliGenerate, ListWritesNoScene) {
+  const std::string dir = scratch_dir("list");
+  const CliResult listed = run_cli("generate --list -o " + dir);
+  EXPECT_EQ(listed.exit_code, 0) << listed.output;
+  EXPECT_NE(listed.output.find("stiff_1e4 "), std::string::npos) << listed.output;
+  EXPECT_FALSE(fs::exists(dir + "/point_cloud.ply"));
+  expect_one_line_error(run_cli("generate demo --list -o " + dir), "--list: lists the stress cases", "demo --list");
+  EXPECT_FALSE(fs::exists(dir + "/point_cloud.ply"));
 }
 
 TEST(CliGenerate, CountMustBePositive) {

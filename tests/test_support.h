@@ -10,6 +10,24 @@
 #include "flashgs/image.h"
 #include "flashgs/scene.h"
 
+// Whether the suites (and the binaries they run) are a ThreadSanitizer build (tools/tsan.sh).
+#if defined(__SANITIZE_THREAD__)
+#define FLASHGS_TEST_THREAD_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define FLASHGS_TEST_THREAD_SANITIZER 1
+#endif
+#endif
+#ifndef FLASHGS_TEST_THREAD_SANITIZER
+#define FLASHGS_TEST_THREAD_SANITIZER 0
+#endif
+
+// TSan maps its shadow memory up front, far past the address-space caps (RLIMIT_AS) that
+// some tests set on a child process, which then dies in TSan itself: those tests skip there.
+#define SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN()                                                  \
+  if (FLASHGS_TEST_THREAD_SANITIZER)                                                           \
+  GTEST_SKIP() << "ThreadSanitizer build: this test caps the address space, which TSan's shadow memory exceeds"
+
 namespace flashgs::test {
 
 // ../shared/scenes/<name>; empty when the folder is absent.

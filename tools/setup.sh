@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the build needs (as root, or through sudo) and configures +
 # builds into build/. Sourced by tools/run.sh and tools/test.sh; safe to run again.
+# FLASHGS_EXTRA_PACKAGES, FLASHGS_BUILD_DIR and FLASHGS_CMAKE_ARGS let tools/tsan.sh reuse it.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 packages=(build-essential cmake ninja-build pkg-config
           libglm-dev libopenimageio-dev openimageio-tools libcli11-dev nlohmann-json3-dev libgtest-dev
           libglfw3-dev libimgui-dev libgl-dev libx11-dev libxtst-dev xvfb xauth libgl1-mesa-dri
-          libhwy-dev libwebp-dev zlib1g-dev libzstd-dev)
+          libhwy-dev libwebp-dev zlib1g-dev libzstd-dev ${FLASHGS_EXTRA_PACKAGES:-})
 missing=()
 for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then

@@ -17,7 +17,7 @@ namespace flashgs::cli {
 namespace {
 
 struct GenerateArgs {
-  std::string kind = "demo";
+  std::string kind;  // demo when not given (or stress with --list)
   std::string output_dir = "generated";
   std::string input;  // tile: the scene to copy
   int copies = 4;
@@ -48,7 +48,16 @@ void write_scene(const Scene& scene, const std::vector<Camera>& cameras, const s
               dir.c_str(), scene.size(), scene.sh_degree, dir.c_str(), cameras.size());
 }
 
-void run(const GenerateArgs& args) {
+// The kind asked for: --list goes with stress alone (it wrote a demo scene before).
+GenerateArgs with_kind(GenerateArgs args) {
+  if (args.list && !args.kind.empty() && args.kind != "stress")
+    throw Error("--list: lists the stress cases; it does not go with generate " + args.kind);
+  if (args.kind.empty()) args.kind = args.list ? "stress" : "demo";
+  return args;
+}
+
+void run(const GenerateArgs& given) {
+  const GenerateArgs args = with_kind(given);
   const bool lists_only = args.kind == "stress" && (args.list || args.stress.empty());
   if (!lists_only && (args.kind == "demo" || args.kind == "tile" || args.kind == "stress")) check_output_scene(args);
   if (args.kind == "demo") {
