@@ -172,7 +172,10 @@ TEST(CliOptions, CameraListsAreCheckedAgainstTheFile) {
   expect_one_line_error(run_cli("report --camera-list abc" + quick + "-o " + dir), "--camera-list", "report abc");
   expect_one_line_error(run_cli("bench --camera-list 1," + missing + quick + "--json " + dir + "/b.json"),
                         "--camera-list: camera " + missing + " does not exist (" + cameras, "bench 1," + missing);
+  expect_one_line_error(run_cli("render -c " + missing + quick + "-o " + dir + "/r.png"),
+                        "--camera: camera " + missing + " does not exist (" + cameras, "render -c " + missing);
   EXPECT_FALSE(fs::exists(dir + "/report.csv"));
+  EXPECT_FALSE(fs::exists(dir + "/r.png"));
 }
 
 // The demo scene at 51200x28800: 17.7 GB of image alone. Under a 2 GB address-space limit

@@ -150,9 +150,7 @@ Camera CameraArgs::select(const std::string& cameras_path) const {
     return camera;
   }
   const std::vector<Camera> cameras = load_cameras(cameras_path);
-  if (index < 0 || index >= static_cast<int>(cameras.size()))
-    throw Error("camera " + std::to_string(index) + " does not exist (the file has " + std::to_string(cameras.size()) +
-                ": 0.." + std::to_string(cameras.size() - 1) + ")");
+  check_camera_indices("--camera", {index}, cameras.size(), cameras_path);
   Camera camera = cameras[index];
   if (!resolution.empty()) {
     const Resolution size = parse_resolution(resolution);
