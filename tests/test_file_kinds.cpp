@@ -255,6 +255,14 @@ TEST(FileKindsCli, TheCamerasOptionRefusesWhatIsNotAFile) {
   expect_cli_error(render + "''", "--cameras: the path is empty");
 }
 
+TEST(FileKindsCli, TheReplotOptionRefusesWhatIsNotAFile) {
+  const OddPaths odd(fresh_dir("cli_replot"));
+  expect_cli_error("report --replot " + quoted_arg(odd.fifo),
+                   odd.fifo.string() + ": is a FIFO (named pipe), not a regular file");
+  expect_cli_error("report --replot " + quoted_arg(odd.folder), odd.folder.string() + ": is a folder, not a file");
+  expect_cli_error("report --replot " + quoted_arg(odd.device), odd.device.string() + ": is a device, not a regular file");
+}
+
 TEST(FileKindsCli, SceneFolderAndTrainingOutputRender) {
   const fs::path folder = fresh_dir("cli_folder");
   write_file(folder / "point_cloud.ply", small_ply());

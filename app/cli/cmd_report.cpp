@@ -16,6 +16,7 @@
 #include "backend_factory.h"
 #include "commands.h"
 #include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "flashgs/io.h"
 #include "flashgs/parse.h"
 #include "flashgs/reference_renderer.h"
@@ -60,10 +61,14 @@ std::string psnr_text(double db) { return std::isfinite(db) ? fmt("%.1f", db) : 
 // The CSV keeps more digits, so that --replot finds the same Pareto front.
 std::string psnr_csv(double db) { return std::isfinite(db) ? fmt("%.4f", db) : "inf"; }
 
+// A report.csv holds a row per configuration and backend: a few kB.
+constexpr std::size_t kMaxReportCsvBytes = std::size_t{64} << 20;
+
 // Re-plots a report.csv (written by an earlier run) without measuring again.
 void replot(const ReportArgs& args) {
-  std::ifstream in(args.replot);
-  if (!in) throw Error(args.replot + ": cannot open");
+  // Checked and read without blocking: a FIFO or a folder is one line, not a hang.
+  const std::vector<char> text = read_regular_file(args.replot, kMaxReportCsvBytes);
+  std::istringstream in(std::string(text.begin(), text.end()));
   std::string line;
   std::getline(in, line);
   std::vector<std::string> header;
