@@ -756,6 +756,27 @@ TEST(ViewerScreenshots, TheDefaultFolderIsTheXdgPicturesFolder) {
   unsetenv("XDG_PICTURES_DIR");
 }
 
+// Without XDG_PICTURES_DIR, user-dirs.dirs names the folder; a FIFO in its place is passed
+// over without blocking (it used to hang the viewer's start).
+TEST(ViewerScreenshots, UserDirsNamesTheFolderAndAFifoThereIsPassedOver) {
+  const std::string dir = scratch_dir("viewer_user_dirs");
+  const std::string config = dir + "/config", home = dir + "/home";
+  std::filesystem::create_directories(config);
+  std::filesystem::create_directories(home + "/Shots");
+  const char* saved_home = std::getenv("HOME");
+  const std::string restore_home = saved_home ? saved_home : "";
+  unsetenv("XDG_PICTURES_DIR");
+  setenv("XDG_CONFIG_HOME", config.c_str(), 1);
+  setenv("HOME", home.c_str(), 1);
+  std::ofstream(config + "/user-dirs.dirs") << "XDG_DESKTOP_DIR=\"$HOME/Desktop\"\nXDG_PICTURES_DIR=\"$HOME/Shots\"\n";
+  EXPECT_EQ(fv::default_screenshot_folder(), home + "/Shots");
+  std::filesystem::remove(config + "/user-dirs.dirs");
+  ASSERT_EQ(mkfifo((config + "/user-dirs.dirs").c_str(), 0600), 0);
+  EXPECT_EQ(fv::default_screenshot_folder(), ".");  // no Pictures folder in this home either
+  unsetenv("XDG_CONFIG_HOME");
+  if (saved_home) setenv("HOME", restore_home.c_str(), 1);
+}
+
 TEST(ViewerGuides, FrustumsProjectWhereTheCamerasAreAndAClickPicksOne) {
   const auto cameras = orbit(8);
   fv::CameraController c;

@@ -3,8 +3,11 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
+#include <vector>
 
+#include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "flashgs/image_io.h"
 
 namespace flashgs::viewer {
@@ -15,11 +18,20 @@ bool is_folder(const std::string& path) {
   return !path.empty() && std::filesystem::is_directory(path, ec);
 }
 
+// user-dirs.dirs names a handful of folders.
+constexpr std::size_t kMaxUserDirsBytes = std::size_t{1} << 20;
+
 // XDG_PICTURES_DIR="$HOME/Pictures" from user-dirs.dirs, $HOME expanded; empty if absent.
 std::string pictures_from_user_dirs(const std::string& home) {
   const char* config = std::getenv("XDG_CONFIG_HOME");
   const std::string file = (config && *config ? std::string(config) : home + "/.config") + "/user-dirs.dirs";
-  std::ifstream in(file);
+  std::vector<char> text;
+  try {  // read without blocking: a FIFO or a device there must not hang the viewer's start
+    text = read_regular_file(file, kMaxUserDirsBytes);
+  } catch (const Error&) {
+    return "";  // absent or not a file: the next choice
+  }
+  std::istringstream in(std::string(text.begin(), text.end()));
   std::string line;
   while (std::getline(in, line)) {
     const std::string key = "XDG_PICTURES_DIR=";

@@ -2,7 +2,6 @@
 // level, a range of Gaussians in one of its chunk files; a level is the union of its ranges.
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -146,11 +145,8 @@ void check_level(const LodMeta& meta, int level, const std::string& name) {
 
 bool is_sog_lod_set(const std::string& path) {
   if (path_kind(path) != PathKind::regular_file) return false;
-  std::ifstream file(path, std::ios::binary);
-  std::string head(64 << 10, '\0');
-  file.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(file.gcount()));
-  return looks_like_sog_lod_meta(head);
+  const std::vector<char> head = read_file_start(path, 64 << 10);  // opened without blocking
+  return looks_like_sog_lod_meta(std::string(head.begin(), head.end()));
 }
 
 SogLodSet describe_sog_lod(const std::string& path) {
