@@ -182,7 +182,7 @@ TEST(CliOptions, CameraListsAreCheckedAgainstTheFile) {
 // the frame is refused before rendering, with the estimate and what is available (it was a
 // std::bad_alloc inside an OpenMP region: std::terminate, SIGABRT).
 TEST(CliMemory, FrameTooLargeForTheAddressSpaceIsRefused) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const std::string out = scratch_dir("too_large") + "/x.ppm";
   const CliResult r = run_cli("render --backend cpu -r 51200x28800 -o " + out, std::size_t{2} << 30);
   expect_one_line_error(r, "--resolution: a 51200x28800 frame needs about", "51200x28800");
@@ -194,7 +194,7 @@ TEST(CliMemory, FrameTooLargeForTheAddressSpaceIsRefused) {
 // covering all 8192 tiles of a 2048x1024 frame, are 164M pairs (2 GB) that run out of address
 // space inside the emit stage's parallel region. That is an error naming the frame, exit 2.
 TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const std::string dir = scratch_dir("pairs_oom");
   test::PlyBuilder b = test::PlyBuilder::inria(0, 20000);
   for (std::size_t i = 0; i < b.vertices.size(); ++i) {
@@ -213,7 +213,7 @@ TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
 // `bench --tile N` renders N copies of the scene (scale runs), reports the upload and the
 // first frame apart, and refuses copies that cannot fit in memory before making any.
 TEST(CliBench, TiledSceneIsBenchedAndTooManyCopiesAreRefused) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const std::string dir = scratch_dir("bench_tile");
   const std::size_t demo = load_ply(demo_scene_path()).size();
   const std::string quick = " --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 --json ";

@@ -97,7 +97,7 @@ void expect_refused(const std::function<void()>& read, const fs::path& path, con
 }
 
 TEST(FileKinds, TheSceneLoaderRefusesWhatIsNotAFile) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const OddPaths odd(fresh_dir("ply"));
   const std::vector<std::tuple<fs::path, std::string>> cases = {
       {odd.folder, "is a folder, not a file"},
@@ -110,7 +110,7 @@ TEST(FileKinds, TheSceneLoaderRefusesWhatIsNotAFile) {
 }
 
 TEST(FileKinds, TheCameraLoaderRefusesWhatIsNotAFile) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const OddPaths odd(fresh_dir("cameras"));
   const std::vector<std::tuple<fs::path, std::string>> cases = {
       {odd.folder, "is a folder, not a file"},
@@ -122,7 +122,7 @@ TEST(FileKinds, TheCameraLoaderRefusesWhatIsNotAFile) {
 }
 
 TEST(FileKinds, CameraFileOverTheSizeLimit) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const fs::path path = fresh_dir("big_cameras") / "cameras.json";
   write_file(path, "");
   fs::resize_file(path, 65000000);  // sparse: no 65 MB written
@@ -130,7 +130,7 @@ TEST(FileKinds, CameraFileOverTheSizeLimit) {
 }
 
 TEST(FileKinds, UnreadableFile) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const fs::path path = fresh_dir("unreadable") / "point_cloud.ply";
   write_file(path, small_ply());
   fs::permissions(path, fs::perms::none);
@@ -176,7 +176,7 @@ TEST(SceneLocation, ATrainingOutputFolder) {
 }
 
 TEST(SceneLocation, WhatIsNoScene) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const fs::path dir = fresh_dir("no_scene");
   const OddPaths odd(dir);
   fs::create_directories(dir / "fifo_inside");

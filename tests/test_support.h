@@ -10,23 +10,25 @@
 #include "flashgs/image.h"
 #include "flashgs/scene.h"
 
-// Whether the suites (and the binaries they run) are a ThreadSanitizer build (tools/tsan.sh).
-#if defined(__SANITIZE_THREAD__)
-#define FLASHGS_TEST_THREAD_SANITIZER 1
+// Whether the suites (and the binaries they run) are built with ThreadSanitizer
+// (tools/tsan.sh) or AddressSanitizer (FLASHGS_SANITIZE).
+#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
+#define FLASHGS_TEST_SHADOW_SANITIZER 1
 #elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define FLASHGS_TEST_THREAD_SANITIZER 1
+#if __has_feature(thread_sanitizer) || __has_feature(address_sanitizer)
+#define FLASHGS_TEST_SHADOW_SANITIZER 1
 #endif
 #endif
-#ifndef FLASHGS_TEST_THREAD_SANITIZER
-#define FLASHGS_TEST_THREAD_SANITIZER 0
+#ifndef FLASHGS_TEST_SHADOW_SANITIZER
+#define FLASHGS_TEST_SHADOW_SANITIZER 0
 #endif
 
-// TSan maps its shadow memory up front, far past the address-space caps (RLIMIT_AS) that
-// some tests set on a child process, which then dies in TSan itself: those tests skip there.
-#define SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN()                                                  \
-  if (FLASHGS_TEST_THREAD_SANITIZER)                                                           \
-  GTEST_SKIP() << "ThreadSanitizer build: this test caps the address space, which TSan's shadow memory exceeds"
+// These sanitizers map their shadow memory up front, far past the address-space caps
+// (RLIMIT_AS) that some tests set on a child process, which then dies in the sanitizer
+// itself: those tests skip there.
+#define SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER()                                             \
+  if (FLASHGS_TEST_SHADOW_SANITIZER)                                                           \
+  GTEST_SKIP() << "sanitizer build: this test caps the address space, which the sanitizer's shadow memory exceeds"
 
 namespace flashgs::test {
 

@@ -960,7 +960,7 @@ TEST(Viewer, ARenderSizeBeyondTheTextureLimitFallsBackToOneThatFits) {
 // An allocation failure inside a frame (here forced by a 3 GB address-space limit) is one line
 // and exit 2 from a scripted run, not "std::bad_alloc" from the top level.
 TEST(Viewer, AFrameThatRunsOutOfMemoryIsReportedNotFatal) {
-  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_TSAN();
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   REQUIRE_DISPLAY(prefix);
   const RunResult r = run(prefix + "sh -c 'ulimit -v 3000000; exec " + viewer() +
                           " --backend cpu --size 320x180 --render-size 12000x12000 --frames 2 --exit'");
