@@ -1,4 +1,4 @@
-// Counts as the viewer shows them (see count_text.h).
+// Counts and sizes as the viewer shows them (see count_text.h).
 #include "count_text.h"
 
 #include <cstdio>
@@ -12,5 +12,7 @@ std::string human_count(double v) {
   else std::snprintf(text, sizeof text, "%.0f", v);
   return text;
 }
+
+std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
 
 }  // namespace flashgs::viewer

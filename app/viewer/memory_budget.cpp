@@ -3,6 +3,7 @@
 
 #include <thread>
 
+#include "count_text.h"
 #include "flashgs/frame_memory.h"
 #include "flashgs/scene.h"
 
@@ -45,7 +46,7 @@ std::uint64_t scene_bytes_per_gaussian(int sh_degree) {
 
 std::string frame_size_problem(int width, int height, int texture_count, int max_texture_size,
                                std::uint64_t available) {
-  const std::string size = std::to_string(width) + "x" + std::to_string(height);
+  const std::string size = size_text(width, height);
   if (width < 1 || height < 1) return "a " + size + " frame has no pixels";
   const std::uint64_t need = frame_bytes(width, height, texture_count);
   if (max_texture_size > 0 && (width > max_texture_size || height > max_texture_size))

@@ -3,13 +3,14 @@
 
 #include <chrono>
 #include <exception>
-#include <new>
 
 #ifdef __linux__
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 #endif
+
+#include "flashgs/error.h"
 
 namespace flashgs::viewer {
 
@@ -127,10 +128,8 @@ void RenderWorker::loop() {
         std::string error;
         try {
           m_renderer->set_scene(std::move(scene));
-        } catch (const std::bad_alloc&) {
-          error = "out of memory";
         } catch (const std::exception& e) {
-          error = e.what();
+          error = error_text(e);
         }
         lock.lock();
         m_rendering = false;
@@ -155,10 +154,8 @@ void RenderWorker::loop() {
     const auto t0 = Clock::now();
     try {
       m_renderer->render(frame.request.camera, frame.request.options, frame.image, &frame.stats);
-    } catch (const std::bad_alloc&) {
-      frame.error = "out of memory";
     } catch (const std::exception& e) {
-      frame.error = e.what();
+      frame.error = error_text(e);
     }
     frame.wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     renderer_lock.unlock();

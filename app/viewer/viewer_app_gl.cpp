@@ -6,15 +6,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <new>
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
-#include "flashgs/demo_scene.h"
 #include "flashgs/gaussian_math.h"
 #include "flashgs/error.h"
 #include "flashgs/renderer.h"
+#include "count_text.h"
 #include "gl_headers_gl.h"
 #include "image_presenter_gl.h"
 #include "imgui_layer_ui.h"
@@ -57,14 +56,9 @@ glm::vec3 axis_from_text(const std::string& t) {
   return v;
 }
 
-// An exception's text for a message: a bare std::bad_alloc says only "std::bad_alloc".
-std::string reason(const std::exception& e) {
-  return dynamic_cast<const std::bad_alloc*>(&e) ? std::string("out of memory") : std::string(e.what());
-}
-
-std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
-
 }  // namespace
+
+double ViewerApp::ms_since_start() const { return ms_since(m_started); }
 
 ViewerApp::ViewerApp(ViewerArgs args)
     : m_args(std::move(args)),
@@ -220,129 +214,10 @@ void ViewerApp::select_frame_path() {
                why.c_str(), why.empty() ? "" : ")");
 }
 
-void ViewerApp::install_scene(LoadedScene scene) {
-  m_path->set_scene(scene.scene);  // throws on failure: the old scene stays
-  // Another level of the same LOD set: the same place, seen from where the user stands.
-  const bool same_place = !scene.lod_gaussians.empty() && scene.path == m_scene.path && m_scene.scene;
-  m_scene = std::move(scene);
-  m_compare_task.cancel();  // a comparison of the old scene: dropped when it ends...
-  m_arrived = {};           // ...or while its textures are going up
-  m_arrived_textures = 0;
-  if (same_place) {
-    m_compare = {};
-    m_have_request = false;
-    std::fprintf(stderr, "flashgs-viewer: %s: LOD level %d, %zu Gaussians\n", m_scene.path.c_str(), m_scene.lod_level,
-                 m_scene.scene->size());
-    return;
-  }
-  stop_path_export("stopped", ": another scene was opened");  // its frames follow the old scene's cameras
-  m_camera_path = std::make_unique<CameraPath>(m_scene.cameras);
-  m_playing = false;
-  m_camera_index = -1;
-  m_compare = {};
-  m_settings.flip_up = m_args.flip_up;
-  apply_up_choice();
-  if (!m_scene.cameras.empty()) snap_to_camera(0);
-  if (!m_args.orbit && !m_args.fly) {
-    // Seen from around (the cameras stand outside it): orbit, as object viewers do; else fly.
-    const bool object = is_object_sized(m_scene.centre, m_scene.extent, m_scene.cameras);
-    m_settings.mode = object ? NavigationMode::orbit : NavigationMode::fly;
-    std::fprintf(stderr, "flashgs-viewer: navigation: %s (%s)\n", object ? "orbit" : "fly",
-                 object ? "the cameras look at the scene from outside it" : "the cameras stand inside the scene");
-  }
-  m_have_frame = false;
-  m_have_request = false;
-  std::string note;
-  if (m_scene.report.dropped_non_finite)
-    note += std::to_string(m_scene.report.dropped_non_finite) + " Gaussians with NaN/Inf dropped. ";
-  if (!m_scene.cameras_note.empty()) note += m_scene.cameras_note;
-  std::fprintf(stderr, "flashgs-viewer: %s: %zu Gaussians, SH degree %d, %zu cameras%s%s\n", m_scene.path.c_str(),
-               m_scene.scene->size(), m_scene.scene->sh_degree, m_scene.cameras.size(), note.empty() ? "" : "; ",
-               note.c_str());
-}
-
 void ViewerApp::apply_up_choice() {
   glm::vec3 up = m_settings.up_axis == 0 ? m_scene.up : axis_from_text(kUpAxisNames[m_settings.up_axis]);
   m_controller.reset(m_scene.centre, m_scene.extent, up);
   if (m_settings.flip_up) m_controller.flip_up();
-}
-
-void ViewerApp::report_failed_load(const std::string& error) {
-  // Says what the window shows now: the scene from before, or (first load) nothing yet.
-  m_load_error = m_scene.scene ? "load failed, scene kept: " + error : "load failed (no scene loaded yet): " + error;
-  std::fprintf(stderr, "flashgs-viewer: %s\n", m_load_error.c_str());
-}
-
-bool ViewerApp::open_scene(const std::string& path) {
-  m_path_buffer = path;  // kept in the box when it fails, to be corrected
-  try {
-    install_scene(load_scene(path, path == m_args.scene ? m_args.cameras : ""));
-    m_load_error.clear();
-    m_path_buffer = path;
-    return true;
-  } catch (const std::exception& e) {
-    report_failed_load(reason(e));
-    return false;
-  }
-}
-
-void ViewerApp::request_open(const std::string& path) {
-  m_path_buffer = path;  // the box shows what was asked for, and keeps it when it fails
-  if (m_scripted) {  // scripted runs stay deterministic: load in the frame that asks
-    open_scene(path);
-    return;
-  }
-  // Parsing a large PLY takes seconds: it runs beside the frame loop, which keeps drawing the
-  // current scene; the new one is installed (uploaded) on this thread once it is ready.
-  m_path_buffer = path;  // kept in the box when it fails, to be corrected
-  if (!m_loader.start(path)) set_notice("still loading " + m_loader.path() + "; " + path + " ignored");
-  m_logged_load_progress = false;
-}
-
-void ViewerApp::request_lod_level(int level) {
-  const std::string path = m_scene.path, cameras = path == m_args.scene ? m_args.cameras : "";
-  std::fprintf(stderr, "flashgs-viewer: loading LOD level %d of %s\n", level, path.c_str());
-  if (m_scripted) {
-    try {
-      install_scene(load_scene(path, cameras, nullptr, level));
-    } catch (const std::exception& e) {
-      report_failed_load(e.what());
-    }
-    return;
-  }
-  const bool started = m_loader.start(path, [cameras, level](const std::string& p, LoadProgress& progress) {
-    return load_scene(p, cameras, &progress, level);
-  });
-  if (!started) set_notice("still loading " + m_loader.path() + "; LOD level " + std::to_string(level) + " ignored");
-  m_logged_load_progress = false;
-}
-
-void ViewerApp::finish_pending_load() {
-  const std::string path = m_loader.path();
-  LoadedScene scene;
-  std::string error;
-  if (!m_loader.take(&scene, &error)) return;
-  const bool first = m_first_load_pending;
-  m_first_load_pending = false;
-  std::fprintf(stderr, "flashgs-viewer: load of %s finished after %.0f ms since start\n", path.c_str(), ms_since(m_started));
-  if (!error.empty()) {
-    report_failed_load(error);
-    if (first && !m_scene.scene) {  // nothing to show: the generated demo scene instead
-      install_scene(generate_demo_scene(30000));
-      m_load_error += "; showing a generated demo scene";
-      std::fprintf(stderr, "flashgs-viewer: showing a generated demo scene instead\n");
-    }
-    return;
-  }
-  try {
-    install_scene(std::move(scene));
-    m_load_error.clear();
-    m_path_buffer = first ? m_args.scene : path;
-    if (first) apply_start_options();
-    if (!first || !m_args.scene.empty()) remember_recent(first ? m_args.scene : path);
-  } catch (const std::exception& e) {
-    report_failed_load(path + ": " + reason(e));
-  }
 }
 
 void ViewerApp::snap_to_camera(int index) {
@@ -681,7 +556,7 @@ void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
       m_path->submit(request, true);
     }
   } catch (const std::exception& e) {  // out of memory, a texture refused: keep running
-    render_failed(rw, rh, reason(e));
+    render_failed(rw, rh, error_text(e));
   }
   m_requested = request;
   m_have_request = true;
@@ -697,7 +572,7 @@ void ViewerApp::collect_frame() {
   try {
     if (!m_path->take_finished(&frame)) return;
   } catch (const std::exception& e) {  // the upload's texture refused
-    render_failed(frame.request.camera.width, frame.request.camera.height, reason(e));
+    render_failed(frame.request.camera.width, frame.request.camera.height, error_text(e));
     return;
   }
   const int width = frame.request.camera.width, height = frame.request.camera.height;
@@ -712,7 +587,7 @@ void ViewerApp::collect_frame() {
   m_have_frame = true;
   m_frame_is_full = !frame.request.reduced;
   m_last_frame_ms = frame.wall_ms;
-  m_rendered_rate.record(ms_since(m_started) / 1000.0);
+  m_rendered_rate.record(ms_since_start() / 1000.0);
   if (m_frame_is_full) {
     m_full_render_ms = frame.wall_ms;
     m_good_scale = m_settings.render_scale;
@@ -739,7 +614,7 @@ void ViewerApp::collect_frame() {
                  m_frame_is_full ? "full" : "reduced", frame.wall_ms);
   if (!m_logged_first_frame && m_frame_is_full) {
     m_logged_first_frame = true;
-    std::fprintf(stderr, "flashgs-viewer: first frame shown %.0f ms after start (%dx%d, %s)\n", ms_since(m_started),
+    std::fprintf(stderr, "flashgs-viewer: first frame shown %.0f ms after start (%dx%d, %s)\n", ms_since_start(),
                  width, height, m_scene.path.c_str());
   }
 }
@@ -799,7 +674,7 @@ void ViewerApp::draw_and_present(int fb_w, int fb_h) {
   // a frame late: from the third frame with panels on after the first load ended (the scene's
   // lines in its panel), they are all on screen where they stay (tests click them from then on).
   if (m_settings.show_ui && !m_first_load_pending && ++m_ui_frames == 3)
-    std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start\n", ms_since(m_started));
+    std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start\n", ms_since_start());
 }
 
 void ViewerApp::log_held_input() {
@@ -825,7 +700,7 @@ void ViewerApp::log_held_input() {
                : m_export_job.busy() ? " (exporting)"
                : m_path->busy()      ? " (a frame is rendering)"
                                      : "",
-               m_rendered_rate.rate(ms_since(m_started) / 1000.0));
+               m_rendered_rate.rate(ms_since_start() / 1000.0));
 }
 
 void ViewerApp::log_option_changes() {
@@ -926,113 +801,6 @@ void ViewerApp::finish_script() {
   m_settings.vsync = !m_args.no_vsync;
 }
 
-namespace {
-
-// The first scene: generated, the argument or the demo file, tiled when --tile asks (on the
-// loader thread for interactive runs: it only reads `args`, a copy). Throws flashgs::Error
-// naming the option or file; a refused --tile leaves the scene untiled with `refused_option` set.
-LoadedScene load_start_scene(const ViewerArgs& args, LoadProgress* progress) {
-  LoadedScene scene;
-  if (args.generate_demo > 0) {
-    const std::string option = "--generate-demo " + std::to_string(args.generate_demo);
-    const int demo_sh_degree = 1;  // what make_demo_scene builds
-    const std::string problem =
-        scene_size_problem(scene_bytes(std::uint64_t(args.generate_demo), scene_bytes_per_gaussian(demo_sh_degree)),
-                           system_available_memory());
-    try {
-      if (!problem.empty()) throw Error(problem);
-      scene = generate_demo_scene(static_cast<std::size_t>(args.generate_demo));
-    } catch (const std::exception& e) {
-      throw Error(option + ": " + reason(e));
-    }
-  } else {
-    const std::string path = args.scene.empty() ? demo_scene_path() : args.scene;
-    scene = load_scene(path, args.cameras, progress);
-  }
-  if (args.tile > 1) {
-    const std::string option = "--tile " + std::to_string(args.tile);
-    const std::uint64_t gaussians = std::uint64_t(scene.scene->size()) * std::uint64_t(args.tile);
-    const std::string problem =
-        scene_size_problem(scene_bytes(gaussians, scene_bytes_per_gaussian(scene.scene->sh_degree)),
-                           system_available_memory());
-    try {
-      if (!problem.empty()) throw Error(problem + " for " + std::to_string(gaussians) + " Gaussians");
-      scene = tile_loaded_scene(scene, args.tile);
-    } catch (const std::exception& e) {
-      scene.refused_option = option + " refused: " + reason(e);
-    }
-  }
-  return scene;
-}
-
-}  // namespace
-
-bool ViewerApp::start_first_scene() {
-  if (!m_args.load_gate.empty()) {
-    m_loader.set_gate(m_args.load_gate);
-    std::fprintf(stderr, "flashgs-viewer: each scene load beside the window waits for %s (--load-gate)\n",
-                 m_args.load_gate.c_str());
-  }
-  if (!m_scripted) {
-    // The window and panels come up at once; the scene loads beside them with its progress shown.
-    m_first_load_pending = true;
-    const std::string shown = m_args.generate_demo > 0 ? "generated demo scene"
-                              : m_args.scene.empty()   ? demo_scene_path()
-                                                       : m_args.scene;
-    m_loader.start(shown, [args = m_args](const std::string&, LoadProgress& progress) {
-      return load_start_scene(args, &progress);
-    });
-    m_path_buffer = m_args.scene;
-    return true;
-  }
-  // Scripted runs load before their first frame: what they time and save does not depend on
-  // when a thread finishes.
-  try {
-    LoadedScene scene = load_start_scene(m_args, nullptr);
-    const std::string refused = scene.refused_option;
-    install_scene(std::move(scene));
-    m_path_buffer = m_args.scene;
-    if (!refused.empty()) {  // its numbers would be for another scene
-      set_notice(refused);
-      return false;
-    }
-  } catch (const std::exception& e) {
-    report_failed_load(reason(e));
-    std::fprintf(stderr, "flashgs-viewer: no scene to run the script on\n");
-    return false;
-  }
-  return apply_start_options();
-}
-
-bool ViewerApp::apply_start_options() {
-  // Each refusal is one line naming the option; a scripted run stops (its numbers would be
-  // for something else), an interactive one goes on without the option.
-  if (!m_scene.refused_option.empty()) set_notice(m_scene.refused_option + "; the scene is shown once");
-  if (m_settings.forced_width > 0) {
-    const std::string problem = frame_size_problem(m_settings.forced_width, m_settings.forced_height,
-                                                   m_path->texture_count(), m_max_texture_size, system_available_memory());
-    if (!problem.empty()) {
-      set_notice("--render-size " + size_text(m_settings.forced_width, m_settings.forced_height) + " refused: " +
-                 problem + (m_scripted ? "" : "; rendering at the window size"));
-      if (m_scripted) return false;
-      m_settings.forced_width = m_settings.forced_height = 0;
-    }
-  }
-  if (m_args.camera >= 0) {
-    const int count = static_cast<int>(m_scene.cameras.size());
-    if (m_args.camera >= count) {
-      set_notice("--camera " + std::to_string(m_args.camera) + ": " +
-                 (count == 0 ? std::string("the scene has no cameras")
-                             : "the scene has " + std::to_string(count) + " cameras (0.." + std::to_string(count - 1) + ")"));
-      if (m_scripted) return false;
-    } else {
-      snap_to_camera(m_args.camera);
-    }
-  }
-  if (m_args.fov > 0) m_settings.fov_x_degrees = m_args.fov;
-  return true;
-}
-
 bool ViewerApp::open_window() {
   try {
     m_window = std::make_unique<Window>(m_args.window_width, m_args.window_height, "flashgs-viewer");
@@ -1117,7 +885,7 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.playing = m_playing;
   model.render_width = m_presenter->width();
   model.render_height = m_presenter->height();
-  model.fps = m_rendered_rate.rate(ms_since(m_started) / 1000.0);
+  model.fps = m_rendered_rate.rate(ms_since_start() / 1000.0);
   model.last_frame_ms = m_last_frame_ms;
   model.rendering = background_busy();
   if (comparing()) model.comparing = m_comparing;
@@ -1152,7 +920,7 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   if (!model.loading.empty() && !m_logged_load_progress) {
     m_logged_load_progress = true;
     std::fprintf(stderr, "flashgs-viewer: load progress shown %.0f ms after the load started, %.0f ms after start (%s)\n",
-                 model.load.elapsed_s * 1000.0, ms_since(m_started), model.loading.c_str());
+                 model.load.elapsed_s * 1000.0, ms_since_start(), model.loading.c_str());
   }
 }
 

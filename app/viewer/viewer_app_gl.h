@@ -52,16 +52,17 @@ class ViewerApp {
   // The CPU path (its frames on a worker thread); the one fallback when a GPU path fails.
   // `why` is logged as it is and shown in plain words.
   void use_cpu_path(const std::string& why);
+
+  // Scenes (viewer_scenes_gl.cpp).
   bool start_first_scene();  // scripted: loads now; interactive: starts the load; false: stop
   bool apply_start_options();  // --tile (scripted), --render-size, --camera; false: a scripted run must stop
-
-  // Scenes.
   bool open_scene(const std::string& path);  // loads now; false (error kept) on failure
   void request_open(const std::string& path);  // loads in the background (interactive runs)
   void request_lod_level(int level);  // another level of the SOG LOD set shown, loaded like a new file
   void finish_pending_load();
   void report_failed_load(const std::string& error);
   void install_scene(LoadedScene scene);
+  // Navigation.
   void apply_up_choice();
   void snap_to_camera(int index);
 
@@ -212,6 +213,7 @@ class ViewerApp {
   std::string m_pending_window_shot;
   bool m_close_after_shot = false;
   std::chrono::steady_clock::time_point m_started = std::chrono::steady_clock::now();
+  double ms_since_start() const;  // the viewer's own clock, for its log lines and rates
 };
 
 }  // namespace flashgs::viewer

@@ -1,5 +1,7 @@
-// Making text that comes from files safe to print inside an error message.
+// Making exceptions and text that comes from files safe to print inside an error message.
 #include "flashgs/error.h"
+
+#include <new>
 
 namespace flashgs {
 namespace {
@@ -47,6 +49,10 @@ std::string printable_file_text(std::string_view text, std::size_t max_bytes) {
   }
   if (i < text.size()) out += "... (" + std::to_string(text.size()) + " bytes)";
   return out;
+}
+
+std::string error_text(const std::exception& e) {
+  return dynamic_cast<const std::bad_alloc*>(&e) ? std::string("out of memory") : std::string(e.what());
 }
 
 }  // namespace flashgs

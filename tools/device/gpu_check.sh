@@ -92,19 +92,25 @@ tests() {  # GPU_TEST_FILTER: a gtest filter (default: every test but the saniti
 }
 
 sanitize() {  # SANITIZERS: the compute-sanitizer tools (default memcheck racecheck; racecheck of every kernel
-  # outgrew 300 s in session 22: RACECHECK_KERNELS=blend_warp_tile checks only the kernels whose names hold that
-  # text, the others run unchecked at full speed, ~2 minutes; SANITIZER_TIMEOUT, default 300 s)
+  # outgrew 300 s in session 22: RACECHECK_KERNELS="blend_warp_tile preprocess" checks, one run each, only the
+  # kernels whose names hold one of those texts, the others run unchecked at full speed, ~2 minutes a run;
+  # SANITIZER_TIMEOUT, default 300 s a run)
   export FLASHGS_SANITIZER_SCENE=pc_biker
+  local tool kernel kernels
   for tool in ${SANITIZERS:-memcheck racecheck}; do
-    log "compute-sanitizer $tool${RACECHECK_KERNELS:+ (kernels named *$RACECHECK_KERNELS*)}"
-    local only=()
-    if [ $tool = racecheck ]; then
-      export FLASHGS_SANITIZER_QUICK=1
-      [ -n "${RACECHECK_KERNELS:-}" ] && only=(--kernel-name "kns=$RACECHECK_KERNELS")
-    fi
-    timeout "${SANITIZER_TIMEOUT:-300}" compute-sanitizer --tool $tool ${only[@]+"${only[@]}"} --error-exitcode 9 --print-limit 20 \
-      "$TESTS" --gtest_filter=CudaSanitizer.* > "$OUT/sanitizer_$tool.log" 2>&1
-    log "sanitizer $tool rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$OUT/sanitizer_$tool.log" | tail -1)"
+    kernels=("")
+    [ $tool = racecheck ] && [ -n "${RACECHECK_KERNELS:-}" ] && read -r -a kernels <<< "$RACECHECK_KERNELS"
+    for kernel in "${kernels[@]}"; do
+      local only=() log_name=sanitizer_$tool${kernel:+_$kernel}
+      log "compute-sanitizer $tool${kernel:+ (kernels named *$kernel*)}"
+      if [ $tool = racecheck ]; then
+        export FLASHGS_SANITIZER_QUICK=1
+        [ -n "$kernel" ] && only=(--kernel-name "kns=$kernel")
+      fi
+      timeout "${SANITIZER_TIMEOUT:-300}" compute-sanitizer --tool $tool ${only[@]+"${only[@]}"} --error-exitcode 9 --print-limit 20 \
+        "$TESTS" --gtest_filter=CudaSanitizer.* > "$OUT/$log_name.log" 2>&1
+      log "sanitizer $tool${kernel:+ ($kernel)} rc=$? $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$OUT/$log_name.log" | tail -1)"
+    done
     if [ $tool = memcheck ]; then  # the sanitizer frames sort per bin; CUB's sort and its list kernels too
       FLASHGS_BIN_SORT=0 timeout 300 compute-sanitizer --tool memcheck --error-exitcode 9 --print-limit 20 \
         "$TESTS" --gtest_filter=CudaSanitizer.* > "$OUT/sanitizer_memcheck_cub_sort.log" 2>&1

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <exception>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -18,6 +19,10 @@ class LoadCancelled : public Error {
  public:
   explicit LoadCancelled(const std::string& path) : Error(path + ": loading cancelled") {}
 };
+
+// An exception's text for a message: "out of memory" for std::bad_alloc, whose own text says
+// only "std::bad_alloc"; what() otherwise.
+std::string error_text(const std::exception& e);
 
 // Text taken from a file (a header line, a token, an img_name), made safe to put in a message:
 // control bytes and invalid UTF-8 become \xNN, and text longer than `max_bytes` is cut with
