@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "settings_store.h"
@@ -89,7 +90,7 @@ TEST(ViewerSettingsStore, AFolderOrUnwritablePlaceIsOneLine) {
   const std::string dir = scratch("unwritable");
   fv::StoredSettings s;
   const std::string problem = fv::read_settings_file(dir, s);  // a folder where the file should be
-  EXPECT_EQ(problem, dir + ": not a regular file: ignored, using the defaults");
+  EXPECT_EQ(problem, dir + ": is a folder, not a file: ignored, using the defaults");
   const std::string blocked = dir + "/a_file";
   write_text(blocked, "x");
   const std::string written = fv::write_settings_file(blocked + "/settings.ini", s);  // its folder is a file
@@ -101,6 +102,20 @@ TEST(ViewerSettingsStore, AFolderOrUnwritablePlaceIsOneLine) {
     EXPECT_NE(fv::write_settings_file(locked + "/settings.ini", s), "");
     std::filesystem::permissions(locked, std::filesystem::perms::owner_all);
   }
+}
+
+// A FIFO would block a plain open until a writer came; a huge file is not the viewer's.
+TEST(ViewerSettingsStore, AFifoOrAHugeFileIsRefusedWithoutWaiting) {
+  const std::string dir = scratch("odd_kinds");
+  const std::string fifo = dir + "/settings.ini";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  fv::StoredSettings s;
+  EXPECT_EQ(fv::read_settings_file(fifo, s), fifo + ": is a FIFO (named pipe), not a regular file: ignored, using the defaults");
+  const std::string huge = dir + "/huge.ini";
+  write_text(huge, std::string(2 << 20, '#'));  // comment lines only: it would parse
+  const std::string problem = fv::read_settings_file(huge, s);
+  EXPECT_EQ(problem.rfind(huge + ": the file is ", 0), 0u) << problem;
+  EXPECT_NE(problem.find("ignored, using the defaults"), std::string::npos) << problem;
 }
 
 TEST(ViewerSettingsStore, RecentFilesAreNewestFirstOnceAndCut) {

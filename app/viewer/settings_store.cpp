@@ -12,10 +12,15 @@
 #include <sstream>
 #include <system_error>
 
+#include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "flashgs/options.h"
 
 namespace flashgs::viewer {
 namespace {
+
+// What the viewer writes is a few KB; anything past this is not its settings file.
+constexpr std::size_t kMaxSettingsFileBytes = 1 << 20;
 
 bool parse_number(const std::string& text, float* out) {
   char* end = nullptr;
@@ -121,9 +126,13 @@ std::string read_settings_file(const std::string& path, StoredSettings& stored) 
   const auto status = std::filesystem::status(path, ec);
   if (ec || status.type() == std::filesystem::file_type::not_found) return "";  // first run
   const std::string ignored = ": ignored, using the defaults";
-  if (status.type() != std::filesystem::file_type::regular) return path + ": not a regular file" + ignored;
-  std::ifstream in(path);
-  if (!in) return path + ": cannot be read (" + std::strerror(errno) + ")" + ignored;
+  std::vector<char> bytes;
+  try {  // checked and read in one step: a FIFO, folder or huge file put there is refused, never waited on
+    bytes = read_regular_file(path, kMaxSettingsFileBytes);
+  } catch (const Error& e) {
+    return e.what() + ignored;
+  }
+  std::istringstream in(std::string(bytes.begin(), bytes.end()));
   StoredSettings parsed = stored;
   parsed.recent.clear();
   std::string line;
@@ -138,7 +147,6 @@ std::string read_settings_file(const std::string& path, StoredSettings& stored) 
     if (eq == std::string::npos || !apply_line(key, value, parsed))
       return path + " line " + std::to_string(number) + ": \"" + t.substr(0, 80) + "\" is not a valid setting" + ignored;
   }
-  if (in.bad()) return path + ": read error" + ignored;
   stored = std::move(parsed);
   return "";
 }
