@@ -905,6 +905,29 @@ TEST(Viewer, ACameraBeyondTheSceneIsAnErrorNamingTheOption) {
   EXPECT_NE(r.output.find("--camera 99: the scene has 36 cameras (0..35)"), std::string::npos) << r.output;
 }
 
+// --lod opens that level of a SOG LOD set (as `flashgs render --lod` does); a level the set
+// lacks, or a scene that is no LOD set, is one line naming the option.
+TEST(Viewer, TheLodOptionOpensThatLevelAndABadOneIsNamed) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string set = flashgs::test::shared_format_file("playbot_sog");
+  if (set.empty()) GTEST_SKIP() << "../shared/scenes/formats/playbot_sog is absent";
+  const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --frames 1 --exit ";
+  const RunResult coarse = run(common + "'" + set + "'" + " --lod 6");
+  EXPECT_EQ(coarse.exit_code, 0) << coarse.output;
+  EXPECT_NE(coarse.output.find(": LOD level 6 of 0..6, "), std::string::npos) << coarse.output;
+  const RunResult beyond = run(common + "'" + set + "'" + " --lod 7");
+  EXPECT_EQ(beyond.exit_code, 2) << beyond.output;
+  EXPECT_NE(beyond.output.find("load failed (no scene loaded yet): --lod 7: "), std::string::npos) << beyond.output;
+  EXPECT_NE(beyond.output.find("the set has levels 0..6"), std::string::npos) << beyond.output;
+  const RunResult no_set = run(common + "--lod 1");  // the bundled demo PLY
+  EXPECT_EQ(no_set.exit_code, 2) << no_set.output;
+  EXPECT_NE(no_set.output.find("--lod 1: "), std::string::npos) << no_set.output;
+  EXPECT_NE(no_set.output.find("not a SOG LOD set"), std::string::npos) << no_set.output;
+  const RunResult both = run(common + "--lod 1 --generate-demo 1000");
+  EXPECT_NE(both.exit_code, 0) << both.output;
+  EXPECT_NE(both.output.find("--lod excludes --generate-demo"), std::string::npos) << both.output;
+}
+
 // Frames and scenes too large for this machine are refused with their figures, before any
 // allocation (no std::bad_alloc, no abort).
 TEST(Viewer, ARenderSizeBeyondMemoryOrTextureLimitIsRefused) {

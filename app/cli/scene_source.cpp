@@ -19,12 +19,9 @@
 namespace flashgs::cli {
 
 void SceneArgs::add_to(CLI::App* command) {
-  m_scene_option = command->add_option("scene", scene_path,
-                                       "scene file (INRIA or PlayCanvas compressed PLY, .splat, SPZ, SOG meta.json or "
-                                       "lod-meta.json), a folder holding point_cloud.ply or a SOG set, or a 3DGS "
-                                       "training output folder (default: the bundled demo scene)");
+  m_scene_option = command->add_option("scene", scene_path, kSceneArgumentHelp);
   m_cameras_option = command->add_option("--cameras", cameras_path, "cameras.json (default: the scene's own)");
-  command->add_option("--lod", lod, "level of a SOG LOD set, 0 = finest (default: the finest that fits in memory)")
+  command->add_option("--lod", lod, kLodOptionHelp)
       ->check(CLI::NonNegativeNumber);
 }
 

@@ -10,6 +10,7 @@
 #include "compare_mode.h"
 #include "finite_option.h"
 #include "flashgs/error.h"
+#include "flashgs/io.h"
 #include "flashgs/parse.h"
 #include "viewer_settings.h"
 
@@ -38,10 +39,12 @@ void parse_size(const std::string& option, const std::string& text, int* w, int*
 int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   CLI::App app{"flashgs-viewer: fly through a 3D Gaussian Splatting scene (FlashGS renderer, CUDA or CPU)"};
   std::string size, render_size;
-  app.add_option("scene", a->scene, "PLY file or a folder holding point_cloud.ply (default: the bundled demo scene)");
-  app.add_option("--cameras", a->cameras, "cameras.json (default: the one beside the PLY)");
+  app.add_option("scene", a->scene, kSceneArgumentHelp);
+  app.add_option("--cameras", a->cameras, "cameras.json (default: the scene's own)");
+  CLI::Option* lod = app.add_option("--lod", a->lod, kLodOptionHelp)->check(CLI::NonNegativeNumber);
   app.add_option("--generate-demo", a->generate_demo, "use a procedural demo scene of N Gaussians instead of a file")
-      ->check(CLI::Range(1L, 200000000L));
+      ->check(CLI::Range(1L, 200000000L))
+      ->excludes(lod);
   app.add_option("--tile", a->tile, "render K copies of the scene on a grid (large-scene benchmarks)")
       ->check(CLI::Range(1, 1024));
   app.add_option("--size", size, "window size WxH in screen points (default 1280x800)");

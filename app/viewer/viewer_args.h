@@ -9,9 +9,10 @@
 namespace flashgs::viewer {
 
 struct ViewerArgs {
-  std::string scene;          // PLY or a folder holding point_cloud.ply; empty: the demo scene
-  std::string cameras;        // cameras.json; empty: the one beside the PLY
+  std::string scene;          // what locate_scene takes: a scene file or folder; empty: the demo scene
+  std::string cameras;        // cameras.json; empty: the scene's own
   long generate_demo = 0;     // > 0: a procedural demo scene of this many Gaussians instead of a file
+  int lod = -1;               // >= 0: this level of a SOG LOD set; -1: the finest that fits in memory
   int tile = 1;               // copies of the scene on a grid (large-scene benchmarks)
   int window_width = 1280, window_height = 800;
   int render_width = 0, render_height = 0;  // > 0: render at exactly this size

@@ -51,9 +51,13 @@ void ViewerApp::install_scene(LoadedScene scene) {
   if (m_scene.report.dropped_non_finite)
     note += std::to_string(m_scene.report.dropped_non_finite) + " Gaussians with NaN/Inf dropped. ";
   if (!m_scene.cameras_note.empty()) note += m_scene.cameras_note;
-  std::fprintf(stderr, "flashgs-viewer: %s: %zu Gaussians, SH degree %d, %zu cameras%s%s\n", m_scene.path.c_str(),
-               m_scene.scene->size(), m_scene.scene->sh_degree, m_scene.cameras.size(), note.empty() ? "" : "; ",
-               note.c_str());
+  const std::string level = m_scene.lod_gaussians.empty()
+                                ? ""
+                                : "LOD level " + std::to_string(m_scene.lod_level) + " of 0.." +
+                                      std::to_string(m_scene.lod_gaussians.size() - 1) + ", ";
+  std::fprintf(stderr, "flashgs-viewer: %s: %s%zu Gaussians, SH degree %d, %zu cameras%s%s\n", m_scene.path.c_str(),
+               level.c_str(), m_scene.scene->size(), m_scene.scene->sh_degree, m_scene.cameras.size(),
+               note.empty() ? "" : "; ", note.c_str());
 }
 
 void ViewerApp::report_failed_load(const std::string& error) {
@@ -155,7 +159,17 @@ LoadedScene load_start_scene(const ViewerArgs& args, LoadProgress* progress) {
     }
   } else {
     const std::string path = args.scene.empty() ? demo_scene_path() : args.scene;
-    scene = load_scene(path, args.cameras, progress);
+    if (args.lod < 0) {
+      scene = load_scene(path, args.cameras, progress);
+    } else {
+      try {
+        scene = load_scene(path, args.cameras, progress, args.lod);
+      } catch (const LoadCancelled&) {
+        throw;
+      } catch (const std::exception& e) {
+        throw Error("--lod " + std::to_string(args.lod) + ": " + error_text(e));
+      }
+    }
   }
   if (args.tile > 1) {
     const std::string option = "--tile " + std::to_string(args.tile);

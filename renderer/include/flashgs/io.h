@@ -21,6 +21,12 @@ struct SceneLocation {
 // line naming the path and the problem for an empty path, a missing path, a folder holding
 // no scene, or a FIFO, device or link loop where the PLY should be; no file is opened.
 SceneLocation locate_scene(const std::string& path);
+// What a scene argument may name, as the command-line help of the CLI and the viewer says it.
+inline constexpr const char kSceneArgumentHelp[] =
+    "scene file (INRIA or PlayCanvas compressed PLY, .splat, SPZ, SOG meta.json or lod-meta.json), a folder holding "
+    "point_cloud.ply or a SOG set, or a 3DGS training output folder (default: the bundled demo scene)";
+inline constexpr const char kLodOptionHelp[] =
+    "level of a SOG LOD set, 0 = finest (default: the finest that fits in memory)";
 // cameras.json beside the PLY, or at the model root of a training output
 // (<model>/point_cloud/iteration_<N>/point_cloud.ply -> <model>/cameras.json).
 std::string default_cameras_path(const std::string& ply_path);
