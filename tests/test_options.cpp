@@ -135,7 +135,7 @@ TEST(OptionsTable, SingleSwitchConfigsAreBaselineFlashAndEachSwitchOff) {
 
 RenderOptions parse_flags(const std::string& command_line) {
   CLI::App app;
-  cli::SwitchFlags flags;
+  SwitchFlags flags;
   flags.add_to(&app);
   app.parse(command_line, false);
   RenderOptions o;
@@ -161,7 +161,7 @@ TEST(SwitchFlags, EveryFlagAtOnceGivesEverySwitchOff) {
 
 TEST(SwitchFlags, HelpNamesEveryFlagAndUnknownOnesAreRejected) {
   CLI::App app;
-  cli::SwitchFlags flags;
+  SwitchFlags flags;
   flags.add_to(&app);
   const std::string help = app.help();
   for (const RenderSwitch& s : kRenderSwitches)

@@ -203,31 +203,54 @@ double lit_fraction(const flashgs::Image& image) {
 std::string viewer() { return FLASHGS_VIEWER; }
 std::string cli() { return FLASHGS_CLI; }
 
-// The viewer's screenshot of `camera` vs `flashgs render` of the same camera at the same size.
-void expect_matches_cli(const std::string& prefix, const std::string& scene, int camera, const std::string& stem) {
+// The number after `key` in `output`, or -1.
+long long number_after(const std::string& output, const std::string& key) {
+  const auto at = output.find(key);
+  return at == std::string::npos ? -1 : std::atoll(output.c_str() + at + key.size());
+}
+
+// The viewer's screenshot of `camera` vs `flashgs render` of the same camera at the same size,
+// both given `options`: the same image and the same kv pairs. Returns the pairs.
+long long expect_matches_cli(const std::string& prefix, const std::string& scene, int camera, const std::string& stem,
+                             const std::string& options = "") {
   const std::string dir = out_dir();
   const std::string shot = dir + "/" + stem + "_viewer" + kExt, ref = dir + "/" + stem + "_cli" + kExt;
   std::filesystem::remove(shot);
   const std::string scene_arg = scene.empty() ? "" : "\"" + scene + "\" ";
-  const RunResult v = run(prefix + viewer() + " " + scene_arg + "--backend cpu --size 640x360 --camera " +
+  const RunResult v = run(prefix + viewer() + " " + scene_arg + options + " --backend cpu --size 640x360 --camera " +
                           std::to_string(camera) + " --frames 2 --screenshot " + shot + " --exit");
-  ASSERT_EQ(v.exit_code, 0) << v.output;
+  EXPECT_EQ(v.exit_code, 0) << v.output;
   EXPECT_NE(v.output.find("frame path: CPU"), std::string::npos) << v.output;
-  const RunResult c = run(cli() + " render " + scene_arg + "--backend cpu -c " + std::to_string(camera) +
+  const RunResult c = run(cli() + " render " + scene_arg + options + " --backend cpu -c " + std::to_string(camera) +
                           " -r 640x360 -o " + ref);
-  ASSERT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_EQ(c.exit_code, 0) << c.output;
+  if (v.exit_code != 0 || c.exit_code != 0) return -1;
   const flashgs::Image a = flashgs::read_image(shot), b = flashgs::read_image(ref);
-  ASSERT_EQ(a.width, 640);
-  ASSERT_EQ(a.height, 360);
+  EXPECT_EQ(a.width, 640);
+  EXPECT_EQ(a.height, 360);
   const flashgs::ImageDifference d = flashgs::compare_images(a, b);
   std::printf("%s: viewer vs CLI PSNR %.2f dB, max abs %.4f\n", stem.c_str(), d.psnr_db, d.max_abs);
   if (!(d.psnr_db >= 40.0)) flashgs::test::dump_images("viewer_" + stem, b, a);
   EXPECT_GE(d.psnr_db, 40.0);
+  const long long pairs = number_after(v.output, "last frame kv pairs ");
+  EXPECT_EQ(pairs, number_after(c.output, "kv pairs:")) << v.output << "\n" << c.output;
+  return pairs;
 }
 
 TEST(Viewer, DemoSceneScreenshotMatchesCliRender) {
   REQUIRE_DISPLAY(prefix);
   expect_matches_cli(prefix, "", 3, "demo_cam3");
+}
+
+// The --no-<switch> flags are the CLI's (one table): the same frame as `flashgs render` with
+// them, and more pairs than without.
+TEST(Viewer, SwitchFlagsTurnOffTheirOptimizationsAsInTheCli) {
+  REQUIRE_DISPLAY(prefix);
+  const long long flash = expect_matches_cli(prefix, "", 3, "demo_cam3_flash");
+  const long long without = expect_matches_cli(prefix, "", 3, "demo_cam3_no_exact", "--no-exact-tile-test --no-tight-bbox");
+  std::printf("kv pairs: flash %lld, without the exact test and the tight box %lld\n", flash, without);
+  EXPECT_GT(flash, 0);
+  EXPECT_GT(without, flash);
 }
 
 TEST(Viewer, BikerCameraZeroMatchesCliRender) {

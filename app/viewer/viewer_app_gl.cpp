@@ -79,6 +79,7 @@ ViewerApp::ViewerApp(ViewerArgs args)
   if (given(m_args.fp16_sh != defaults.fp16_sh)) o.fp16_sh = m_args.fp16_sh;
   if (given(m_args.fp16_shape != defaults.fp16_shape)) o.fp16_shape = m_args.fp16_shape;
   if (given(m_args.fp16_blend != defaults.fp16_blend)) o.fp16_blend = m_args.fp16_blend;
+  m_args.switches.apply(&o);
   if (given(m_args.background != defaults.background))
     for (int c = 0; c < 3; ++c) o.background[c] = m_args.background[c];
   if (given(m_args.scale != defaults.scale)) m_settings.render_scale = m_args.scale;

@@ -1,4 +1,4 @@
-// The CLI's --no-<switch> flags, one per row of kRenderSwitches (options.h).
+// The --no-<switch> flags of the CLI and the viewer, one per row of kRenderSwitches (options.h).
 #pragma once
 
 #include <array>
@@ -8,7 +8,7 @@
 
 #include "flashgs/options.h"
 
-namespace flashgs::cli {
+namespace flashgs {
 
 struct SwitchFlags {
   std::array<bool, std::size(kRenderSwitches)> off{};  // per table row: its --no- flag was given
@@ -17,4 +17,4 @@ struct SwitchFlags {
   void apply(RenderOptions* options) const;
 };
 
-}  // namespace flashgs::cli
+}  // namespace flashgs

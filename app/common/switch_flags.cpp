@@ -3,7 +3,7 @@
 
 #include <string>
 
-namespace flashgs::cli {
+namespace flashgs {
 
 void SwitchFlags::add_to(CLI::App* command) {
   for (std::size_t k = 0; k < off.size(); ++k) {
@@ -18,4 +18,4 @@ void SwitchFlags::apply(RenderOptions* options) const {
     if (off[k]) options->*(kRenderSwitches[k].member) = false;
 }
 
-}  // namespace flashgs::cli
+}  // namespace flashgs
