@@ -946,7 +946,7 @@ TEST(Viewer, TheLodOptionOpensThatLevelAndABadOneIsNamed) {
   EXPECT_EQ(no_set.exit_code, 2) << no_set.output;
   EXPECT_NE(no_set.output.find("--lod 1: "), std::string::npos) << no_set.output;
   EXPECT_NE(no_set.output.find("not a SOG LOD set"), std::string::npos) << no_set.output;
-  const RunResult both = run(common + "--lod 1 --generate-demo 1000");
+  const RunResult both = run(viewer() + " --lod 1 --generate-demo 1000");  // refused before any window
   EXPECT_NE(both.exit_code, 0) << both.output;
   EXPECT_NE(both.output.find("--lod excludes --generate-demo"), std::string::npos) << both.output;
 }
