@@ -71,7 +71,6 @@ bool ViewerApp::open_scene(const std::string& path) {
   try {
     install_scene(load_scene(path, path == m_args.scene ? m_args.cameras : ""));
     m_load_error.clear();
-    m_path_buffer = path;
     return true;
   } catch (const std::exception& e) {
     report_failed_load(error_text(e));
@@ -87,7 +86,6 @@ void ViewerApp::request_open(const std::string& path) {
   }
   // Parsing a large PLY takes seconds: it runs beside the frame loop, which keeps drawing the
   // current scene; the new one is installed (uploaded) on this thread once it is ready.
-  m_path_buffer = path;  // kept in the box when it fails, to be corrected
   if (!m_loader.start(path)) set_notice("still loading " + m_loader.path() + "; " + path + " ignored");
   m_logged_load_progress = false;
 }
