@@ -9,11 +9,19 @@
 #include <numeric>
 #include <random>
 
+#include <sys/resource.h>
+
 #include "flashgs/demo_scene.h"
 #include "flashgs/io.h"
 #include "flashgs/netpbm.h"
 
 namespace flashgs::test {
+
+double children_cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_CHILDREN, &usage);
+  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
 
 std::string shared_scene_dir(const std::string& name) {
   const std::filesystem::path dir = std::filesystem::path(FLASHGS_SHARED_SCENES) / name;

@@ -32,6 +32,12 @@
 
 namespace flashgs::test {
 
+// How many times slower code runs in those sanitizer builds: the CPU-time bounds that tell
+// failing fast from rendering first scale by it (a process start alone takes ~1 s under TSan).
+constexpr double kSanitizerSlowdown = FLASHGS_TEST_SHADOW_SANITIZER ? 10.0 : 1.0;
+// CPU seconds (user + system) of the child processes that have finished so far.
+double children_cpu_seconds();
+
 // ../shared/scenes/<name>; empty when the folder is absent.
 std::string shared_scene_dir(const std::string& name);
 // ../shared/scenes/formats/<file> (the compressed samples: biker.compressed.ply, biker.spz,
