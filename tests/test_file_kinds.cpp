@@ -18,6 +18,8 @@
 
 #include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
+#include "flashgs/file_access.h"
+#include "flashgs/load_progress.h"
 #include "flashgs/io.h"
 #include "ply_builder.h"
 #include "test_support.h"
@@ -141,6 +143,29 @@ TEST(FileKinds, UnreadableFile) {
         load_ply(path.string());
       },
       path, "cannot open: permission denied");
+}
+
+// A file large enough for 2 MB pages (huge_pages.h) comes back byte for byte, with progress
+// counting every byte.
+TEST(FileKinds, ALargeFileIsReadWhole) {
+  const fs::path path = fresh_dir("large_file") / "data.bin";
+  std::string content(24u << 20, '\0');
+  std::uint32_t x = 12345;
+  for (char& c : content) c = static_cast<char>((x = x * 1664525u + 1013904223u) >> 24);
+  write_file(path, content);
+  LoadProgress progress;
+  const std::vector<char> bytes = read_regular_file(path.string(), content.size(), &progress);
+  ASSERT_EQ(bytes.size(), content.size());
+  EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), content.begin()));
+  EXPECT_EQ(progress.bytes_done.load(), content.size());
+  EXPECT_EQ(progress.bytes_total.load(), content.size());
+  // One byte more than allowed is refused before anything is read.
+  try {
+    read_regular_file(path.string(), content.size() - 1);
+    ADD_FAILURE() << "a file over the limit was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("this kind of file may have"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SceneLocation, AFileIsThePlyAndItsCamerasAreBesideIt) {
