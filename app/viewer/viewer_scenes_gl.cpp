@@ -157,16 +157,13 @@ LoadedScene load_start_scene(const ViewerArgs& args, LoadProgress* progress) {
     }
   } else {
     const std::string path = args.scene.empty() ? demo_scene_path() : args.scene;
-    if (args.lod < 0) {
-      scene = load_scene(path, args.cameras, progress);
-    } else {
-      try {
-        scene = load_scene(path, args.cameras, progress, args.lod);
-      } catch (const LoadCancelled&) {
-        throw;
-      } catch (const std::exception& e) {
-        throw Error("--lod " + std::to_string(args.lod) + ": " + error_text(e));
-      }
+    try {
+      scene = load_scene(path, args.cameras, progress, args.lod);  // lod -1: the finest that fits
+    } catch (const LoadCancelled&) {
+      throw;
+    } catch (const std::exception& e) {
+      if (args.lod < 0) throw;
+      throw Error("--lod " + std::to_string(args.lod) + ": " + error_text(e));  // the option that chose it
     }
   }
   if (args.tile > 1) {
