@@ -17,6 +17,7 @@ struct PlyBuilder {
   long long declared_count = -1;  // -1: the real count
   // Other elements: header lines and data bytes, before and after the vertex element.
   std::string leading_elements, leading_data, trailing_elements, trailing_data;
+  std::vector<std::string> comments;  // header comment lines (after the builder's own)
 
   // The INRIA layout with SH degree `degree` and `n` plausible Gaussians.
   static PlyBuilder inria(int degree, int n) {
@@ -50,7 +51,9 @@ struct PlyBuilder {
 
   std::string header() const {
     std::ostringstream h;
-    h << "ply\nformat " << format << " 1.0\ncomment built by the flashgs tests\n" << leading_elements;
+    h << "ply\nformat " << format << " 1.0\ncomment built by the flashgs tests\n";
+    for (const std::string& c : comments) h << "comment " << c << "\n";
+    h << leading_elements;
     h << "element vertex " << (declared_count >= 0 ? declared_count : static_cast<long long>(vertices.size())) << "\n";
     for (const auto& [type, name] : properties) h << "property " << type << " " << name << "\n";
     h << trailing_elements << "end_header\n";

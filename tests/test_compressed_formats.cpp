@@ -198,6 +198,20 @@ TEST(Spz, EveryVersionReadsRandomContent) {
     }
 }
 
+// The header's antialiased flag (bit 0) names gsplat's anti-aliased kernel, in every version.
+TEST(Spz, AntialiasedFlagNamesTheKernel) {
+  std::mt19937 rng(11);
+  for (std::uint32_t version : {2u, 3u, 4u})
+    for (std::uint8_t flags : {std::uint8_t{0}, std::uint8_t{1}}) {
+      test::SpzContent c = test::random_spz(20, 0, version, rng);
+      c.flags = flags;
+      const std::string file = version == 4 ? test::spz_v4_file(c) : test::spz_gzip_file(c);
+      const Scene s = parse_spz(file.data(), file.size(), "flag.spz");
+      EXPECT_EQ(s.trained_kernel.kernel, flags ? SplatKernel::antialiased() : SplatKernel::classic()) << version;
+      EXPECT_EQ(s.trained_kernel.marked(), flags != 0) << version;
+    }
+}
+
 TEST(Spz, ReportsProgressAndStopsWhenCancelled) {
   std::mt19937 rng(3);
   const test::SpzContent c = test::random_spz(100000, 1, 3, rng);
@@ -401,6 +415,23 @@ TEST(Sog, ReadsRandomChunksOfEveryBandCount) {
 }
 
 // A chunk on disk: progress counts its texture bytes and Gaussians, and a cancel request stops it.
+// meta.json's optional "model" names the kernel; an unknown one is refused with one line.
+TEST(Sog, ModelEntryNamesTheKernel) {
+  std::mt19937 rng(12);
+  test::SogChunk chunk = test::random_sog_chunk(10, 0, rng);
+  EXPECT_FALSE(chunk.parse().trained_kernel.marked());
+  chunk.meta["model"] = "antialiased";
+  EXPECT_EQ(chunk.parse().trained_kernel.kernel, SplatKernel::antialiased());
+  chunk.meta["model"] = "default";
+  const Scene classic = chunk.parse();
+  EXPECT_EQ(classic.trained_kernel.kernel, SplatKernel::classic());
+  EXPECT_TRUE(classic.trained_kernel.marked());
+  chunk.meta["model"] = "2dgs";
+  const std::string message = error_of([&] { chunk.parse(); });
+  EXPECT_EQ(message.rfind("chunk/meta.json: ", 0), 0u) << message;
+  EXPECT_NE(message.find("model"), std::string::npos) << message;
+}
+
 TEST(Sog, ReportsProgressAndStopsWhenCancelled) {
   std::mt19937 rng(17);
   const test::SogChunk chunk = test::random_sog_chunk(70000, 1, rng);

@@ -131,6 +131,12 @@ std::vector<RenderOptions> geometry_configs() {
   RenderOptions other_tau;
   other_tau.tau = 0.05f;
   configs.push_back(other_tau);
+  // The anti-aliased kernels (compensated opacity, another dilation), for both algorithms.
+  for (const SplatKernel& kernel : {SplatKernel::antialiased(), SplatKernel::antialiased(kMipSplattingEpsilon)})
+    for (RenderOptions o : {RenderOptions::baseline(), RenderOptions{}}) {
+      o.kernel = kernel;
+      configs.push_back(o);
+    }
   return configs;
 }
 

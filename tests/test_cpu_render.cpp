@@ -36,19 +36,23 @@ TEST(CpuRealScenes, FlashMatchesBaselineWithFewerPairs) {
   for (const std::string& name : test::shared_scene_names()) {
     const auto scene = test::load_shared_scene(name);
     const auto cameras = test::load_shared_cameras(name);
-    for (int index : {0, 20}) {  // far ring: the donut is smaller than the 0.2 near distance of the mid ring
-      const Frame base = render(scene, cameras[index], RenderOptions::baseline());
-      const Frame flash = render(scene, cameras[index], RenderOptions{});
-      const ImageDifference d = compare_images(base.image, flash.image);
-      std::printf("%-13s cam %2d: baseline %9llu pairs, flash %9llu (%.1f%% fewer); PSNR %.1f dB, max abs %.2e\n",
-                  name.c_str(), index, static_cast<unsigned long long>(base.stats.kv_pairs),
-                  static_cast<unsigned long long>(flash.stats.kv_pairs),
-                  100.0 * (1.0 - double(flash.stats.kv_pairs) / double(base.stats.kv_pairs)), d.psnr_db, d.max_abs);
-      EXPECT_GE(d.psnr_db, 50.0) << name << " camera " << index;
-      EXPECT_EQ(d.non_finite, 0u);
-      EXPECT_LT(flash.stats.kv_pairs, base.stats.kv_pairs / 2) << name;
-      if (d.psnr_db < 50.0) test::dump_images(name + "_flash_vs_baseline", base.image, flash.image);
-    }
+    // Far ring: the donut is smaller than the 0.2 near distance of the mid ring.
+    for (int index : {0, 20})
+      for (const SplatKernel& kernel : test::kernels()) {
+        RenderOptions base_options = RenderOptions::baseline(), flash_options;
+        base_options.kernel = flash_options.kernel = kernel;
+        const Frame base = render(scene, cameras[index], base_options);
+        const Frame flash = render(scene, cameras[index], flash_options);
+        const ImageDifference d = compare_images(base.image, flash.image);
+        std::printf("%-13s cam %2d %-15s: baseline %9llu pairs, flash %9llu (%.1f%% fewer); PSNR %.1f dB, max abs %.2e\n",
+                    name.c_str(), index, kernel.spec().c_str(), static_cast<unsigned long long>(base.stats.kv_pairs),
+                    static_cast<unsigned long long>(flash.stats.kv_pairs),
+                    100.0 * (1.0 - double(flash.stats.kv_pairs) / double(base.stats.kv_pairs)), d.psnr_db, d.max_abs);
+        EXPECT_GE(d.psnr_db, 50.0) << name << " camera " << index << " " << kernel.spec();
+        EXPECT_EQ(d.non_finite, 0u);
+        EXPECT_LT(flash.stats.kv_pairs, base.stats.kv_pairs / 2) << name;
+        if (d.psnr_db < 50.0) test::dump_images(name + "_flash_vs_baseline", base.image, flash.image);
+      }
   }
 }
 
@@ -141,12 +145,16 @@ TEST(CpuStats, TileCountsSumToThePairs) {
 // evaluates every pixel where alpha >= 1/255), the baseline against 3DGS's box in double.
 // Against the unbounded image the baseline also loses what 3DGS's box cuts (see
 // stress_scenes.cpp, kBoxCut: at most 0.99 e^-2 = 0.134 per Gaussian).
+// The same holds for each kernel, the anti-aliased ones with their compensated opacity in the
+// opacity-aware extent and the exact tile test.
 void check_against_reference(const std::shared_ptr<const Scene>& scene, const Camera& camera, PixelWindow window,
-                             const std::string& what) {
-  const Image unbounded = render_reference(*scene, camera, RenderOptions{}, window);
-  const Image box_3dgs = render_reference(*scene, camera, RenderOptions{}, window, ReferenceFootprint::box_3dgs);
-  auto check = [&](const RenderOptions& options, const Image& reference, const char* rule, double min_psnr,
-                   double max_abs) {
+                             const std::string& what, const SplatKernel& kernel) {
+  RenderOptions in_kernel;
+  in_kernel.kernel = kernel;
+  const Image unbounded = render_reference(*scene, camera, in_kernel, window);
+  const Image box_3dgs = render_reference(*scene, camera, in_kernel, window, ReferenceFootprint::box_3dgs);
+  auto check = [&](RenderOptions options, const Image& reference, const char* rule, double min_psnr, double max_abs) {
+    options.kernel = kernel;
     const Frame f = render(scene, camera, options);
     const Image crop = crop_image(f.image, window);
     const ImageDifference d = compare_images(reference, crop);
@@ -163,8 +171,9 @@ void check_against_reference(const std::shared_ptr<const Scene>& scene, const Ca
 }
 
 TEST(CpuVsReference, DemoSceneWholeFrame) {
-  check_against_reference(test::load_demo_scene(), test::load_demo_cameras()[1].resized(160, 90), {0, 0, 160, 90},
-                          "demo 160x90");
+  for (const SplatKernel& kernel : test::kernels())
+    check_against_reference(test::load_demo_scene(), test::load_demo_cameras()[1].resized(160, 90), {0, 0, 160, 90},
+                            "demo 160x90", kernel);
 }
 
 TEST(CpuVsReference, RealSceneCrops) {
@@ -172,10 +181,12 @@ TEST(CpuVsReference, RealSceneCrops) {
   for (const std::string& name : test::shared_scene_names()) {
     const Camera camera = test::load_shared_cameras(name)[0];
     const PixelWindow centre{camera.width / 2 - 24, camera.height / 2 - 24, 48, 48};
-    check_against_reference(test::load_shared_scene(name), camera, centre, name + " centre 48x48");
     // Off centre, where small distant Gaussians (3DGS's smallest boxes) are common.
     const PixelWindow off_centre{camera.width * 3 / 8, camera.height * 3 / 8, 48, 48};
-    check_against_reference(test::load_shared_scene(name), camera, off_centre, name + " off-centre 48x48");
+    for (const SplatKernel& kernel : test::kernels()) {
+      check_against_reference(test::load_shared_scene(name), camera, centre, name + " centre 48x48", kernel);
+      check_against_reference(test::load_shared_scene(name), camera, off_centre, name + " off-centre 48x48", kernel);
+    }
   }
 }
 
@@ -184,15 +195,18 @@ TEST(CpuVsReference, RealSceneCrops) {
 TEST(CpuOptions, ExactTileTestRemovesPairs) {
   const auto scene = test::load_demo_scene();
   const Camera camera = test::load_demo_cameras()[0].resized(640, 360);
-  RenderOptions without;
-  without.exact_tile_test = false;
-  const Frame with_test = render(scene, camera, RenderOptions{});
-  const Frame box_only = render(scene, camera, without);
-  std::printf("demo 640x360: %llu pairs with the exact test, %llu with the box alone\n",
-              static_cast<unsigned long long>(with_test.stats.kv_pairs),
-              static_cast<unsigned long long>(box_only.stats.kv_pairs));
-  EXPECT_LT(double(with_test.stats.kv_pairs), 0.9 * double(box_only.stats.kv_pairs));
-  EXPECT_EQ(with_test.image.rgb, box_only.image.rgb) << "the tiles removed held no pixel with alpha >= tau";
+  for (const SplatKernel& kernel : test::kernels()) {
+    RenderOptions with, without;
+    with.kernel = without.kernel = kernel;
+    without.exact_tile_test = false;
+    const Frame with_test = render(scene, camera, with);
+    const Frame box_only = render(scene, camera, without);
+    std::printf("demo 640x360: %llu pairs with the exact test, %llu with the box alone\n",
+                static_cast<unsigned long long>(with_test.stats.kv_pairs),
+                static_cast<unsigned long long>(box_only.stats.kv_pairs));
+    EXPECT_LT(double(with_test.stats.kv_pairs), 0.9 * double(box_only.stats.kv_pairs));
+    EXPECT_EQ(with_test.image.rgb, box_only.image.rgb) << "the tiles removed held no pixel with alpha >= tau";
+  }
 }
 
 // A degree-3 scene capped at degree 0 renders exactly like the same scene stored without

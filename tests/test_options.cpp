@@ -11,7 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/error.h"
 #include "flashgs/options.h"
+#include "flashgs/splat_kernel.h"
 #include "report_sweep.h"
 #include "switch_flags.h"
 
@@ -170,7 +172,7 @@ TEST(SwitchFlags, HelpNamesEveryFlagAndUnknownOnesAreRejected) {
 }
 
 TEST(ReportSweep, EverySwitchIsSweptAloneAndLeftOut) {
-  const std::vector<cli::SweepConfig> configs = cli::sweep_configs();
+  const std::vector<cli::SweepConfig> configs = cli::sweep_configs(SplatKernel::classic());
   std::set<std::string> names;
   for (const cli::SweepConfig& c : configs) EXPECT_TRUE(names.insert(c.name).second) << "swept twice: " << c.name;
   auto find = [&](const std::string& name) -> const cli::SweepConfig* {
@@ -237,7 +239,7 @@ TEST(OptionsTable, Fp16BlendIsACudaPrecisionOption) {
 // The report sweeps the half blend alone and with the fp16 storage, on the GPU only.
 TEST(ReportSweep, Fp16BlendIsSweptOnTheGpu) {
   std::map<std::string, RenderOptions> swept;
-  for (const cli::SweepConfig& c : cli::sweep_configs())
+  for (const cli::SweepConfig& c : cli::sweep_configs(SplatKernel::classic()))
     if (c.options.fp16_blend) {
       EXPECT_EQ(c.group, "precision");
       EXPECT_TRUE(c.gpu_only) << c.name;
@@ -250,7 +252,7 @@ TEST(ReportSweep, Fp16BlendIsSweptOnTheGpu) {
 
 TEST(ReportSweep, Fp16OptionsAreSweptOnEveryBackend) {
   std::map<std::string, RenderOptions> swept;
-  for (const cli::SweepConfig& c : cli::sweep_configs()) {
+  for (const cli::SweepConfig& c : cli::sweep_configs(SplatKernel::classic())) {
     if ((!c.options.fp16_sh && !c.options.fp16_shape) || c.options.fp16_blend) continue;
     EXPECT_EQ(c.group, "precision");
     EXPECT_FALSE(c.gpu_only);
@@ -264,6 +266,55 @@ TEST(ReportSweep, Fp16OptionsAreSweptOnEveryBackend) {
   EXPECT_EQ(swept["fp16-sh"], sh);
   EXPECT_EQ(swept["fp16-shape"], shape);
   EXPECT_EQ(swept["fp16-all"], all);
+}
+
+
+// The kernel: classic by default for both algorithms, named in the label when it is not,
+// part of equality, parsed strictly from what users type.
+TEST(SplatKernelOption, ParsedStrictlyAndNamedInTheLabel) {
+  EXPECT_EQ(RenderOptions{}.kernel, SplatKernel::classic());
+  EXPECT_EQ(RenderOptions::baseline().kernel, SplatKernel::classic());
+  EXPECT_EQ(parse_splat_kernel("classic", "--kernel"), SplatKernel::classic());
+  EXPECT_EQ(parse_splat_kernel("antialiased", "--kernel"), SplatKernel::antialiased(0.3f));
+  EXPECT_EQ(parse_splat_kernel("antialiased=0.1", "--kernel"), SplatKernel::antialiased(0.1f));
+  for (const char* bad : {"", "Classic", "antialiased=", "antialiased=0", "antialiased=-0.1", "antialiased=nan",
+                          "antialiased=inf", "antialiased= 0.1", "antialiased=0.1x", "antialiased=17", "mip"}) {
+    try {
+      parse_splat_kernel(bad, "--kernel");
+      ADD_FAILURE() << "accepted \"" << bad << "\"";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--kernel \"", 0), 0u) << e.what();
+    }
+  }
+  // spec() reads back as the same kernel.
+  for (const SplatKernel& k : {SplatKernel::classic(), SplatKernel::antialiased(), SplatKernel::antialiased(0.1f),
+                               SplatKernel::antialiased(1.25f)})
+    EXPECT_EQ(parse_splat_kernel(k.spec(), "--kernel"), k) << k.spec();
+  RenderOptions aa;
+  aa.kernel = SplatKernel::antialiased(0.1f);
+  EXPECT_EQ(aa.label(), "flash-antialiased_0.1");
+  EXPECT_FALSE(aa == RenderOptions{});
+  aa.kernel = SplatKernel::antialiased();
+  EXPECT_EQ(aa.label(), "flash-antialiased");
+  EXPECT_FALSE(aa == RenderOptions{});
+  EXPECT_TRUE(aa.seen_by(Backend::cpu).kernel == aa.kernel);
+}
+
+// The report draws every configuration with the trained kernel, and each other kernel once.
+TEST(ReportSweep, KernelGroupHoldsTheOtherKernels) {
+  for (const SplatKernel& trained : {SplatKernel::classic(), SplatKernel::antialiased(0.1f)}) {
+    std::vector<SplatKernel> others;
+    for (const cli::SweepConfig& c : cli::sweep_configs(trained)) {
+      if (c.group != "kernel") {
+        EXPECT_EQ(c.options.kernel, trained) << c.name;
+        continue;
+      }
+      EXPECT_NE(c.options.kernel, trained) << c.name;
+      EXPECT_EQ(c.name, "kernel=" + c.options.kernel.spec());
+      others.push_back(c.options.kernel);
+    }
+    EXPECT_EQ(others.size(), 2u) << trained.spec();
+  }
 }
 
 }  // namespace

@@ -110,13 +110,107 @@ TEST(PlyLoad, BigEndianAndAsciiReadTheSameValues) {
 TEST(PlyLoad, NonFiniteAttributesDropTheGaussianAndAreCounted) {
   PlyBuilder b = PlyBuilder::inria(1, 6);
   b.vertices[0][b.index_of("x")] = NAN;
-  b.vertices[1][b.index_of("opacity")] = INFINITY;
+  b.vertices[1][b.index_of("opacity")] = NAN;
   b.vertices[2][b.index_of("f_rest_4")] = -INFINITY;
   b.vertices[3][b.index_of("scale_1")] = 100.0;  // exp(100) overflows float
   LoadReport report;
   const Scene s = parse(b.bytes(), &report);
   EXPECT_EQ(s.size(), 2u);
   EXPECT_EQ(report.dropped_non_finite, 4u);
+}
+
+// Converters write a logit of +inf for a quantised opacity of 255 (splat-transform) and -inf
+// for 0: opacity 1 and 0, not dropped Gaussians. NaN is still dropped.
+TEST(PlyLoad, InfiniteOpacityLogitsAreOpacityOneAndZero) {
+  for (const char* format : {"binary_little_endian", "ascii"}) {
+    PlyBuilder b = PlyBuilder::inria(0, 3);
+    b.format = format;
+    b.vertices[0][b.index_of("opacity")] = INFINITY;
+    b.vertices[1][b.index_of("opacity")] = -INFINITY;
+    b.vertices[2][b.index_of("opacity")] = NAN;
+    LoadReport report;
+    const Scene s = parse(b.bytes(), &report);
+    ASSERT_EQ(s.size(), 2u) << format;
+    EXPECT_EQ(s.opacities[0], 1.0f) << format;
+    EXPECT_EQ(s.opacities[1], 0.0f) << format;
+    EXPECT_EQ(report.dropped_non_finite, 1u) << format;
+  }
+}
+
+// The marks trainers leave in the header name the kernel; the last one wins; without one the
+// scene is classic and unmarked.
+TEST(PlyKernelMarks, HeaderCommentsNameTheKernel) {
+  struct Case {
+    std::vector<std::string> comments;
+    SplatKernel kernel;
+    const char* source_fragment;  // nullptr: unmarked
+  };
+  const Case cases[] = {
+      {{}, SplatKernel::classic(), nullptr},
+      {{"Vertical axis: y", "SH degree: 0"}, SplatKernel::classic(), nullptr},
+      {{"SplatRenderMode: mip"}, SplatKernel::antialiased(), "Brush"},
+      {{"SplatRenderMode: default"}, SplatKernel::classic(), "Brush"},
+      {{"antialiased 1"}, SplatKernel::antialiased(), "Postshot"},
+      {{"antialiased 0"}, SplatKernel::classic(), "Postshot"},
+      {{"antialiased 1", "SplatRenderMode: default"}, SplatKernel::classic(), "SplatRenderMode: default"},
+      {{"SplatRenderMode: mip", "antialias_epsilon 0.1"}, SplatKernel::antialiased(0.1f), "Brush"},
+      {{"antialias_epsilon 0.1"}, SplatKernel::classic(), nullptr},
+      {{"SplatRenderMode: 2dgs"}, SplatKernel::classic(), nullptr},
+  };
+  for (const Case& c : cases) {
+    PlyBuilder b = PlyBuilder::inria(0, 2);
+    b.comments = c.comments;
+    const Scene s = parse(b.bytes());
+    const std::string what = c.comments.empty() ? "(none)" : c.comments.front();
+    EXPECT_EQ(s.trained_kernel.kernel, c.kernel) << what << ": " << s.trained_kernel.kernel.spec();
+    EXPECT_EQ(s.trained_kernel.marked(), c.source_fragment != nullptr) << what;
+    if (c.source_fragment)
+      EXPECT_NE(s.trained_kernel.source.find(c.source_fragment), std::string::npos) << s.trained_kernel.source;
+  }
+}
+
+// Mip-Splatting's filter_3D: the scene is drawn with its 2D filter (eps 0.1), and the 3D filter
+// is fused at load: scale sqrt(s^2 + f^2), opacity times sqrt(prod s^2 / prod(s^2 + f^2)).
+TEST(PlyKernelMarks, Filter3dIsFusedAndNamesMipSplatting) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  b.properties.push_back({"float", "filter_3D"});
+  b.vertices[0].push_back(0.0);
+  b.vertices[1].push_back(0.05);
+  b.vertices[1][b.index_of("opacity")] = 0.0;  // opacity 0.5
+  b.vertices[1][b.index_of("scale_0")] = std::log(0.1);
+  b.vertices[1][b.index_of("scale_1")] = std::log(0.02);
+  b.vertices[1][b.index_of("scale_2")] = std::log(0.05);
+  LoadReport report;
+  const Scene s = parse(b.bytes(), &report);
+  EXPECT_EQ(s.trained_kernel.kernel, SplatKernel::antialiased(kMipSplattingEpsilon));
+  EXPECT_NE(s.trained_kernel.source.find("filter_3D"), std::string::npos);
+  EXPECT_EQ(report.ignored_properties, 3u) << "normals only: filter_3D is used";
+  // A zero filter leaves the Gaussian as it is.
+  EXPECT_FLOAT_EQ(s.scales[0], static_cast<float>(std::exp(-3.0)));
+  EXPECT_FLOAT_EQ(s.opacities[0], static_cast<float>(1.0 / (1.0 + std::exp(-1.0))));
+  const double f2 = 0.05 * 0.05, sq[3] = {0.01, 0.0004, 0.0025};
+  double ratio = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(s.scales[3 + k], std::sqrt(sq[k] + f2), 1e-7) << k;
+    ratio *= sq[k] / (sq[k] + f2);
+  }
+  EXPECT_NEAR(s.opacities[1], 0.5 * std::sqrt(ratio), 1e-7);
+}
+
+// What the writer marks reads back as the same kernel; an unmarked classic scene stays unmarked.
+TEST(PlyKernelMarks, WrittenMarksReadBack) {
+  const std::string path = (std::filesystem::path(FLASHGS_TEST_OUTPUT_DIR) / "kernel_marks.ply").string();
+  std::filesystem::create_directories(FLASHGS_TEST_OUTPUT_DIR);
+  Scene scene = parse(PlyBuilder::inria(1, 3).bytes());
+  for (const TrainedKernel& mark : {TrainedKernel{}, TrainedKernel{SplatKernel::classic(), "test"},
+                                    TrainedKernel{SplatKernel::antialiased(), "test"},
+                                    TrainedKernel{SplatKernel::antialiased(0.1f), "test"}}) {
+    scene.trained_kernel = mark;
+    save_ply(scene, path);
+    const Scene back = load_ply(path);
+    EXPECT_EQ(back.trained_kernel.kernel, mark.kernel) << mark.kernel.spec();
+    EXPECT_EQ(back.trained_kernel.marked(), mark.marked()) << mark.kernel.spec();
+  }
 }
 
 TEST(PlyLoad, ExtremeButFiniteValuesLoad) {

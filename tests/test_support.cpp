@@ -33,6 +33,11 @@ std::string shared_format_file(const std::string& file) {
   return std::filesystem::exists(path) ? path.string() : std::string();
 }
 
+std::vector<SplatKernel> kernels() {
+  return {SplatKernel::classic(), SplatKernel::antialiased(kGsplatAntialiasEpsilon),
+          SplatKernel::antialiased(kMipSplattingEpsilon)};
+}
+
 std::vector<std::string> shared_scene_names() {
   std::vector<std::string> names;
   for (const char* name : {"pc_biker", "pc_guitar", "v3dg_donut", "kacytran_try", "pc_playbot"})

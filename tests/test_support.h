@@ -45,6 +45,9 @@ std::string shared_scene_dir(const std::string& name);
 std::string shared_format_file(const std::string& file);
 // Names of the real scenes present (pc_biker, pc_guitar, ...); empty when none.
 std::vector<std::string> shared_scene_names();
+// The kernels every parity test covers: classic, gsplat's anti-aliased (eps 0.3) and
+// Mip-Splatting's (eps 0.1).
+std::vector<SplatKernel> kernels();
 // Loads (once per process) the scene and its cameras.
 std::shared_ptr<const Scene> load_shared_scene(const std::string& name);
 std::vector<Camera> load_shared_cameras(const std::string& name);

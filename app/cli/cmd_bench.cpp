@@ -41,6 +41,7 @@ struct BenchArgs {
   std::string frames = "queued";
   int copies = 1;  // --tile: the scene copied on a grid in memory (scale benchmarks)
   std::string json_path = "bench.json";
+  KernelOption kernel;  // applied to every configuration
 };
 
 double ms_since(std::chrono::steady_clock::time_point start) {
@@ -152,13 +153,17 @@ void run(const BenchArgs& args) {
   const std::string backend_name = probe->name();
   const bool queued = args.frames == "queued" && can_queue_frames(*probe);
   probe.reset();
-  const auto configs = select_configs(args.configs, cpu);
+  auto configs = select_configs(args.configs, cpu);
+  const SplatKernel kernel = args.kernel.resolve(*scene);
+  for (auto& config : configs) config.second.kernel = kernel;
 
   nlohmann::json out;
   out["scene"] = scene_path;
   out["copies"] = args.copies;
   out["gaussians"] = scene->size();
   out["sh_degree"] = scene->sh_degree;
+  out["kernel"] = kernel.spec();
+  out["kernel_from"] = args.kernel.chosen() ? "--kernel" : scene->trained_kernel.source;
   out["scene_bytes_host_layout"] = scene->byte_size();
   out["backend"] = backend_name;
   out["timing"] = cpu ? "wall clock per stage (CPU)" : "GPU time per stage from CUDA events; total = sum of stages";
@@ -168,8 +173,8 @@ void run(const BenchArgs& args) {
   out["repeat"] = args.repeat;
   out["results"] = nlohmann::json::array();
 
-  std::printf("%s: %zu Gaussians (SH degree %d) on %s; cameras", scene_path.c_str(), scene->size(), scene->sh_degree,
-              backend_name.c_str());
+  std::printf("%s: %zu Gaussians (SH degree %d, %s kernel) on %s; cameras", scene_path.c_str(), scene->size(),
+              scene->sh_degree, kernel.description().c_str(), backend_name.c_str());
   for (int id : camera_ids) std::printf(" %d", id);
   std::printf("; %d warm-up + %d timed frames each, %s; per-camera medians, then median (p95) over cameras\n",
               args.warmup, args.repeat,
@@ -336,6 +341,7 @@ void register_bench(CLI::App& app) {
   sub->add_option("--tile", args->copies, "render this many copies of the scene on a grid (scale runs)")
       ->check(CLI::Range(1, 4096));
   sub->add_option("--json,-o", args->json_path, "JSON output file");
+  args->kernel.add_to(sub);
   sub->callback([args] { run(*args); });
 }
 

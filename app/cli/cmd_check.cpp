@@ -24,7 +24,14 @@ struct CheckArgs {
   std::string csv;
   std::string images_dir;
   bool explain = false;
+  std::string kernel = "both";  // both, or one kernel
 };
+
+// The kernels --kernel names: classic and gsplat's anti-aliased one for "both".
+std::vector<SplatKernel> kernels_of(const std::string& text) {
+  if (text == "both") return {SplatKernel::classic(), SplatKernel::antialiased()};
+  return {parse_splat_kernel(text, "--kernel")};
+}
 
 struct Backend {
   std::string name;
@@ -45,7 +52,50 @@ std::vector<Backend> present_backends(const std::string& which) {
   return out;
 }
 
+// Case `c` with one kernel on every backend, both algorithms: prints its rows (and writes them to
+// `csv` and its images) and returns the failures.
+int check_case(const StressCase& c, const std::shared_ptr<const Scene>& scene, const SplatKernel& kernel,
+               std::vector<Backend>& backends, const CheckArgs& args, std::FILE* csv) {
+  const std::string& name = c.name;
+  int failures = 0;
+  const StressReference reference = render_stress_reference(c, kernel);
+  for (Backend& backend : backends) {
+    backend.renderer->set_scene(scene);
+    // On the CPU the image must also not depend on how the work is split: one thread too.
+    std::unique_ptr<Renderer> single;
+    if (backend.name == "cpu" && !c.huge) {
+      single = make_cpu_renderer(1);
+      single->set_scene(scene);
+    }
+    for (Algorithm algorithm : {Algorithm::flash, Algorithm::baseline}) {
+      std::vector<Image> images;
+      const StressResult r = run_stress_case(c, reference, *backend.renderer, backend.name, algorithm, single.get(),
+                                             args.images_dir.empty() || c.huge ? nullptr : &images, kernel);
+      failures += r.pass ? 0 : 1;
+      std::string result = r.pass ? "pass" : "FAIL " + r.why_failed;
+      if (!r.ran && r.pass) result = "pass (refused: " + r.error + ")";
+      std::printf("%-16s %-11s %-5s %-8s %7llu %11.3e %9.2e %6s %10llu %9.2f  %s\n", name.c_str(), r.kernel.c_str(),
+                  backend.name.c_str(), r.algorithm.c_str(), static_cast<unsigned long long>(r.non_finite),
+                  r.max_abs_error, r.bound, r.deterministic ? "yes" : "NO", static_cast<unsigned long long>(r.kv_pairs),
+                  r.milliseconds, result.c_str());
+      std::fflush(stdout);
+      if (csv)
+        std::fprintf(csv, "%s,%s,%s,%s,%d,%llu,%.6e,%.6e,%d,%llu,%.3f,%d,\"%s\"\n", name.c_str(), r.kernel.c_str(),
+                     backend.name.c_str(), r.algorithm.c_str(), r.ran ? 1 : 0, static_cast<unsigned long long>(r.non_finite),
+                     r.max_abs_error, r.bound, r.deterministic ? 1 : 0, static_cast<unsigned long long>(r.kv_pairs),
+                     r.milliseconds, r.pass ? 1 : 0, (r.why_failed + r.error).c_str());
+      for (std::size_t k = 0; k < images.size(); ++k)
+        write_image(images[k], args.images_dir + "/" + name + "_" + r.kernel + "_" + backend.name + "_" +
+                                   r.algorithm + "_cam" + std::to_string(k) + ".png");
+    }
+  }
+  std::printf("%-16s %-11s fp64 reference: %.2f s%s\n", name.c_str(), kernel.spec().c_str(), reference.seconds,
+              c.windows.empty() ? " (whole image)" : " (windows of the image)");
+  return failures;
+}
+
 int run(const CheckArgs& args) {
+  const std::vector<SplatKernel> kernels = kernels_of(args.kernel);
   // Output paths first: a failure after the cases have run would waste minutes.
   if (!args.csv.empty()) check_output_file("--csv", args.csv);
   if (!args.images_dir.empty()) check_output_folder("--images", args.images_dir);
@@ -60,10 +110,10 @@ int run(const CheckArgs& args) {
   if (!args.csv.empty()) {
     csv = std::fopen(args.csv.c_str(), "w");
     if (!csv) throw Error(args.csv + ": cannot open for writing");
-    std::fprintf(csv, "case,backend,algorithm,ran,nan_inf,max_abs_error,bound,deterministic,kv_pairs,ms,pass,note\n");
+    std::fprintf(csv, "case,kernel,backend,algorithm,ran,nan_inf,max_abs_error,bound,deterministic,kv_pairs,ms,pass,note\n");
   }
-  std::printf("%-16s %-5s %-8s %7s %11s %9s %6s %10s %9s  %s\n", "case", "back", "algo", "nan/inf", "max|err|",
-              "bound", "determ", "kv pairs", "ms", "result");
+  std::printf("%-16s %-11s %-5s %-8s %7s %11s %9s %6s %10s %9s  %s\n", "case", "kernel", "back", "algo", "nan/inf",
+              "max|err|", "bound", "determ", "kv pairs", "ms", "result");
   int failures = 0;
   std::vector<std::pair<std::string, std::string>> reasons;
   for (const std::string& name : names) {
@@ -74,40 +124,8 @@ int run(const CheckArgs& args) {
                   name.c_str(), c.scene.size(), report.vertices_in_file, report.dropped_non_finite,
                   report.repaired_zero_quaternion);
     auto scene = std::make_shared<const Scene>(c.scene);
-    const StressReference reference = render_stress_reference(c);
     reasons.push_back({name, c.bound_reason});
-    for (Backend& backend : backends) {
-      backend.renderer->set_scene(scene);
-      // On the CPU the image must also not depend on how the work is split: one thread too.
-      std::unique_ptr<Renderer> single;
-      if (backend.name == "cpu" && !c.huge) {
-        single = make_cpu_renderer(1);
-        single->set_scene(scene);
-      }
-      for (Algorithm algorithm : {Algorithm::flash, Algorithm::baseline}) {
-        std::vector<Image> images;
-        const StressResult r = run_stress_case(c, reference, *backend.renderer, backend.name, algorithm, single.get(),
-                                               args.images_dir.empty() || c.huge ? nullptr : &images);
-        failures += r.pass ? 0 : 1;
-        std::string result = r.pass ? "pass" : "FAIL " + r.why_failed;
-        if (!r.ran && r.pass) result = "pass (refused: " + r.error + ")";
-        std::printf("%-16s %-5s %-8s %7llu %11.3e %9.2e %6s %10llu %9.2f  %s\n", name.c_str(), backend.name.c_str(),
-                    r.algorithm.c_str(), static_cast<unsigned long long>(r.non_finite), r.max_abs_error, r.bound,
-                    r.deterministic ? "yes" : "NO", static_cast<unsigned long long>(r.kv_pairs), r.milliseconds,
-                    result.c_str());
-        std::fflush(stdout);
-        if (csv)
-          std::fprintf(csv, "%s,%s,%s,%d,%llu,%.6e,%.6e,%d,%llu,%.3f,%d,\"%s\"\n", name.c_str(), backend.name.c_str(),
-                       r.algorithm.c_str(), r.ran ? 1 : 0, static_cast<unsigned long long>(r.non_finite),
-                       r.max_abs_error, r.bound, r.deterministic ? 1 : 0, static_cast<unsigned long long>(r.kv_pairs),
-                       r.milliseconds, r.pass ? 1 : 0, (r.why_failed + r.error).c_str());
-        for (std::size_t k = 0; k < images.size(); ++k)
-          write_image(images[k], args.images_dir + "/" + name + "_" + backend.name + "_" + r.algorithm + "_cam" +
-                                     std::to_string(k) + ".png");
-      }
-    }
-    std::printf("%-16s fp64 reference: %.2f s%s\n", name.c_str(), reference.seconds,
-                c.windows.empty() ? " (whole image)" : " (windows of the image)");
+    for (const SplatKernel& kernel : kernels) failures += check_case(c, scene, kernel, backends, args, csv);
   }
   if (csv) std::fclose(csv);
   if (args.explain) {
@@ -131,6 +149,17 @@ void register_check(CLI::App& app) {
   sub->add_option("--csv", args->csv, "also write the table as CSV");
   sub->add_option("--images", args->images_dir, "write each rendered image (PNG) into this folder");
   sub->add_flag("--explain", args->explain, "print why each bound is what it is");
+  sub->add_option("--kernel", args->kernel, "both (classic and antialiased), or one: classic, antialiased[=EPS]")
+      ->check(CLI::Validator(
+          [](std::string& value) -> std::string {
+            try {
+              kernels_of(value);
+            } catch (const Error& e) {
+              return e.what();
+            }
+            return "";
+          },
+          "both|classic|antialiased[=EPS]", "KERNEL"));
   sub->callback([args] {
     const int failures = run(*args);
     if (failures) throw CLI::RuntimeError(1);

@@ -44,6 +44,12 @@ void run(const ConvertArgs& args) {
   if (write == save_splat && scene.sh_degree > 0)
     std::fprintf(stderr, "note: .splat has no SH bands; degree %d of %s is reduced to its base colour\n",
                  scene.sh_degree, input_file.c_str());
+  if (write == save_splat && scene.trained_kernel.kernel.compensates_opacity())
+    std::fprintf(stderr,
+                 "note: .splat cannot say which kernel a scene needs; %s is %s (from the %s): draw the .splat file "
+                 "with --kernel %s\n",
+                 input_file.c_str(), scene.trained_kernel.kernel.description().c_str(),
+                 scene.trained_kernel.source.c_str(), scene.trained_kernel.kernel.spec().c_str());
   write_atomically(args.output, [&](const std::string& path) { write(scene, path); });
   std::printf("read %s (%s, %zu Gaussians, SH degree %d, decoded in %.3f s), wrote %s\n", input_file.c_str(),
               report.format.c_str(), scene.size(), scene.sh_degree, report.decode_seconds, args.output.c_str());

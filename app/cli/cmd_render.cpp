@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "flashgs/image_io.h"
 #include "flashgs/io.h"
+#include "flashgs/scene_summary.h"
 #include "option_checks.h"
 #include "scene_source.h"
 #include "stats_format.h"
@@ -28,7 +29,7 @@ struct RenderCommand {
     check_frame_fits(*renderer, cam, loaded->size(),
                      camera.resolution.empty() ? "the camera's size" : "--resolution");
     renderer->set_scene(loaded);
-    const RenderOptions options = render.options();
+    const RenderOptions options = render.options(*loaded);
     Image image;
     FrameStats stats;
     for (int i = 0; i < repeat; ++i) renderer->render(cam, options, image, &stats);
@@ -36,6 +37,8 @@ struct RenderCommand {
     std::printf("%s: %zu Gaussians (SH degree %d), camera %d \"%s\" at %dx%d, %s on %s\n", scene_path.c_str(),
                 loaded->size(), loaded->sh_degree, camera.index, cam.name.c_str(), cam.width, cam.height,
                 options.label().c_str(), renderer->name().c_str());
+    std::printf("kernel: %s\n", render.kernel.chosen() ? (options.kernel.description() + " (--kernel)").c_str()
+                                                        : kernel_summary(loaded->trained_kernel).c_str());
     std::printf("%s", format_stats(stats).c_str());
     std::printf("wrote %s\n", output.c_str());
   }

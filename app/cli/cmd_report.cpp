@@ -20,6 +20,7 @@
 #include "flashgs/io.h"
 #include "flashgs/parse.h"
 #include "flashgs/reference_renderer.h"
+#include "flashgs/scene_summary.h"
 #include "option_checks.h"
 #include "report_plot.h"
 #include "report_sweep.h"
@@ -41,6 +42,7 @@ struct ReportArgs {
   std::string title;
   std::string replot;    // re-plot this report.csv instead of measuring
   std::string subtitle;  // for --replot
+  KernelOption kernel;   // the kernel every configuration but the kernel group's draws with
 };
 
 std::string cpu_model() {
@@ -175,7 +177,9 @@ void run(const ReportArgs& args) {
   frames.windows = {window_at(0.5, 0.5), window_at(0.35, 0.6), window_at(0.65, 0.4)};
   const std::size_t ref_cameras = std::min<std::size_t>(std::max(0, args.ref_cameras), frames.cameras.size());
   const auto ref_start = std::chrono::steady_clock::now();
+  const SplatKernel kernel = args.kernel.resolve(*scene);
   RenderOptions ref_options;
+  ref_options.kernel = kernel;
   for (std::size_t c = 0; c < ref_cameras; ++c) {
     std::vector<Image> per_window;
     for (const PixelWindow& w : frames.windows)
@@ -192,7 +196,7 @@ void run(const ReportArgs& args) {
     renderer->set_scene(scene);
     backend_names.push_back(name + ": " + renderer->name());
     const bool gpu = name == "cuda";
-    for (const SweepConfig& config : sweep_configs()) {
+    for (const SweepConfig& config : sweep_configs(kernel)) {
       if (config.gpu_only && !gpu) continue;  // the CPU ignores these switches
       const auto start = std::chrono::steady_clock::now();
       // A fresh backend per configuration: its buffers only grow, so the peak memory of one
@@ -247,7 +251,9 @@ void run(const ReportArgs& args) {
   std::string camera_text;
   for (int i : kept) camera_text += (camera_text.empty() ? "" : ", ") + std::to_string(i);
   md << "# flashgs report: " << title << "\n\n";
-  md << "- scene: `" << scene_path << "`, " << scene->size() << " Gaussians, SH degree " << scene->sh_degree << "\n";
+  md << "- scene: `" << scene_path << "`, " << scene->size() << " Gaussians, SH degree " << scene->sh_degree
+     << ", drawn with the " << kernel.description() << " kernel ("
+     << (args.kernel.chosen() ? std::string("--kernel") : kernel_summary(scene->trained_kernel)) << ")\n";
   md << "- cameras " << camera_text << " at " << width << "x" << height << "; per camera one warm-up frame, then "
      << args.repeat << " timed frames; time is the backend's FrameStats total (CPU: wall time of the stages)\n";
   md << "- host: " << cpu_model() << ", " << std::thread::hardware_concurrency() << " hardware threads\n";
@@ -318,6 +324,7 @@ void register_report(CLI::App& app) {
   sub->add_option("--title", args->title, "title of the table and plots (default: the scene's folder name)");
   sub->add_option("--replot", args->replot, "only redraw the SVG plot(s) from this report.csv (beside it)");
   sub->add_option("--subtitle", args->subtitle, "with --replot: the plot's second line");
+  args->kernel.add_to(sub);
   sub->callback([args] { run(*args); });
 }
 

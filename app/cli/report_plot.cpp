@@ -37,7 +37,8 @@ std::string escape(const std::string& text) {
 const char* group_colour(const std::string& group) {
   static const std::map<std::string, const char*> colours = {
       {"baseline", "#d62728"}, {"flash", "#1f77b4"},    {"alone", "#2ca02c"},       {"left out", "#ff7f0e"},
-      {"tau", "#9467bd"},      {"gpu alone", "#8c564b"}, {"gpu left out", "#e377c2"}, {"precision", "#17becf"}};
+      {"tau", "#9467bd"},      {"gpu alone", "#8c564b"}, {"gpu left out", "#e377c2"}, {"precision", "#17becf"},
+      {"kernel", "#bcbd22"}};
   auto it = colours.find(group);
   return it == colours.end() ? "#7f7f7f" : it->second;
 }

@@ -11,7 +11,7 @@
 
 namespace flashgs::cli {
 
-std::vector<SweepConfig> sweep_configs() {
+std::vector<SweepConfig> sweep_configs(const SplatKernel& trained) {
   std::vector<SweepConfig> out;
   out.push_back({"baseline", "baseline", RenderOptions::baseline(), false});
   out.push_back({"flash", "flash", RenderOptions{}, false});
@@ -46,7 +46,17 @@ std::vector<SweepConfig> sweep_configs() {
   // The half blend: a CUDA kernel (the CPU renders these exactly, so it skips their rows).
   for (const RenderOptions& o : fp16_blend_configs())
     out.push_back({o.fp16_sh ? "fp16-all-blend" : "fp16-blend", "precision", o, true});
+  // Not the scene's image: the error says how far drawing with another kernel moves it.
+  for (const SplatKernel& k : {SplatKernel::classic(), SplatKernel::antialiased(),
+                               SplatKernel::antialiased(kMipSplattingEpsilon)}) {
+    if (k == trained) continue;
+    RenderOptions o;
+    o.kernel = k;
+    out.push_back({"kernel=" + k.spec(), "kernel", o, false});
+  }
   add_group(gpu_only, "gpu-only-", "gpu alone", "gpu left out", true);
+  for (SweepConfig& c : out)
+    if (c.group != "kernel") c.options.kernel = trained;
   return out;
 }
 

@@ -16,15 +16,18 @@ namespace flashgs::cli {
 
 struct SweepConfig {
   std::string name;   // e.g. "flash", "only-tight_bbox", "no-exact_tile_test", "tau=1/32"
-  std::string group;  // baseline | flash | alone | left out | tau | precision | gpu alone | gpu left out
+  std::string group;  // baseline | flash | alone | left out | tau | precision | kernel | gpu alone | gpu left out
   RenderOptions options;
   bool gpu_only = false;  // a scheduling switch the CPU backend ignores: measured on CUDA only
 };
 
 // baseline; flash (everything on, default tau); each switch every backend honours alone and
 // each left out; tau = 1/128 ... 1/16; the SH, the shapes or both as halves (fp16-sh,
-// fp16-shape, fp16-all); and each GPU-only switch alone and left out.
-std::vector<SweepConfig> sweep_configs();
+// fp16-shape, fp16-all); flash with each other kernel (kernel=classic, kernel=antialiased,
+// kernel=antialiased=0.1: how far the image moves from the trained one); and each GPU-only
+// switch alone and left out. Every configuration but those of the kernel group draws with
+// `trained`, the kernel the scene was trained with.
+std::vector<SweepConfig> sweep_configs(const SplatKernel& trained);
 
 // Error of a set of images against another, pooled over cameras / windows.
 struct ErrorSummary {

@@ -99,6 +99,7 @@ std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod
 void RenderArgs::add_to(CLI::App* command) {
   command->add_option("--algorithm,-a", algorithm, "flash or baseline")->check(CLI::IsMember({"flash", "baseline"}));
   switches.add_to(command);
+  kernel.add_to(command);
   command->add_option("--tau", tau, "alpha threshold of the opacity-aware extent")->check(finite_in(1e-6, 0.99));
   command->add_option("--background", background, "background colour r,g,b in [0, 1]")
       ->delimiter(',')->expected(3)->check(finite_in(0.0, 1.0));
@@ -111,9 +112,10 @@ void RenderArgs::add_to(CLI::App* command) {
   command->add_option("--backend", backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
 }
 
-RenderOptions RenderArgs::options() const {
+RenderOptions RenderArgs::options(const Scene& scene) const {
   RenderOptions o = algorithm == "baseline" ? RenderOptions::baseline() : RenderOptions{};
   if (algorithm != "baseline") switches.apply(&o);
+  o.kernel = kernel.resolve(scene);
   o.tau = tau;
   for (int k = 0; k < 3; ++k) o.background[k] = background[k];
   o.sh_degree_cap = sh_degree;

@@ -11,6 +11,7 @@
 #include "flashgs/io.h"
 #include "flashgs/options.h"
 #include "flashgs/scene.h"
+#include "kernel_option.h"
 #include "switch_flags.h"
 
 namespace flashgs::cli {
@@ -43,6 +44,7 @@ std::string describe_lod_levels(const std::string& path);
 struct RenderArgs {
   std::string algorithm = "flash";
   SwitchFlags switches;
+  KernelOption kernel;
   float tau = kDefaultTau;
   std::vector<float> background = {0, 0, 0};
   int sh_degree = 3;
@@ -51,7 +53,8 @@ struct RenderArgs {
   bool fp16_blend = false;
   std::string backend = "auto";
   void add_to(CLI::App* command);
-  RenderOptions options() const;
+  // The options these flags give for `scene` (whose trained kernel --kernel auto takes).
+  RenderOptions options(const Scene& scene) const;
 };
 
 // The largest |coordinate| --eye, --look-at and --up accept (float range).

@@ -406,16 +406,16 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
       // w' = sqrt(log2(e) / 2) w, so o e^(-q/2) = exp2(log2 o - (u'^2 + v'^2)): one exp2.
       const float hs = sqrtf(0.5f * kLog2e);
       out[0] = make_float4(f.mean_x, f.mean_y, hs * f.whiten[0], hs * f.whiten[1]);
-      out[1] = make_float4(hs * f.whiten[2], hs * f.whiten[3], log2f(g.opacity), rgb[0]);
+      out[1] = make_float4(hs * f.whiten[2], hs * f.whiten[3], log2f(f.opacity), rgb[0]);
     } else {
       out[0] = make_float4(f.mean_x, f.mean_y, f.whiten[0], f.whiten[1]);
-      out[1] = make_float4(f.whiten[2], f.whiten[3], g.opacity, rgb[0]);
+      out[1] = make_float4(f.whiten[2], f.whiten[3], f.opacity, rgb[0]);
     }
     // Rows farther than reach_y from the centre have q > 2 ln(255 o), i.e. alpha < 1/255
     // (min over dx of q at offset dy is dy^2 / Sigma_yy); the margins cover rounding, so
     // the blend may skip them without changing a pixel.
     const float det_w = f.whiten[0] * f.whiten[3] - f.whiten[1] * f.whiten[2];
-    const float q_cut = 2.0f * logf(255.0f * g.opacity) + 0.01f;
+    const float q_cut = 2.0f * logf(255.0f * f.opacity) + 0.01f;
     const float conic_a = f.whiten[0] * f.whiten[0] + f.whiten[2] * f.whiten[2];
     float reach_y = q_cut > 0.0f ? sqrtf(q_cut * conic_a) / fabsf(det_w) + 0.01f : -1.0f;
     if (!(reach_y < 1e30f) && q_cut > 0.0f) reach_y = 1e30f;  // degenerate: never skip

@@ -12,6 +12,7 @@
 #include "flashgs/error.h"
 #include "flashgs/model_constants.h"
 #include "format_readers.h"
+#include "kernel_marks.h"
 #include "ply_header.h"
 
 namespace flashgs {
@@ -168,6 +169,7 @@ Scene parse_compressed_ply(const char* data, std::size_t size, const std::string
   const unsigned char* sh_data = vertex_data + count * 16;
   Scene scene;
   scene.sh_degree = sh_degree;
+  scene.trained_kernel = kernel_from_ply_comments(header.comments);
   report.sh_degree_in_file = sh_degree;
   report.vertices_in_file = count;
   scene.reserve(count);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -112,6 +113,27 @@ struct SceneArrays {
   const float* rest;       // [count][rest_n]
   int rest_n;
 };
+
+// BlendGaussian's opacity-only terms of an opacity: log2_opacity, and q_cut (power_cut = -q_cut / 2
+// exactly, with a margin below alpha = 1/255).
+inline void opacity_terms(float opacity, float& log2_opacity, float& q_cut) {
+  const float power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
+  log2_opacity = std::log2(opacity);
+  q_cut = -2.0f * power_cut;
+}
+
+// BlendGaussian's opacity and its terms for visible Gaussian `i` drawn at `opacity`
+// (Footprint::opacity): the per-scene cache where that is the scene's opacity (the classic
+// kernel), else computed here (the anti-aliased kernel's opacity depends on the view).
+inline void set_opacity_terms(const Frame& frame, std::int64_t i, float opacity, BlendGaussian& g) {
+  g.opacity = opacity;
+  if (frame.geometry.compensate_opacity) {
+    opacity_terms(opacity, g.log2_opacity, g.q_cut);
+  } else {
+    g.log2_opacity = frame.log2_opacity[i];
+    g.q_cut = frame.q_cut[i];
+  }
+}
 
 // Which kernel projects: both give the same bytes (the SIMD one runs gm::project's operations
 // per lane, in its order); the scalar one is the reference the tests compare with.

@@ -24,17 +24,15 @@ void project_range(const SceneArrays& scene, Frame& frame, std::int64_t begin, s
     g.mean_x = f.mean_x;
     g.mean_y = f.mean_y;
     for (int k = 0; k < 4; ++k) g.whiten[k] = f.whiten[k];
-    g.opacity = opacity;
-    g.log2_opacity = frame.log2_opacity[i];
-    g.q_cut = frame.q_cut[i];
+    set_opacity_terms(frame, i, f.opacity, g);
     set_row_pruning(g);
     gm::sh_to_rgb<DEGREE>(frame.camera.position, &scene.positions[i * 3], scene.dc + i * 3,
                           DEGREE > 0 ? scene.rest + i * scene.rest_n : nullptr, g.rgb);
   }
 }
 
-// log2_opacity and q_cut depend on the opacity alone: computed once per scene (and precision),
-// not per frame.
+// log2_opacity and q_cut depend on the opacity alone: under the classic kernel computed once
+// per scene (and precision), not per frame.
 void cache_opacity_terms(const SceneArrays& scene, Frame& frame) {
   const std::size_t n = static_cast<std::size_t>(scene.count);
   if (frame.opacity_terms_of == scene.opacities && frame.opacity_terms_size == n) return;
@@ -42,10 +40,7 @@ void cache_opacity_terms(const SceneArrays& scene, Frame& frame) {
   frame.q_cut.resize(n);
 #pragma omp parallel for schedule(static) num_threads(frame.threads)
   for (std::int64_t i = 0; i < scene.count; ++i) {
-    const float opacity = scene.opacities[i];
-    const float power_cut = opacity > 0 ? std::log(gm::kAlphaMin / opacity) - 1e-3f : 0.0f;
-    frame.log2_opacity[i] = std::log2(opacity);
-    frame.q_cut[i] = -2.0f * power_cut;  // exact: power_cut = -0.5 q_cut
+    opacity_terms(scene.opacities[i], frame.log2_opacity[i], frame.q_cut[i]);
   }
   frame.opacity_terms_of = scene.opacities;
   frame.opacity_terms_size = n;

@@ -93,7 +93,7 @@ struct Lanes {
   static constexpr std::size_t kMax = HWY_MAX_BYTES / sizeof(float);
   HWY_ALIGN std::int32_t reason[kMax];
   HWY_ALIGN std::int32_t tile_x0[kMax], tile_y0[kMax], tile_x1[kMax], tile_y1[kMax];
-  HWY_ALIGN float mean_x[kMax], mean_y[kMax], depth[kMax], threshold[kMax];
+  HWY_ALIGN float mean_x[kMax], mean_y[kMax], depth[kMax], threshold[kMax], opacity[kMax];
   HWY_ALIGN float conic_a[kMax], conic_b[kMax], conic_c[kMax];
   HWY_ALIGN float w0[kMax], w1[kMax], w2[kMax], w3[kMax];
   HWY_ALIGN float edge_slope_x[kMax], edge_slope_y[kMax];
@@ -151,9 +151,6 @@ bool project_vector(const SceneArrays& scene, const Frame& frame, std::int64_t i
     return false;
   }
 
-  const FloatVec threshold =
-      kOpacityRadius ? hn::Mul(hn::Set(d, 2.0f), portable_log(hn::Div(opacity, hn::Set(d, frame.geometry.tau))))
-                     : hn::Set(d, gm::kBaselineSigmas * gm::kBaselineSigmas);
   const FloatVec inv_z = hn::Div(hn::Set(d, 1.0f), v2);
   const FloatVec fx = hn::Set(d, cam.fx), fy = hn::Set(d, cam.fy);
   const FloatVec mean_x = hn::Add(hn::Mul(hn::Mul(fx, v0), inv_z), hn::Set(d, cam.cx));
@@ -197,14 +194,24 @@ bool project_vector(const SceneArrays& scene, const Frame& frame, std::int64_t i
   const FloatVec minor12 = hn::Sub(hn::Mul(m0[1], m1[2]), hn::Mul(m0[2], m1[1]));
   const FloatVec det = dot3(minor01, minor02, minor12, minor01, minor02, minor12);
 
-  const FloatVec dilation = hn::Set(d, gm::kDilation), zero = hn::Zero(d), half = hn::Set(d, 0.5f);
+  const gm::GeometryParams& geo = frame.geometry;
+  const FloatVec dilation = hn::Set(d, geo.dilation), zero = hn::Zero(d), half = hn::Set(d, 0.5f);
   const FloatVec ad = hn::Add(a, dilation), cd = hn::Add(c, dilation);
   const FloatVec det_d =
-      hn::Add(hn::Add(det, hn::Mul(dilation, hn::Add(a, c))), hn::Set(d, gm::kDilation * gm::kDilation));
+      hn::Add(hn::Add(det, hn::Mul(dilation, hn::Add(a, c))), hn::Set(d, geo.dilation * geo.dilation));
   const FloatMask well_formed = hn::And(
       hn::And(hn::And(is_finite(mean_x), is_finite(mean_y)), hn::And(is_finite(ad), is_finite(cd))),
       hn::And(hn::And(is_finite(b), is_finite(det_d)), hn::Gt(det_d, zero)));
   cull.cull_where(hn::Not(well_formed), gm::kCulledDegenerate);
+  // gm::project's drawn opacity and extent (the raw opacity's where the drawn one is below tau).
+  const FloatVec tau = hn::Set(d, geo.tau);
+  const FloatVec drawn_opacity =
+      geo.compensate_opacity ? hn::Mul(opacity, hn::Sqrt(hn::Div(det, det_d))) : opacity;
+  const FloatMask drawn_visible = hn::Ge(drawn_opacity, tau);
+  const FloatVec threshold =
+      kOpacityRadius
+          ? hn::Mul(hn::Set(d, 2.0f), portable_log(hn::Div(hn::IfThenElse(drawn_visible, drawn_opacity, opacity), tau)))
+          : hn::Set(d, gm::kBaselineSigmas * gm::kBaselineSigmas);
   // The eigen-decomposition (see gm::project).
   const FloatVec half_diff = hn::Mul(half, hn::Sub(ad, cd));
   const FloatVec spread = hn::Add(hn::Mul(half_diff, half_diff), hn::Mul(b, b));
@@ -267,6 +274,7 @@ bool project_vector(const SceneArrays& scene, const Frame& frame, std::int64_t i
     tile_y1 = hn::Add(hn::ShiftRight<4>(hn::ConvertTo(di, py1)), one_tile);
   }
   cull.cull_where(hn::Not(hn::And(hn::Lt(tile_x0, tile_x1), hn::Lt(tile_y0, tile_y1))), gm::kCulledOffscreen);
+  if (kOpacityRadius) cull.cull_where(hn::Not(drawn_visible), gm::kCulledLowOpacity);
   hn::Store(cull.reasons(), di, out.reason);
   if (cull.none_left()) return false;
 
@@ -281,6 +289,7 @@ bool project_vector(const SceneArrays& scene, const Frame& frame, std::int64_t i
   hn::Store(mean_y, d, out.mean_y);
   hn::Store(v2, d, out.depth);
   hn::Store(threshold, d, out.threshold);
+  hn::Store(drawn_opacity, d, out.opacity);
   hn::Store(conic_a, d, out.conic_a);
   hn::Store(conic_b, d, out.conic_b);
   hn::Store(conic_c, d, out.conic_c);
@@ -369,6 +378,7 @@ void store_lanes(const SceneArrays& scene, Frame& frame, std::int64_t i,
     f.conic_b = v.conic_b[l];
     f.conic_c = v.conic_c[l];
     f.threshold = v.threshold[l];
+    f.opacity = v.opacity[l];
     f.tile_x0 = v.tile_x0[l];
     f.tile_y0 = v.tile_y0[l];
     f.tile_x1 = v.tile_x1[l];
@@ -383,12 +393,10 @@ void store_lanes(const SceneArrays& scene, Frame& frame, std::int64_t i,
     g.mean_x = f.mean_x;
     g.mean_y = f.mean_y;
     for (int k = 0; k < 4; ++k) g.whiten[k] = f.whiten[k];
-    g.opacity = scene.opacities[id];
     HWY_ALIGN float rgb[4];
     sh_sums<DEGREE>(scene.dc + id * 3, DEGREE > 0 ? scene.rest + id * rest_n : nullptr, v, l, rgb);
     for (int ch = 0; ch < 3; ++ch) g.rgb[ch] = rgb[ch];
-    g.log2_opacity = frame.log2_opacity[id];
-    g.q_cut = frame.q_cut[id];
+    set_opacity_terms(frame, id, f.opacity, g);
     set_row_pruning(g);  // in double, per visible Gaussian
   }
 }

@@ -25,6 +25,8 @@ gm::GeometryParams make_geometry_params(const RenderOptions& options) {
   g.opacity_radius = options.uses_opacity_radius();
   g.tight_bbox = options.uses_tight_bbox();
   g.tau = options.tau;
+  g.dilation = options.kernel.epsilon;
+  g.compensate_opacity = options.kernel.compensates_opacity();
   return g;
 }
 

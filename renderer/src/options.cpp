@@ -21,6 +21,11 @@ std::string RenderOptions::label() const {
   if (!is_baseline())
     for (const RenderSwitch& s : kRenderSwitches)
       if (!(this->*(s.member))) label += std::string("-no_") + s.label;
+  if (kernel.mode != KernelMode::classic) {  // "-antialiased", "-antialiased_0.1": a file-name token
+    std::string token = kernel.spec();
+    std::replace(token.begin(), token.end(), '=', '_');
+    label += "-" + token;
+  }
   if (fp16_sh) label += "-fp16_sh";
   if (fp16_shape) label += "-fp16_shape";
   if (fp16_blend) label += "-fp16_blend";
@@ -39,7 +44,7 @@ RenderOptions RenderOptions::seen_by(Backend backend) const {
 bool operator==(const RenderOptions& a, const RenderOptions& b) {
   for (const RenderSwitch& s : kRenderSwitches)
     if (a.*(s.member) != b.*(s.member)) return false;
-  return a.algorithm == b.algorithm && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
+  return a.algorithm == b.algorithm && a.kernel == b.kernel && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
          a.fp16_sh == b.fp16_sh && a.fp16_shape == b.fp16_shape &&
          a.fp16_blend == b.fp16_blend &&
          a.collect_tile_counts == b.collect_tile_counts && std::equal(a.background, a.background + 3, b.background);

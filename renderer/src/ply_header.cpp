@@ -80,7 +80,10 @@ Header parse_header(const char* data, std::size_t size, const std::string& name)
       else if (format == "ascii") header.format = Format::ascii;
       else fail(name, "unknown PLY format " + quoted(format));
       saw_format = true;
-    } else if (keyword == "comment" || keyword == "obj_info" || keyword.empty()) {
+    } else if (keyword == "comment") {
+      const std::size_t text = line.find_first_not_of(" \t", line.find("comment") + 7);
+      header.comments.push_back(text == std::string::npos ? std::string() : line.substr(text));
+    } else if (keyword == "obj_info" || keyword.empty()) {
       continue;
     } else if (keyword == "element") {
       Element element;

@@ -36,6 +36,7 @@ struct Header {
   Format format = Format::binary_little_endian;
   std::vector<Element> elements;
   std::size_t data_offset = 0;  // first byte after "end_header\n"
+  std::vector<std::string> comments;  // the text after "comment ", in header order (trainers' marks)
 };
 
 // Throws flashgs::Error naming `name` and the problem for anything that is not a complete

@@ -16,6 +16,7 @@
 #include "flashgs/file_access.h"
 #include "flashgs/io.h"
 #include "format_readers.h"
+#include "kernel_marks.h"
 #include "ply_header.h"
 
 namespace flashgs {
@@ -33,6 +34,7 @@ struct Layout {
   int scale[3] = {-1, -1, -1};
   int rot[4] = {-1, -1, -1, -1};
   int dc[3] = {-1, -1, -1};
+  int filter_3d = -1;     // Mip-Splatting's 3D filter (a standard deviation per Gaussian), if present
   std::vector<int> rest;  // f_rest_0 .. f_rest_{n-1}
   int sh_degree = 0;
 };
@@ -48,6 +50,7 @@ Layout find_layout(const Element& vertex, const std::string& name, LoadReport* r
     else if (p.name == "y") slot = &layout.y;
     else if (p.name == "z") slot = &layout.z;
     else if (p.name == "opacity") slot = &layout.opacity;
+    else if (p.name == "filter_3D") slot = &layout.filter_3d;
     else if (p.name.size() == 7 && p.name.compare(0, 6, "scale_") == 0 && p.name[6] >= '0' && p.name[6] <= '2')
       slot = &layout.scale[p.name[6] - '0'];
     else if (p.name.size() == 5 && p.name.compare(0, 4, "rot_") == 0 && p.name[4] >= '0' && p.name[4] <= '3')
@@ -301,6 +304,21 @@ std::unique_ptr<RecordSource> binary_source(const Header& header, std::size_t ve
   return std::make_unique<BinarySource>(start + offset, vertex, swap);
 }
 
+// Mip-Splatting's 3D filter fused into the Gaussian, as its exporter does: each scale becomes
+// sqrt(s^2 + f^2), and the opacity is scaled by sqrt(prod s^2 / prod(s^2 + f^2)) so that the
+// Gaussian keeps its integral.
+void apply_3d_filter(double filter, DecodedGaussian& g) {
+  const double f2 = filter * filter;
+  if (f2 == 0.0) return;  // no filter (and a zero scale keeps its opacity)
+  double ratio = 1.0;
+  for (double& scale : g.scale) {
+    const double s2 = scale * scale;
+    ratio *= s2 / (s2 + f2);
+    scale = std::sqrt(s2 + f2);
+  }
+  g.opacity *= std::sqrt(ratio);
+}
+
 }  // namespace
 
 Scene parse_ply(const char* data, std::size_t size, const std::string& name, LoadReport* report,
@@ -340,6 +358,7 @@ Scene parse_ply(const char* data, std::size_t size, const std::string& name, Loa
 
   Scene scene;
   scene.sh_degree = layout.sh_degree;
+  scene.trained_kernel = layout.filter_3d >= 0 ? mip_splatting_kernel() : kernel_from_ply_comments(header.comments);
   report->sh_degree_in_file = layout.sh_degree;
   report->vertices_in_file = vertex.count;
   scene.reserve(vertex.count);
@@ -359,8 +378,11 @@ Scene parse_ply(const char* data, std::size_t size, const std::string& name, Loa
       g.sh_dc[k] = values[layout.dc[k]];
     }
     for (int k = 0; k < 4; ++k) g.rotation[k] = values[layout.rot[k]];
+    // A logit of +inf or -inf is opacity 1 or 0 (splat-transform writes +inf for a quantised 255);
+    // NaN stays NaN and the Gaussian is dropped.
     const double opacity_logit = values[layout.opacity];
-    g.opacity = std::isfinite(opacity_logit) ? 1.0 / (1.0 + std::exp(-opacity_logit)) : NAN;
+    g.opacity = std::isnan(opacity_logit) ? NAN : 1.0 / (1.0 + std::exp(-opacity_logit));
+    if (layout.filter_3d >= 0) apply_3d_filter(values[layout.filter_3d], g);
     // INRIA stores f_rest channel-major (all R, then G, then B); we keep [k][channel].
     for (int k = 0; k < per_channel; ++k)
       for (int ch = 0; ch < 3; ++ch) rest[k * 3 + ch] = static_cast<float>(values[layout.rest[ch * per_channel + k]]);

@@ -7,6 +7,7 @@
 
 #include "flashgs/error.h"
 #include "flashgs/io.h"
+#include "kernel_marks.h"
 
 namespace flashgs {
 
@@ -15,7 +16,9 @@ void save_ply(const Scene& scene, const std::string& path) {
   if (!file) throw Error(path + ": cannot open for writing");
   const int rest_n = scene.sh_rest_per_gaussian();
   const int per_channel = rest_n / 3;
-  file << "ply\nformat binary_little_endian 1.0\nelement vertex " << scene.size() << "\n";
+  file << "ply\nformat binary_little_endian 1.0\n";
+  for (const std::string& comment : ply_comments_for(scene.trained_kernel)) file << "comment " << comment << "\n";
+  file << "element vertex " << scene.size() << "\n";
   for (const char* p : {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"})
     file << "property float " << p << "\n";
   for (int k = 0; k < rest_n; ++k) file << "property float f_rest_" << k << "\n";

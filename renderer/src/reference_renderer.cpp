@@ -18,7 +18,6 @@ namespace {
 // z = 0.2f (= 0.2000000030) was culled by the backends and drawn by the reference, and two
 // alpha = 0.99 layers ((1 - 0.99)^2 = 1e-4, the stop threshold) stopped on opposite sides.
 constexpr double kNearZ = gm::kNearZ;
-constexpr double kDilation = gm::kDilation;
 constexpr double kAlphaMax = gm::kAlphaMax;
 constexpr double kAlphaMin = gm::kAlphaMin;
 constexpr double kTransmittanceMin = gm::kTransmittanceMin;
@@ -111,6 +110,9 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
   if (window.width < 0) window.width = camera.width;
   if (window.height < 0) window.height = camera.height;
   const int degree = std::max(0, std::min(scene.sh_degree, options.sh_degree_cap));
+  // The kernel's dilation, the float value the backends add, held exactly.
+  const double dilation = options.kernel.epsilon;
+  const bool compensate = options.kernel.compensates_opacity();
   double rot[9], centre[3];
   for (int k = 0; k < 9; ++k) rot[k] = camera.rotation[k];
   for (int k = 0; k < 3; ++k) centre[k] = camera.position[k];
@@ -121,8 +123,8 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
     for (int k = 0; k < 3; ++k) d[k] = static_cast<double>(scene.positions[i * 3 + k]) - centre[k];
     for (int r = 0; r < 3; ++r) v[r] = rot[r * 3] * d[0] + rot[r * 3 + 1] * d[1] + rot[r * 3 + 2] * d[2];
     if (!(v[2] > kNearZ)) continue;
-    const double opacity = scene.opacities[i];
-    if (!(opacity >= kAlphaMin)) continue;  // alpha <= opacity can never reach 1/255
+    const double raw_opacity = scene.opacities[i];
+    if (!(raw_opacity >= kAlphaMin)) continue;  // alpha <= opacity can never reach 1/255
     // Sigma_2D = M M^T, M = J W R S (double precision throughout).
     const double qw = scene.rotations[i * 4], qx = scene.rotations[i * 4 + 1],
                  qy = scene.rotations[i * 4 + 2], qz = scene.rotations[i * 4 + 3];
@@ -149,13 +151,16 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
       m0[k] = t0[0] * ax + t0[1] * ay + t0[2] * az;
       m1[k] = t1[0] * ax + t1[1] * ay + t1[2] * az;
     }
-    const double a = m0[0] * m0[0] + m0[1] * m0[1] + m0[2] * m0[2] + kDilation;
+    const double a = m0[0] * m0[0] + m0[1] * m0[1] + m0[2] * m0[2] + dilation;
     const double b = m0[0] * m1[0] + m0[1] * m1[1] + m0[2] * m1[2];
-    const double c = m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2] + kDilation;
+    const double c = m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2] + dilation;
     const double n01 = m0[0] * m1[1] - m0[1] * m1[0], n02 = m0[0] * m1[2] - m0[2] * m1[0],
                  n12 = m0[1] * m1[2] - m0[2] * m1[1];
-    const double det = n01 * n01 + n02 * n02 + n12 * n12 + kDilation * (a + c - 2 * kDilation) + kDilation * kDilation;
+    const double det_undilated = n01 * n01 + n02 * n02 + n12 * n12;
+    const double det = det_undilated + dilation * (a + c - 2 * dilation) + dilation * dilation;
     if (!std::isfinite(det) || !(det > 0) || !std::isfinite(a) || !std::isfinite(c)) continue;
+    // The anti-aliased kernel's opacity (gm::project): the integral of the undilated Gaussian kept.
+    const double opacity = compensate ? raw_opacity * std::sqrt(det_undilated / det) : raw_opacity;
     // The backends cull (FrameStats::culled_degenerate) a footprint whose covariance squared
     // leaves float range (screen sigma above ~4e9 px, e.g. a log-scale of 50 in a file): it
     // is not representable there. The reference applies the same documented rule, so that it

@@ -24,6 +24,10 @@ std::string quantiles(std::vector<float> values) {
 
 }  // namespace
 
+std::string kernel_summary(const TrainedKernel& kernel) {
+  return kernel.kernel.description() + " (" + (kernel.marked() ? "from the " + kernel.source : "no mark in the file") + ")";
+}
+
 std::string summarize_scene(const Scene& scene, const LoadReport* report) {
   std::ostringstream out;
   const std::size_t n = scene.size();
@@ -39,6 +43,7 @@ std::string summarize_scene(const Scene& scene, const LoadReport* report) {
   out << "gaussians:       " << n << "\n";
   out << "sh degree:       " << scene.sh_degree << " (" << sh_coefficient_count(scene.sh_degree)
       << " coefficients per channel)\n";
+  out << "kernel:          " << kernel_summary(scene.trained_kernel) << "\n";
   out << "memory:          " << scene.byte_size() / 1e6 << " MB (" << scene.byte_size() / std::max<std::size_t>(n, 1)
       << " bytes per Gaussian)\n";
   float lo[3], hi[3];

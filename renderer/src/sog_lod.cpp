@@ -198,6 +198,7 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
                            std::to_string(scene.sh_degree) + ")");
     if (first) {
       scene.sh_degree = chunk.sh_degree;
+      scene.trained_kernel = chunk.trained_kernel;
       first = false;
     }
     total.sh_degree_in_file = std::max(total.sh_degree_in_file, chunk_report.sh_degree_in_file);

@@ -8,6 +8,7 @@
 
 #include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
+#include "kernel_marks.h"
 
 namespace flashgs {
 namespace {
@@ -111,6 +112,12 @@ SogMeta parse_sog_meta(const std::string& json_text, const std::string& name) {
   meta.sh0_codebook = codebook(sh0, "sh0", name);
   meta.sh0_file = files(sh0, "sh0", 1, name)[0];
 
+  if (root.contains("model") && !root.at("model").is_null()) {
+    const json& model = root.at("model");
+    if (!model.is_string() || !kernel_from_sog_model(model.get<std::string>(), meta.kernel))
+      fail(name, "meta.json's model " + printable_file_text(model.dump()) +
+                     " is not one this renderer draws (antialiased, mip, default or classic)");
+  }
   if (root.contains("shN") && !root.at("shN").is_null()) {
     const json& sh = root.at("shN");
     meta.sh_bands = static_cast<int>(whole_number(field(sh, "bands", "shN.", name), 1, 3, "shN.bands", name));

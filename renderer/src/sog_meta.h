@@ -30,6 +30,7 @@ struct SogMeta {
   std::size_t sh_palette_size = 0;
   std::vector<float> sh_codebook;
   std::array<std::string, 2> sh_files;  // centroids, labels
+  TrainedKernel kernel;  // from the optional "model" entry
 };
 
 // Throws flashgs::Error "<name>: ..." for invalid JSON, another version, a missing or

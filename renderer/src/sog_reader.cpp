@@ -149,6 +149,7 @@ Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const 
 
   Scene scene;
   scene.sh_degree = meta.sh_bands;
+  scene.trained_kernel = meta.kernel;
   scene.reserve(n);
   if (progress) progress->gaussians_total.store(n, std::memory_order_relaxed);
   const int rest = scene.sh_rest_per_gaussian();

@@ -13,6 +13,7 @@
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
 #include "flashgs/frame_memory.h"
+#include "kernel_marks.h"
 
 namespace flashgs {
 namespace {
@@ -201,6 +202,7 @@ Scene unpack(const Packed& packed, const Header& header, const std::string& name
   const double position_scale = std::ldexp(1.0, -header.fractional_bits);
   Scene scene;
   scene.sh_degree = degree;
+  scene.trained_kernel = kernel_from_spz_flags(header.flags);
   scene.reserve(n);
   if (progress) progress->gaussians_total.store(n, std::memory_order_relaxed);
   const auto& pos = packed.attribute[0];

@@ -26,10 +26,11 @@ bool bit_identical(const Image& a, const Image& b) {
 
 }  // namespace
 
-StressReference render_stress_reference(const StressCase& c) {
+StressReference render_stress_reference(const StressCase& c, const SplatKernel& kernel) {
   StressReference ref;
   const auto start = std::chrono::steady_clock::now();
-  RenderOptions options;  // the reference uses only the background and the SH cap
+  RenderOptions options;  // the reference uses only the background, the SH cap and the kernel
+  options.kernel = kernel;
   for (const Camera& camera : c.cameras)
     for (const PixelWindow& w : windows_of(c, camera)) ref.images.push_back(render_reference(c.scene, camera, options, w));
   ref.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -38,13 +39,15 @@ StressReference render_stress_reference(const StressCase& c) {
 
 StressResult run_stress_case(const StressCase& c, const StressReference& reference, Renderer& renderer,
                              const std::string& backend_name, Algorithm algorithm, Renderer* second,
-                             std::vector<Image>* keep_images) {
+                             std::vector<Image>* keep_images, const SplatKernel& kernel) {
   StressResult r;
   r.case_name = c.name;
   r.backend = backend_name;
   r.algorithm = algorithm_name(algorithm);
+  r.kernel = kernel.spec();
   r.bound = algorithm == Algorithm::baseline ? c.bound_baseline : c.bound_flash;
   RenderOptions options = algorithm == Algorithm::baseline ? RenderOptions::baseline() : RenderOptions{};
+  options.kernel = kernel;
   std::size_t ref_index = 0;
   try {
     for (const Camera& camera : c.cameras) {

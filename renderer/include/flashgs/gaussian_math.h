@@ -25,7 +25,6 @@ namespace gm {
 
 constexpr int kTileSize = 16;
 constexpr float kNearZ = 0.2f;           // 3DGS culls at view-space z <= 0.2
-constexpr float kDilation = 0.3f;        // added to the 2D covariance diagonal (3DGS)
 constexpr float kAlphaMax = 0.99f;       // alpha clamp (3DGS)
 constexpr float kAlphaMin = 1.0f / 255.0f;    // blend skips alpha below this
 constexpr float kTransmittanceMin = 1e-4f;    // stop once T would fall below this
@@ -48,6 +47,8 @@ struct GeometryParams {
   bool opacity_radius;       // extent sqrt(2 ln(o / tau)) instead of 3 sigma
   bool tight_bbox;           // per-axis half widths instead of a square
   float tau;
+  float dilation;            // px^2 added to the 2D covariance diagonal (SplatKernel::epsilon)
+  bool compensate_opacity;   // the anti-aliased kernel: opacity * sqrt(det S / det(S + dilation I))
 };
 
 enum CullReason : std::uint8_t {
@@ -63,6 +64,7 @@ constexpr int kCullReasonCount = 5;  // the values above, 0 .. 4: counters are i
 struct Footprint {
   float mean_x, mean_y;            // pixel-index coordinates (pixel centres are integers)
   float depth;                     // view-space z, > kNearZ
+  float opacity;                   // what the blend multiplies: the anti-aliased kernel's compensated one
   float conic_a, conic_b, conic_c; // inverse 2D covariance: q = a dx^2 + 2 b dx dy + c dy^2
   float threshold;                 // the ellipse is q <= threshold
   int tile_x0, tile_y0;            // first tile of the box
@@ -182,7 +184,7 @@ FLASHGS_HD CullReason cull_by_centre(const GeometryParams& geo, const float view
 // comes from Cauchy-Binet as a sum of squared 2x2 minors of M, never as a*c - b*b: for a
 // needle or pancake (scale ratios of 1e6 and more) a*c and b*b agree in every float digit
 // and their difference is noise, often negative. The dilated determinant
-// det + 0.3 (a + c) + 0.09 is then a sum of positive terms, so the conic stays finite and
+// det + e (a + c) + e^2 (e = geo.dilation) is then a sum of positive terms, so the conic stays finite and
 // positive definite for any finite input.
 FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo,
                               const float position[3], const float scale[3],
@@ -191,9 +193,6 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
   to_view(cam, position, v);
   const CullReason by_centre = cull_by_centre(geo, v, opacity);
   if (by_centre != kVisible) return by_centre;
-
-  float threshold = kBaselineSigmas * kBaselineSigmas;
-  if (geo.opacity_radius) threshold = 2.0f * portable_log(opacity / geo.tau);
 
   const float inv_z = 1.0f / v[2];
   const float mean_x = cam.fx * v[0] * inv_z + cam.cx;
@@ -228,11 +227,21 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
   const float minor12 = m0[1] * m1[2] - m0[2] * m1[1];
   const float det = minor01 * minor01 + minor02 * minor02 + minor12 * minor12;
 
-  const float ad = a + kDilation, cd = c + kDilation;
-  const float det_d = det + kDilation * (a + c) + kDilation * kDilation;
+  const float dilation = geo.dilation;
+  const float ad = a + dilation, cd = c + dilation;
+  const float det_d = det + dilation * (a + c) + dilation * dilation;
   if (!is_finite(mean_x) || !is_finite(mean_y) || !is_finite(ad) || !is_finite(cd) ||
       !is_finite(b) || !is_finite(det_d) || !(det_d > 0.0f))
     return kCulledDegenerate;
+  // The anti-aliased kernel keeps the Gaussian's integral: opacity * sqrt(det / det_d), both
+  // determinants sums of non-negative terms (a needle's compensation stays accurate).
+  const float drawn_opacity = geo.compensate_opacity ? opacity * sqrtf(det / det_d) : opacity;
+  // alpha = o e^(-q/2) >= tau <=> q <= 2 ln(o / tau), with the opacity the blend uses. A
+  // compensated opacity below tau is culled below, after the off-screen test, which then sees
+  // the raw opacity's extent (>= 0: cull_by_centre passed it): the CUDA chunk cull bounds
+  // that extent, so both name the same reason for every Gaussian.
+  float threshold = kBaselineSigmas * kBaselineSigmas;
+  if (geo.opacity_radius) threshold = 2.0f * portable_log((drawn_opacity >= geo.tau ? drawn_opacity : opacity) / geo.tau);
   // Eigen-decomposition of the dilated covariance [ad b; b cd], each step free of
   // cancellation: the largest eigenvalue as mid + root (a sum of non-negative terms), the
   // smallest as det / lambda_max (Vieta) rather than mid - root, which for a needle is the
@@ -295,8 +304,10 @@ FLASHGS_HD CullReason project(const CameraParams& cam, const GeometryParams& geo
     out.tile_y1 = static_cast<int>(py1) / kTileSize + 1;
   }
   if (out.tile_x0 >= out.tile_x1 || out.tile_y0 >= out.tile_y1) return kCulledOffscreen;
+  if (geo.opacity_radius && !(drawn_opacity >= geo.tau)) return kCulledLowOpacity;
 
   out.mean_x = mean_x;
+  out.opacity = drawn_opacity;
   out.mean_y = mean_y;
   out.depth = v[2];
   // The conic from the whitened rows (W^T W): consistent with them, and free of det_d,

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/splat_kernel.h"
+
 namespace flashgs {
 
 enum class Algorithm { baseline, flash };
@@ -32,6 +34,9 @@ struct RenderOptions {
   bool pipelined_blend = true;
   bool exp2_alpha = true;
 
+  // The footprint model: not an optimisation but part of the image (the scene's trained kernel
+  // by default where the CLI and the viewer set it; classic here). Both algorithms honour it.
+  SplatKernel kernel;
   float tau = kDefaultTau;    // alpha below which a Gaussian contributes nothing
   float background[3] = {0.0f, 0.0f, 0.0f};
   int sh_degree_cap = 3;      // use at most this many SH bands (0..3)
@@ -55,7 +60,7 @@ struct RenderOptions {
   bool uses_opacity_radius() const { return !is_baseline() && opacity_aware_radius; }
   bool uses_tight_bbox() const { return !is_baseline() && tight_bbox; }
   bool uses_exact_tile_test() const { return !is_baseline() && exact_tile_test; }
-  // A short label such as "flash", "baseline" or "flash-no_tight_bbox".
+  // A short label such as "flash", "baseline", "flash-no_tight_bbox" or "flash-antialiased".
   std::string label() const;
   // These options as `backend` renders them: each switch it does not honour is back at its
   // default, so that two option sets with the same image on that backend compare equal.

@@ -22,8 +22,9 @@ enum class ReferenceFootprint {
 
 // Renders in double precision with no tiles and no extent (unless `footprint` asks for 3DGS's
 // box): each pixel composites all Gaussians sorted by (depth, index) under the 3DGS rules
-// (near cull z <= 0.2, +0.3 dilation, alpha = min(0.99, o e^power), skip alpha < 1/255, stop
-// before T < 1e-4). Only options.background and options.sh_degree_cap are used. Cost is
+// (near cull z <= 0.2, the kernel's dilation and, anti-aliased, its opacity compensation, alpha =
+// min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4). Only options.background,
+// options.sh_degree_cap and options.kernel are used. Cost is
 // pixels x Gaussians, so meant for small scenes and crops (Gaussians that cannot reach alpha
 // 1/255 anywhere in the window are skipped exactly, with the same minimum-over-a-rectangle
 // test as the tile test).

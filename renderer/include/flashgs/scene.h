@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/splat_kernel.h"
+
 namespace flashgs {
 
 // Number of SH coefficients per colour channel for a degree (1, 4, 9, 16).
@@ -24,13 +26,17 @@ struct Scene {
   // Per Gaussian, (sh_coefficient_count(sh_degree) - 1) * 3 floats, coefficient-major:
   // [k][channel], k = 1..K-1. Empty for degree 0.
   std::vector<float> sh_rest;
+  // The kernel the file says the scene was trained with (classic and unmarked when it says
+  // nothing): what `--kernel auto` and the viewer draw it with.
+  TrainedKernel trained_kernel;
 
   std::size_t size() const { return opacities.size(); }
   int sh_rest_per_gaussian() const { return (sh_coefficient_count(sh_degree) - 1) * 3; }
   // Bytes of Gaussian data (what a backend has to keep resident).
   std::size_t byte_size() const;
   void reserve(std::size_t n);
-  // Appends every Gaussian of `other` (same SH degree required; throws otherwise).
+  // Appends every Gaussian of `other` (same SH degree required; throws otherwise); the trained
+  // kernel stays this scene's.
   void append(const Scene& other);
 };
 

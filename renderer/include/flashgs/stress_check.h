@@ -18,10 +18,11 @@ struct StressReference {
   std::vector<Image> images;
   double seconds = 0;
 };
-StressReference render_stress_reference(const StressCase& stress_case);
+// `kernel`: the footprint model the reference and the backends draw with.
+StressReference render_stress_reference(const StressCase& stress_case, const SplatKernel& kernel = {});
 
 struct StressResult {
-  std::string case_name, backend, algorithm;
+  std::string case_name, backend, algorithm, kernel;
   bool ran = false;         // rendered without an exception
   std::string error;        // the exception's message otherwise
   bool clear_error = false; // an out-of-memory / size error with a message (allowed for huge cases)
@@ -39,8 +40,9 @@ struct StressResult {
 // `renderer` must already hold the case's scene (set_scene). `second` (may be null) is
 // another renderer holding the same scene (e.g. another thread count): its image must also
 // be bit-identical. `keep_images` (may be null) receives the first render of each camera.
+// `kernel` must be the one `reference` was rendered with.
 StressResult run_stress_case(const StressCase& stress_case, const StressReference& reference, Renderer& renderer,
                              const std::string& backend_name, Algorithm algorithm, Renderer* second = nullptr,
-                             std::vector<Image>* keep_images = nullptr);
+                             std::vector<Image>* keep_images = nullptr, const SplatKernel& kernel = {});
 
 }  // namespace flashgs
