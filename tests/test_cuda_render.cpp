@@ -44,7 +44,19 @@ Result render(Renderer& r, const Camera& camera, const RenderOptions& options) {
   return out;
 }
 
-std::vector<RenderOptions> all_configs() { return single_switch_configs(); }
+// Every switch alone off, and the anti-aliased kernels (both algorithms at gsplat's epsilon,
+// flash at Mip-Splatting's).
+std::vector<RenderOptions> all_configs() {
+  std::vector<RenderOptions> configs = single_switch_configs();
+  for (RenderOptions o : {RenderOptions::baseline(), RenderOptions{}}) {
+    o.kernel = SplatKernel::antialiased();
+    configs.push_back(o);
+  }
+  RenderOptions mip;
+  mip.kernel = SplatKernel::antialiased(kMipSplattingEpsilon);
+  configs.push_back(mip);
+  return configs;
+}
 
 // The CPU ignores the switches it does not honour: its image for a config is that of the
 // config with those switches at their defaults.

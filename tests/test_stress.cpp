@@ -22,22 +22,25 @@ using test::stress_data;
 class StressCpu : public ::testing::TestWithParam<test::StressParam> {};
 
 TEST_P(StressCpu, MatchesReferenceDeterministically) {
-  const auto& [name, algorithm] = GetParam();
+  const auto& [name, algorithm, antialiased] = GetParam();
   if (make_stress_case(name).huge && !test::huge_stress_enabled())
     GTEST_SKIP() << name << ": set FLASHGS_STRESS_HUGE=1 (or run `flashgs check --huge`)";
-  const test::StressData& d = stress_data(name);
+  const SplatKernel kernel = test::stress_kernel(GetParam());
+  const test::StressData& d = stress_data(name, kernel);
   auto renderer = make_cpu_renderer();
   auto single = make_cpu_renderer(1);  // another split of the work must give the same bytes
   renderer->set_scene(d.scene);
   single->set_scene(d.scene);
   std::vector<Image> images;
-  const StressResult r = run_stress_case(d.c, d.reference, *renderer, "cpu", algorithm, single.get(), &images);
+  const StressResult r =
+      run_stress_case(d.c, d.reference, *renderer, "cpu", algorithm, single.get(), &images, kernel);
   test::expect_stress_pass(r, d.c);
-  std::printf("%-16s %-8s max|err| %.3e (bound %.2e), kv %llu\n", name.c_str(), r.algorithm.c_str(),
+  std::printf("%-16s %-8s %-11s max|err| %.3e (bound %.2e), kv %llu\n", name.c_str(), r.algorithm.c_str(),
+              r.kernel.c_str(),
               r.max_abs_error, r.bound, static_cast<unsigned long long>(r.kv_pairs));
   if (!r.pass && d.c.windows.empty())
     for (std::size_t k = 0; k < images.size(); ++k)
-      test::dump_images("stress_" + name + "_" + r.algorithm + "_cam" + std::to_string(k),
+      test::dump_images("stress_" + name + "_" + r.algorithm + "_" + r.kernel + "_cam" + std::to_string(k),
                         d.reference.images.at(k), images[k]);
 }
 
@@ -65,8 +68,8 @@ TEST(StressScenes, DegenerateFileThroughTheLoader) {
   const test::StressData& d = stress_data("degenerate_file");
   EXPECT_EQ(d.report.vertices_in_file, d.c.scene.size() + d.report.dropped_non_finite);
   // 23 used attributes x {NaN, +Inf, -Inf}, less -Inf in the 3 log-scales (exp(-inf) = 0 is a
-  // finite, flat scale), plus the log-scale of 100.
-  EXPECT_EQ(d.report.dropped_non_finite, 23u * 3u - 3u + 1u);
+  // finite, flat scale) and +-Inf in the opacity logit (opacity 1 and 0), plus the log-scale of 100.
+  EXPECT_EQ(d.report.dropped_non_finite, 23u * 3u - 3u - 2u + 1u);
   EXPECT_EQ(d.report.repaired_zero_quaternion, 1u);
   for (float v : d.c.scene.positions) EXPECT_TRUE(std::isfinite(v));
   for (float v : d.c.scene.scales) EXPECT_TRUE(std::isfinite(v));

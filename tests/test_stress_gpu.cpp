@@ -15,15 +15,17 @@ class StressCuda : public ::testing::TestWithParam<test::StressParam> {};
 TEST_P(StressCuda, MatchesReferenceDeterministically) {
   std::string why;
   if (!cuda_available(&why)) GTEST_SKIP() << "no CUDA device: " << why;
-  const auto& [name, algorithm] = GetParam();
+  const auto& [name, algorithm, antialiased] = GetParam();
   if (make_stress_case(name).huge && !test::huge_stress_enabled())
     GTEST_SKIP() << name << ": set FLASHGS_STRESS_HUGE=1 (or run `flashgs check --huge`)";
-  const test::StressData& d = test::stress_data(name);
+  const SplatKernel kernel = test::stress_kernel(GetParam());
+  const test::StressData& d = test::stress_data(name, kernel);
   auto renderer = make_cuda_renderer();
   renderer->set_scene(d.scene);
-  const StressResult r = run_stress_case(d.c, d.reference, *renderer, "cuda", algorithm);
+  const StressResult r = run_stress_case(d.c, d.reference, *renderer, "cuda", algorithm, nullptr, nullptr, kernel);
   test::expect_stress_pass(r, d.c);
-  std::printf("%-16s %-8s max|err| %.3e (bound %.2e), kv %llu\n", name.c_str(), r.algorithm.c_str(),
+  std::printf("%-16s %-8s %-11s max|err| %.3e (bound %.2e), kv %llu\n", name.c_str(), r.algorithm.c_str(),
+              r.kernel.c_str(),
               r.max_abs_error, r.bound, static_cast<unsigned long long>(r.kv_pairs));
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <numeric>
@@ -33,10 +34,7 @@ std::string shared_format_file(const std::string& file) {
   return std::filesystem::exists(path) ? path.string() : std::string();
 }
 
-std::vector<SplatKernel> kernels() {
-  return {SplatKernel::classic(), SplatKernel::antialiased(kGsplatAntialiasEpsilon),
-          SplatKernel::antialiased(kMipSplattingEpsilon)};
-}
+std::vector<SplatKernel> kernels() { return {std::begin(kTrainerKernels), std::end(kTrainerKernels)}; }
 
 std::vector<std::string> shared_scene_names() {
   std::vector<std::string> names;

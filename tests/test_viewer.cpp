@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "flashgs/demo_scene.h"
+#include "flashgs/file_access.h"
 #include "flashgs/image.h"
 #include "flashgs/image_io.h"
 #include "flashgs/frame_memory.h"
@@ -253,6 +254,59 @@ TEST(Viewer, SwitchFlagsTurnOffTheirOptimizationsAsInTheCli) {
   EXPECT_GT(without, flash);
 }
 
+// A scene whose file names the anti-aliased kernel opens in it without a flag, as the CLI renders
+// it (auto), and --kernel overrides it in both alike.
+TEST(Viewer, MarkedSceneOpensInItsTrainedKernelAsTheCliRendersIt) {
+  REQUIRE_DISPLAY(prefix);
+  namespace fs = std::filesystem;
+  // The demo scene with Brush's mark for gsplat's anti-aliased kernel, and its cameras beside it.
+  const fs::path dir = fs::path(out_dir()) / "marked_scene";
+  fs::create_directories(dir);
+  const std::vector<char> bytes = flashgs::read_regular_file(flashgs::demo_scene_path(), 1u << 30);
+  std::string text(bytes.begin(), bytes.end());
+  const std::size_t format_end = text.find('\n', text.find("format ")) + 1;
+  text.insert(format_end, "comment SplatRenderMode: mip\n");
+  const std::string scene = (dir / "point_cloud.ply").string();
+  {
+    std::FILE* f = std::fopen(scene.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(text.data(), 1, text.size(), f);
+    std::fclose(f);
+  }
+  fs::copy_file(fs::path(flashgs::demo_scene_path()).parent_path() / "cameras.json", dir / "cameras.json",
+                fs::copy_options::overwrite_existing);
+  const long long marked = expect_matches_cli(prefix, scene, 3, "demo_cam3_marked");
+  const long long classic = expect_matches_cli(prefix, scene, 3, "demo_cam3_marked_classic", "--kernel classic");
+  const long long mip = expect_matches_cli(prefix, "", 3, "demo_cam3_mip", "--kernel antialiased=0.1");
+  std::printf("kv pairs: marked (antialiased) %lld, --kernel classic %lld, demo at antialiased=0.1 %lld\n", marked,
+              classic, mip);
+  // The compensated opacity shrinks the opacity-aware extents: fewer pairs than classic.
+  EXPECT_GT(marked, 0);
+  EXPECT_LT(marked, classic);
+}
+
+// K steps through the trainers' kernels live; each one is a new options line (and frame).
+TEST(Viewer, TheKKeyStepsThroughTheKernels) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // GLFW key code: K 75.
+  const std::string steps =
+      "wait_for \"UI ready\" || status=10\n"
+      "[ $status -eq 0 ] && { hold k \" key75 \" && wait_for \"options: flash-antialiased\" || status=11; }\n"
+      "[ $status -eq 0 ] && { hold k \" key75 \" && wait_for \"options: flash-antialiased_0.1\" || status=12; }\n"
+      "[ $status -eq 0 ] && { hold k \" key75 \" && wait_count \"options: flash\" 4 || status=13; }\n"
+      "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "k_key", "--backend cpu --size 1280x800 --log-input", steps, 14);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11-13 K, 14 crash, 15 close)\n"
+                            << r.output;
+  EXPECT_NE(r.output.find("kernel: antialiased (eps 0.1) (K)"), std::string::npos) << r.output;
+#endif
+}
+
 TEST(Viewer, BikerCameraZeroMatchesCliRender) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = flashgs::test::shared_scene_dir("pc_biker");
@@ -428,7 +482,8 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
                             "[ $status -eq 0 ] && { click \"Compare this view (C)\" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=12; }\n";
-  const RunResult r = run_live_viewer(prefix, "click", "--backend cpu --size 1280x720 --log-input", steps, 13);
+  // The default window height (800): at 720 the Compare button sits below the panels' fold.
+  const RunResult r = run_live_viewer(prefix, "click", "--backend cpu --size 1280x800 --log-input", steps, 13);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 click, 12 no comparison, 13 crash)\n"
                             << r.output;
 #endif

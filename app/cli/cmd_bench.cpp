@@ -48,12 +48,18 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The configurations by name (their labels): baseline, flash, flash with one switch off, and
-// flash with the precision options: those that change the scene's bytes (fp16_sh, fp16_shape,
-// both), then the half blend alone and with them (fp16_blend; CUDA only).
+// The configurations by name (their labels): baseline, flash, flash with one switch off, both
+// algorithms with gsplat's anti-aliased kernel (baseline-antialiased, flash-antialiased: its cost
+// against the classic rows of the same run), and flash with the precision options: those that
+// change the scene's bytes (fp16_sh, fp16_shape, both), then the half blend alone and with them
+// (fp16_blend; CUDA only).
 std::vector<std::pair<std::string, RenderOptions>> known_configs() {
   std::vector<std::pair<std::string, RenderOptions>> out;
   for (const RenderOptions& o : single_switch_configs()) out.emplace_back(o.label(), o);
+  for (RenderOptions o : {RenderOptions::baseline(), RenderOptions{}}) {
+    o.kernel = SplatKernel::antialiased();
+    out.emplace_back(o.label(), o);
+  }
   for (const RenderOptions& o : fp16_configs()) out.emplace_back(o.label(), o);
   for (const RenderOptions& o : fp16_blend_configs()) out.emplace_back(o.label(), o);
   return out;
@@ -154,8 +160,10 @@ void run(const BenchArgs& args) {
   const bool queued = args.frames == "queued" && can_queue_frames(*probe);
   probe.reset();
   auto configs = select_configs(args.configs, cpu);
+  // The scene's kernel (or --kernel) for every configuration that does not name one.
   const SplatKernel kernel = args.kernel.resolve(*scene);
-  for (auto& config : configs) config.second.kernel = kernel;
+  for (auto& config : configs)
+    if (config.second.kernel == SplatKernel::classic()) config.second.kernel = kernel;
 
   nlohmann::json out;
   out["scene"] = scene_path;

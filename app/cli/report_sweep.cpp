@@ -47,8 +47,7 @@ std::vector<SweepConfig> sweep_configs(const SplatKernel& trained) {
   for (const RenderOptions& o : fp16_blend_configs())
     out.push_back({o.fp16_sh ? "fp16-all-blend" : "fp16-blend", "precision", o, true});
   // Not the scene's image: the error says how far drawing with another kernel moves it.
-  for (const SplatKernel& k : {SplatKernel::classic(), SplatKernel::antialiased(),
-                               SplatKernel::antialiased(kMipSplattingEpsilon)}) {
+  for (const SplatKernel& k : kTrainerKernels) {
     if (k == trained) continue;
     RenderOptions o;
     o.kernel = k;

@@ -29,6 +29,7 @@ RenderOptions compare_choice_options(int choice, const RenderOptions& current) {
   if (choice >= 3) o.*(kRenderSwitches[choice - 3].member) = false;
   o.tau = current.tau;
   o.sh_degree_cap = current.sh_degree_cap;
+  o.kernel = current.kernel;
   for (int c = 0; c < 3; ++c) o.background[c] = current.background[c];
   return o;
 }

@@ -24,6 +24,7 @@ inline constexpr Shortcut kShortcuts[] = {
     {"click a frustum", "jump to that training camera (frustums on)"},
     {"G", "ground grid and axes"},
     {"B", "baseline / flash (all optimisations)"},
+    {"K", "next kernel: classic, anti-aliased (gsplat), anti-aliased (Mip-Splatting)"},
     {"C", "compare two configurations for this view"},
     {"H", "tile heat map (pairs per tile)"},
     {"F12 / Shift+F12", "screenshot of the render / of the whole window"},

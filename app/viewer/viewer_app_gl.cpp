@@ -12,6 +12,7 @@
 
 #include "flashgs/gaussian_math.h"
 #include "flashgs/error.h"
+#include "flashgs/scene_summary.h"
 #include "flashgs/renderer.h"
 #include "count_text.h"
 #include "gl_headers_gl.h"
@@ -295,6 +296,10 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
     if (pressed(key)) nav.speed_steps -= 1.0f;
   if (pressed(GLFW_KEY_B))
     switch_algorithm(m_settings.options, m_settings.options.is_baseline() ? Algorithm::flash : Algorithm::baseline);
+  if (pressed(GLFW_KEY_K)) {
+    m_settings.options.kernel = next_trainer_kernel(m_settings.options.kernel);
+    std::fprintf(stderr, "flashgs-viewer: kernel: %s (K)\n", m_settings.options.kernel.description().c_str());
+  }
   const bool left_down = m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT);
   if (mouse_free) actions.snap_camera = frustum_under_click(left_down, x, y);
   if (mouse_free || m_divider.dragging()) handle_divider_drag(left_down, x);
@@ -865,6 +870,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.scene_path = m_scene.path;
   model.gaussians = m_scene.scene ? m_scene.scene->size() : 0;
   model.sh_degree = m_scene.scene ? m_scene.scene->sh_degree : 0;
+  model.trained = m_scene.scene ? m_scene.scene->trained_kernel.kernel : SplatKernel::classic();
+  model.trained_kernel = m_scene.scene ? kernel_summary(m_scene.scene->trained_kernel) : std::string();
   model.lod_gaussians = m_scene.lod_gaussians.empty() ? nullptr : &m_scene.lod_gaussians;
   model.lod_level = m_scene.lod_level;
   model.camera_count = static_cast<int>(m_scene.cameras.size());

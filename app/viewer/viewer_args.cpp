@@ -63,6 +63,7 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_option("--fov", a->fov, "horizontal field of view in degrees")->check(finite_in(kFovRange));
   app.add_option("--algorithm,-a", a->algorithm, "flash or baseline")->check(CLI::IsMember({"flash", "baseline"}));
   a->switches.add_to(&app);
+  a->kernel.add_to(&app);
   app.add_option("--tau", a->tau, "alpha threshold of the opacity-aware extent")->check(finite_in(kTauRange));
   app.add_option("--sh-degree", a->sh_degree, "use at most this many SH bands")->check(CLI::Range(0, kMaxShDegree));
   app.add_flag("--fp16-sh", a->fp16_sh, "use the SH coefficients as half values (not exact)");

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "flashgs/options.h"
+#include "kernel_option.h"
 #include "switch_flags.h"
 
 namespace flashgs::viewer {
@@ -31,6 +32,7 @@ struct ViewerArgs {
   bool fp16_shape = false;       // rotation, scale and opacity as half values (RenderOptions::fp16_shape)
   bool fp16_blend = false;       // CUDA: the blend in half arithmetic (RenderOptions::fp16_blend)
   SwitchFlags switches;          // --no-<switch>: turned off over the saved settings
+  KernelOption kernel;           // --kernel: auto (each scene's trained kernel) or one for every scene
   std::vector<float> background = {0, 0, 0};
   bool heatmap = false;
   bool orbit = false;            // start in orbit mode

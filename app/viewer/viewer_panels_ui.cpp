@@ -125,7 +125,24 @@ void hud_line(const UiModel& m, float panel_right) {
   draw->AddText(at, m.rendering ? IM_COL32(255, 220, 120, 255) : IM_COL32(255, 255, 255, 255), text.c_str());
 }
 
-void scene_panel(const UiModel& m, UiActions& a, std::string& path_buffer) {
+// The kernel combo, one row: what the scene file asked for (marked "trained"), and the others
+// to compare by eye; where the choice came from is in the tooltip.
+void kernel_combo(const UiModel& m, ViewerSettings& s) {
+  auto name = [&](const SplatKernel& k) { return k.description() + (k == m.trained ? " (trained)" : ""); };
+  ImGui::SetNextItemWidth(ui(262));
+  if (ImGui::BeginCombo("Kernel (K)", name(s.options.kernel).c_str())) {
+    for (const SplatKernel& k : kTrainerKernels)
+      if (ImGui::Selectable(name(k).c_str(), k == s.options.kernel)) s.options.kernel = k;
+    ImGui::EndCombo();
+  }
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("the footprint model: classic 3DGS, or the anti-aliased kernel of gsplat (eps 0.3) and "
+                      "Mip-Splatting (eps 0.1),\nwhich scales opacity by sqrt(det S / det(S + eps I)).\n"
+                      "Trained: %s",
+                      m.trained_kernel.c_str());
+}
+
+void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer) {
   if (!ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) return;
   if (m.scene_path.empty()) {
     ImGui::TextDisabled(m.loading.empty() ? "no scene loaded" : "no scene yet: loading (below)");
@@ -133,6 +150,7 @@ void scene_panel(const UiModel& m, UiActions& a, std::string& path_buffer) {
     ImGui::TextWrapped("%s", m.scene_path.c_str());
     ImGui::Text("%s Gaussians, SH degree %d, %d cameras", human_count(double(m.gaussians)).c_str(), m.sh_degree,
                 m.camera_count);
+    kernel_combo(m, s);
   }
   if (m.lod_gaussians && !m.lod_gaussians->empty()) {
     // A SOG LOD set: any level, loaded in the background like a new file (the frame time is in the HUD).
@@ -541,7 +559,7 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   panel_width = ImGui::GetWindowSize().x;
   const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
   ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels
-  scene_panel(m, a, path_buffer);
+  scene_panel(m, s, a, path_buffer);
   view_panel(m, s, a);
   render_panel(m, s);
   compare_panel(m, s, a);

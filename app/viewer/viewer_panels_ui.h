@@ -26,6 +26,8 @@ struct UiModel {
   std::string scene_path;
   std::size_t gaussians = 0;
   int sh_degree = 0;
+  SplatKernel trained;            // the kernel the scene file names (classic when none)...
+  std::string trained_kernel;     // ...and where that came from (kernel_summary)
   const std::vector<std::size_t>* lod_gaussians = nullptr;  // a SOG LOD set's levels, else null
   int lod_level = -1;
   int camera_count = 0;

@@ -8,6 +8,7 @@
 #include "count_text.h"
 #include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
+#include "flashgs/scene_summary.h"
 #include "flashgs/frame_memory.h"
 #include "memory_budget.h"
 #include "scene_state.h"
@@ -45,6 +46,8 @@ void ViewerApp::install_scene(LoadedScene scene) {
     std::fprintf(stderr, "flashgs-viewer: navigation: %s (%s)\n", object ? "orbit" : "fly",
                  object ? "the cameras look at the scene from outside it" : "the cameras stand inside the scene");
   }
+  // The kernel the scene was trained with, unless --kernel chose one for every scene.
+  m_settings.options.kernel = m_args.kernel.resolve(*m_scene.scene);
   m_have_frame = false;
   m_have_request = false;
   std::string note;
@@ -55,8 +58,10 @@ void ViewerApp::install_scene(LoadedScene scene) {
                                 ? ""
                                 : "LOD level " + std::to_string(m_scene.lod_level) + " of 0.." +
                                       std::to_string(m_scene.lod_gaussians.size() - 1) + ", ";
-  std::fprintf(stderr, "flashgs-viewer: %s: %s%zu Gaussians, SH degree %d, %zu cameras%s%s\n", m_scene.path.c_str(),
-               level.c_str(), m_scene.scene->size(), m_scene.scene->sh_degree, m_scene.cameras.size(),
+  std::fprintf(stderr, "flashgs-viewer: %s: %s%zu Gaussians, SH degree %d, %zu cameras, %s kernel (%s)%s%s\n",
+               m_scene.path.c_str(), level.c_str(), m_scene.scene->size(), m_scene.scene->sh_degree,
+               m_scene.cameras.size(), m_settings.options.kernel.description().c_str(),
+               m_args.kernel.chosen() ? "--kernel" : kernel_summary(m_scene.scene->trained_kernel).c_str(),
                note.empty() ? "" : "; ", note.c_str());
 }
 

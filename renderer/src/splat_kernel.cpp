@@ -41,6 +41,13 @@ bool operator==(const SplatKernel& a, const SplatKernel& b) {
   return a.mode == b.mode && (a.mode == KernelMode::classic || a.epsilon == b.epsilon);
 }
 
+SplatKernel next_trainer_kernel(const SplatKernel& k) {
+  constexpr std::size_t count = sizeof kTrainerKernels / sizeof kTrainerKernels[0];
+  for (std::size_t i = 0; i < count; ++i)
+    if (kTrainerKernels[i] == k) return kTrainerKernels[(i + 1) % count];
+  return kTrainerKernels[0];
+}
+
 SplatKernel parse_splat_kernel(const std::string& text, const std::string& what) {
   const std::string expected = "expected classic, antialiased or antialiased=EPS with 0 < EPS <= " +
                                shortest_float_text(kMaxAntialiasEpsilon);

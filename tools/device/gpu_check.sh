@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # GPU check on the lent device machine: GPU tests, compute-sanitizer, benchmarks, profiles.
 # Usage (from the repository root, through the device `run` tool, carrying .deps):
-#   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-ab bench-env bench
+#   tools/device/gpu_check.sh STEP...   steps: setup build tests sanitize bench-quick bench-kernel parity-renders
+#                                       bench-ab bench-env bench
 #                                       bench-regions bench-large bench-prev bench-cpu bench-scale report profile
 #                                       cpu-simd-tests build-prev bench-cpu-prev
 #                                       profile-blend profile-sass bench-variants kernel-times trace launch-cost
@@ -128,6 +129,30 @@ bench_scene() {  # scene-folder json-name extra-args...
 bench_quick() {
   log "bench quick"
   bench_scene "$SCENES/pc_biker" bench_biker_quick --backend cuda -r 1920x1080 --configs baseline,flash --warmup 2 --repeat 5
+}
+
+bench_kernel() {  # the classic and the anti-aliased kernel in one run: baseline and flash each, KERNEL_SCENES
+  # (default pc_biker pc_playbot) at 1080p and 4K
+  for scene in ${KERNEL_SCENES:-pc_biker pc_playbot}; do
+    log "bench kernels $scene"
+    bench_scene "$SCENES/$scene" bench_kernel_$scene --backend cuda --kernel classic \
+      --configs baseline,flash,baseline-antialiased,flash-antialiased
+  done
+}
+
+parity_renders() {  # our frames for the side-by-side image check against other rasterizers: cameras PARITY_IDS
+  # (default 0 10 20) of every scene, 1080p, classic and anti-aliased, as /tmp/parity/SCENE/camID_KERNEL.pfm
+  local scene id kernel
+  for scene in pc_biker pc_guitar pc_playbot v3dg_donut kacytran_try; do
+    mkdir -p /tmp/parity/$scene
+    for id in ${PARITY_IDS:-0 10 20}; do
+      for kernel in classic antialiased; do
+        "$FLASHGS" render "$SCENES/$scene/point_cloud.ply" --backend cuda -c $id -r 1920x1080 --kernel $kernel \
+          -o /tmp/parity/$scene/cam${id}_$kernel.pfm > /dev/null || log "parity render $scene $id $kernel failed"
+      done
+    done
+  done
+  log "parity renders: $(find /tmp/parity -name '*.pfm' | wc -l) frames in /tmp/parity"
 }
 
 bench_ab() {  # flash against flash with one switch off (AB_CONFIG, default flash-no_dense_tiles_first), same run;
@@ -385,6 +410,8 @@ for step in "$@"; do
     tests) tests ;;
     sanitize) sanitize ;;
     bench-quick) bench_quick ;;
+    bench-kernel) bench_kernel ;;
+    parity-renders) parity_renders ;;
     bench-ab) bench_ab ;;
     bench-env) bench_env ;;
     bench) bench ;;

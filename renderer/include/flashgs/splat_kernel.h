@@ -31,8 +31,19 @@ struct SplatKernel {
   std::string description() const;
 };
 
+// The kernels trainers use: classic, gsplat's anti-aliased (eps 0.3), Mip-Splatting's (eps 0.1).
+// The viewer offers these, the report sweeps them.
+inline constexpr SplatKernel kTrainerKernels[] = {
+    {KernelMode::classic, kClassicDilation},
+    {KernelMode::antialiased, kGsplatAntialiasEpsilon},
+    {KernelMode::antialiased, kMipSplattingEpsilon},
+};
+
 bool operator==(const SplatKernel& a, const SplatKernel& b);
 inline bool operator!=(const SplatKernel& a, const SplatKernel& b) { return !(a == b); }
+
+// The trainer kernel after `k` in kTrainerKernels, round (the first for any other kernel).
+SplatKernel next_trainer_kernel(const SplatKernel& k);
 
 // Reads "classic", "antialiased" or "antialiased=EPS" (0 < EPS <= kMaxAntialiasEpsilon);
 // throws flashgs::Error starting with `what` (the option or field) otherwise.
