@@ -164,6 +164,8 @@ void run(const BenchArgs& args) {
   const SplatKernel kernel = args.kernel.resolve(*scene);
   for (auto& config : configs)
     if (config.second.kernel == SplatKernel::classic()) config.second.kernel = kernel;
+  // Each row's image is judged against the baseline of its kernel: the baselines go first.
+  std::stable_partition(configs.begin(), configs.end(), [](const auto& c) { return c.second.is_baseline(); });
 
   nlohmann::json out;
   out["scene"] = scene_path;
@@ -206,7 +208,7 @@ void run(const BenchArgs& args) {
     }
     for (int id : camera_ids) {
       const Camera camera = all_cameras[id].resized(width, height);
-      Image reference;
+      std::map<std::string, Image> baseline_of_kernel;  // by SplatKernel::spec()
       for (ConfigRun& r : runs) {
         Image image;
         FrameStats stats;
@@ -257,7 +259,11 @@ void run(const BenchArgs& args) {
                          {"low_opacity", stats.culled_low_opacity},
                          {"degenerate", stats.culled_degenerate},
                          {"by_chunk", stats.culled_by_chunk}};
-        if (r.name == "baseline") reference = image;
+        if (r.options.is_baseline()) baseline_of_kernel[r.options.kernel.spec()] = image;
+        const auto own = baseline_of_kernel.find(r.options.kernel.spec());
+        // Without a baseline of its kernel in the run: the first row's, the scene's kernel.
+        const Image& reference =
+            own != baseline_of_kernel.end() ? own->second : baseline_of_kernel.at(runs.front().options.kernel.spec());
         const ImageDifference d = compare_images(reference, image);
         r.psnr.push_back(d.psnr_db);
         r.max_abs.push_back(d.max_abs);

@@ -128,7 +128,12 @@ inline void opacity_terms(float opacity, float& log2_opacity, float& q_cut) {
 inline void set_opacity_terms(const Frame& frame, std::int64_t i, float opacity, BlendGaussian& g) {
   g.opacity = opacity;
   if (frame.geometry.compensate_opacity) {
-    opacity_terms(opacity, g.log2_opacity, g.q_cut);
+    // One logarithm per visible Gaussian, not two (the classic cache's log2 and log): this runs
+    // every frame. log2 o = ln o * log2(e) is within an ulp of it, far inside the SIMD alpha's bound.
+    const float ln_opacity = opacity > 0 ? std::log(opacity) : -INFINITY;
+    g.log2_opacity = ln_opacity * 1.44269504f;
+    const float power_cut = opacity > 0 ? std::log(gm::kAlphaMin) - ln_opacity - 1e-3f : 0.0f;
+    g.q_cut = -2.0f * power_cut;
   } else {
     g.log2_opacity = frame.log2_opacity[i];
     g.q_cut = frame.q_cut[i];
