@@ -2,13 +2,13 @@
 // crash, and nothing written or rendered first.
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -49,33 +49,58 @@ std::string scratch_dir(const std::string& name) {
   return dir;
 }
 
-// Runs `flashgs <arguments>` through the shell, with the address space limited to
-// `address_space_bytes` when non-zero (setrlimit in the child, as `prlimit --as` would).
-CliResult run_cli(const std::string& arguments, std::size_t address_space_bytes = 0) {
-  // One log per test process: ctest runs the tests of this suite in parallel.
-  const std::string log = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/cli/run_" + std::to_string(getpid()) + ".log";
-  fs::create_directories(fs::path(log).parent_path());
+// What run_cli holds the binary to (setrlimit and alarm in the child, as `prlimit` and
+// `timeout` would); 0 leaves a limit off.
+struct ChildLimits {
+  std::size_t address_space_bytes = 0;
+  // A write past this size fails with EFBIG ("File too large"), as a write to a full disk fails.
+  std::size_t file_size_bytes = 0;
+  // SIGALRM ends a run that takes longer: a hang fails the test instead of stalling it.
+  unsigned seconds = 0;
+};
+
+// Seconds a run that must fail at once may take before the test calls it hung.
+constexpr unsigned kHangSeconds = 60;
+
+// Runs `flashgs <arguments>` through the shell within `limits`.
+CliResult run_cli(const std::string& arguments, const ChildLimits& limits = {}) {
+  // A pipe, not a log file: a file-size limit would cut the log too.
+  int output[2];
+  if (pipe(output) != 0) return {};
   const std::string command = std::string(FLASHGS_CLI) + " " + arguments;
   const pid_t child = fork();
   if (child == 0) {
-    if (address_space_bytes) {
-      const rlimit limit{address_space_bytes, address_space_bytes};
+    if (limits.address_space_bytes) {
+      const rlimit limit{limits.address_space_bytes, limits.address_space_bytes};
       setrlimit(RLIMIT_AS, &limit);
     }
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
+    if (limits.file_size_bytes) {
+      signal(SIGXFSZ, SIG_IGN);  // the write returns EFBIG instead of killing the process
+      const rlimit limit{limits.file_size_bytes, limits.file_size_bytes};
+      setrlimit(RLIMIT_FSIZE, &limit);
+    }
+    if (limits.seconds) alarm(limits.seconds);  // kept across exec
+    close(output[0]);
+    dup2(output[1], 1);
+    dup2(output[1], 2);
+    close(output[1]);
     // exec, not the shell's own fork: the status is the binary's, a signal included.
     execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
+  close(output[1]);
+  CliResult r;
+  char chunk[4096];
+  for (ssize_t n; (n = read(output[0], chunk, sizeof chunk)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    r.output.append(chunk, static_cast<std::size_t>(n));
+  }
+  close(output[0]);
   int status = 0;
   waitpid(child, &status, 0);
-  CliResult r;
   if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
-  std::ifstream in(log);
-  r.output.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   return r;
 }
 
@@ -178,7 +203,7 @@ TEST(CliOptions, CameraListsAreCheckedAgainstTheFile) {
 TEST(CliMemory, FrameTooLargeForTheAddressSpaceIsRefused) {
   SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const std::string out = scratch_dir("too_large") + "/x.ppm";
-  const CliResult r = run_cli("render --backend cpu -r 51200x28800 -o " + out, std::size_t{2} << 30);
+  const CliResult r = run_cli("render --backend cpu -r 51200x28800 -o " + out, {std::size_t{2} << 30});
   expect_one_line_error(r, "--resolution: a 51200x28800 frame needs about", "51200x28800");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("is available (the address-space limit, RLIMIT_AS)"), std::string::npos) << r.output;
@@ -199,7 +224,7 @@ TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
   std::ofstream(dir + "/point_cloud.ply", std::ios::binary) << b.bytes();
   const CliResult r = run_cli("render " + dir + "/point_cloud.ply --backend cpu --eye 0,0,-5 --look-at 0,0,0 " +
                                   "-r 2048x1024 -o " + dir + "/x.ppm",
-                              std::size_t{1} << 30);
+                              {std::size_t{1} << 30});
   expect_one_line_error(r, "out of memory for a 2048x1024 frame", "pairs out of memory");
   EXPECT_EQ(r.exit_code, 2);
 }
@@ -217,7 +242,7 @@ TEST(CliBench, TiledSceneIsBenchedAndTooManyCopiesAreRefused) {
   EXPECT_NE(r.output.find("flash                        scene upload"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("first frame"), std::string::npos) << r.output;
 
-  const CliResult huge = run_cli("bench --tile 4096" + quick + dir + "/c.json", std::size_t{1} << 30);
+  const CliResult huge = run_cli("bench --tile 4096" + quick + dir + "/c.json", {std::size_t{1} << 30});
   expect_one_line_error(huge, "--tile: 4096 copies need", "4096 copies");
   EXPECT_FALSE(fs::exists(dir + "/c.json"));
 }
@@ -399,6 +424,116 @@ TEST(CliInfo, ShowsTheFormatItsQuantisationAndTheDecodeTime) {
   EXPECT_NE(r.output.find("in 256-Gaussian chunks"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find(", decoded in "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("gaussians:       600\n"), std::string::npos) << r.output;
+}
+
+// The names in `dir`, sorted: what a command left there.
+std::vector<std::string> names_in(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// An output that is a FIFO is refused before any work: writing opened it, which blocks until a
+// reader comes, so each of these hung for ever (bench and report after all their work).
+TEST(CliOutputs, AFifoAsAnOutputIsRefusedBeforeAnyWork) {
+  const std::string dir = scratch_dir("fifo_outputs");
+  std::vector<std::pair<std::string, std::string>> cases = {  // arguments, the error's start
+      {"render -r 4096x2304 -o " + dir + "/r.png", "--output " + dir + "/r.png"},
+      {"bench --backend cpu --json " + dir + "/b.json", "--json " + dir + "/b.json"},
+      {"check --backend cpu --csv " + dir + "/c.csv", "--csv " + dir + "/c.csv"},
+  };
+  for (const char* name : {"report.csv", "report.md", "report_cpu.svg"}) {
+    const std::string folder = dir + "/report_" + name;
+    fs::create_directories(folder);
+    cases.push_back({"report --backend cpu -o " + folder, "--output-dir " + folder + "/" + name});
+  }
+  for (const auto& [arguments, option_and_path] : cases) {
+    const std::string fifo = option_and_path.substr(option_and_path.find(' ') + 1);
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0) << fifo;
+    // Each command's full run costs minutes of CPU: the error must come before it.
+    const double cpu_before = test::children_cpu_seconds();
+    const CliResult r = run_cli(arguments, {0, 0, kHangSeconds});
+    const double seconds = test::children_cpu_seconds() - cpu_before;
+    expect_one_line_error(r, option_and_path + ": is a FIFO (named pipe), not a regular file", arguments);
+    EXPECT_LT(seconds, 1.5 * test::kSanitizerSlowdown) << arguments << ": worked first";
+    EXPECT_TRUE(fs::is_fifo(fifo)) << fifo << " was replaced";
+  }
+}
+
+// `check --case NAME --csv FILE` opened the CSV before it looked the case up: with a FIFO there
+// it hung instead of naming the case.
+TEST(CliCheck, AnUnknownCaseIsNamedBeforeTheCsvIsOpened) {
+  const std::string dir = scratch_dir("check_unknown_case");
+  const std::string fifo = dir + "/c.csv";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  const CliResult r = run_cli("check --case no_such_case --csv " + fifo, {0, 0, kHangSeconds});
+  expect_one_line_error(r, "unknown stress case \"no_such_case\" (known: ", "check --case no_such_case");
+}
+
+// A link to a device is not a regular file either: a .png linked to /dev/full was "written"
+// with exit 0. Refused before rendering, and nothing is left beside the link.
+TEST(CliOutputs, ALinkToADeviceIsRefusedAndNothingIsLeft) {
+  const std::string dir = scratch_dir("device_outputs");
+  const std::vector<std::pair<std::string, std::string>> cases = {  // arguments, the option and the link
+      {"render -r 64x36 -o " + dir + "/r.ppm", "--output " + dir + "/r.ppm"},
+      {"render -r 64x36 -o " + dir + "/r.png", "--output " + dir + "/r.png"},
+      {"bench --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 --json " + dir + "/b.json",
+       "--json " + dir + "/b.json"},
+  };
+  std::vector<std::string> links;
+  for (const auto& [arguments, option_and_link] : cases) {
+    const std::string link = option_and_link.substr(option_and_link.find(' ') + 1);
+    fs::create_symlink("/dev/full", link);
+    links.push_back(fs::path(link).filename().string());
+    const CliResult r = run_cli(arguments, {0, 0, kHangSeconds});
+    expect_one_line_error(r, option_and_link + ": is a device, not a regular file", arguments);
+    EXPECT_EQ(fs::read_symlink(link), "/dev/full") << link;
+  }
+  std::sort(links.begin(), links.end());
+  EXPECT_EQ(names_in(dir), links) << "a file or a temporary was left";
+}
+
+// A write that fails part way (a file-size limit here; a full disk fails the same way) is one
+// line naming the file and the system's reason, exit non-zero, and leaves neither the file nor a
+// temporary: a cut PNG, bench JSON, cameras.json or report SVG, and an empty report.md, came out
+// with exit 0.
+TEST(CliOutputs, AWriteThatFailsIsAnErrorAndLeavesNoFile) {
+  const std::string dir = scratch_dir("failed_writes");
+  struct Case {
+    std::string arguments;
+    std::size_t file_size_bytes;  // below the size of the file that fails, above the ones before it
+    std::string failing;          // the file the error names
+    std::vector<std::string> kept;  // what the command left in `folder` (written before the failure)
+    std::string folder;
+  };
+  std::vector<Case> cases = {
+      {"render -r 320x180 -o " + dir + "/r.ppm", 4096, dir + "/r.ppm", {}, ""},  // 173 kB
+      {"bench --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 --json " + dir + "/b.json",
+       2048, dir + "/b.json", {}, ""},  // about 4 kB
+      // point_cloud.ply of 10 Gaussians: under 2 kB; cameras.json: about 17 kB.
+      {"generate demo --count 10 -o " + dir + "/scene", 4096, dir + "/scene/cameras.json", {"point_cloud.ply"},
+       dir + "/scene"},
+      // report.csv: about 3 kB; report_cpu.svg (written next): about 6 kB.
+      {"report --backend cpu -r 32x18 --camera-list 0 --repeat 1 --ref-window 8 -o " + dir + "/report", 4096,
+       dir + "/report/report_cpu.svg", {"report.csv"}, dir + "/report"},
+  };
+#ifdef FLASHGS_TEST_HAVE_OIIO
+  cases.push_back({"render -r 320x180 -o " + dir + "/r.png", 4096, dir + "/r.png", {}, ""});  // about 34 kB
+#endif
+  for (const Case& c : cases) {
+    const CliResult r = run_cli(c.arguments, {0, c.file_size_bytes, kHangSeconds});
+    EXPECT_EQ(r.signal, 0) << c.arguments << ": killed by signal " << r.signal << "\n" << r.output;
+    EXPECT_GT(r.exit_code, 0) << c.arguments << "\n" << r.output;
+    const std::vector<std::string> lines = r.error_lines();
+    ASSERT_EQ(lines.size(), 1u) << c.arguments << "\n" << r.output;
+    EXPECT_EQ(lines[0], "error: " + c.failing + ": write error: File too large") << c.arguments;
+    EXPECT_FALSE(fs::exists(c.failing)) << c.arguments;
+    if (!c.folder.empty()) {
+      EXPECT_EQ(names_in(c.folder), c.kept) << c.arguments;
+    }
+  }
+  EXPECT_EQ(names_in(dir), (std::vector<std::string>{"report", "scene"})) << "a file or a temporary was left";
 }
 
 }  // namespace

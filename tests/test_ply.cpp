@@ -164,8 +164,9 @@ TEST(PlyKernelMarks, HeaderCommentsNameTheKernel) {
     const std::string what = c.comments.empty() ? "(none)" : c.comments.front();
     EXPECT_EQ(s.trained_kernel.kernel, c.kernel) << what << ": " << s.trained_kernel.kernel.spec();
     EXPECT_EQ(s.trained_kernel.marked(), c.source_fragment != nullptr) << what;
-    if (c.source_fragment)
+    if (c.source_fragment) {
       EXPECT_NE(s.trained_kernel.source.find(c.source_fragment), std::string::npos) << s.trained_kernel.source;
+    }
   }
 }
 

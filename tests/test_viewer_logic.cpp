@@ -856,6 +856,16 @@ TEST(ViewerFiles, PathExportNumbersFramesAndFindsFfmpegAtRunTime) {
   setenv("PATH", old_path.c_str(), 1);
 }
 
+// A FIFO where the video goes would keep ffmpeg waiting for a reader for ever, after every frame
+// was rendered: the export is refused before its first frame.
+TEST(ViewerFiles, PathExportRefusesAFifoWhereTheVideoGoes) {
+  const std::string dir = scratch_dir("viewer_export_fifo");
+  ASSERT_EQ(mkfifo((dir + "/path.mp4").c_str(), 0644), 0);
+  fv::PathExport e;
+  EXPECT_EQ(e.start(dir, 3), "path export: " + dir + "/path.mp4: is a FIFO (named pipe), not a regular file");
+  EXPECT_FALSE(e.active());
+}
+
 // A SOG LOD set opens at the level asked for and lists every level (the viewer's LOD
 // selector); a file that is not a LOD set refuses a level with one line naming it.
 TEST(ViewerLoad, SogLodSetLoadsTheAskedLevelAndListsTheLevels) {

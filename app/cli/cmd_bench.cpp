@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -14,6 +13,7 @@
 #include "backend_factory.h"
 #include "commands.h"
 #include "flashgs/error.h"
+#include "flashgs/file_write.h"
 #include "flashgs/frame_memory.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
@@ -327,9 +327,7 @@ void run(const BenchArgs& args) {
               "sort", "ranges", "blend", "total", "(p95)", "kv", "peak MB", "PSNRmin", "max abs");
   std::printf("%s", table.c_str());
   std::printf("%s", uploads.c_str());
-  std::ofstream file(args.json_path);
-  if (!file) throw Error("bench: cannot write " + args.json_path);
-  file << out.dump(2) << "\n";
+  write_file_atomically(args.json_path, out.dump(2) + "\n");
   std::printf("wrote %s\n", args.json_path.c_str());
 }
 

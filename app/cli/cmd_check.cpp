@@ -1,7 +1,8 @@
 // `flashgs check`: every stress case, on every backend present, with both algorithms, judged
 // against the fp64 reference; prints a table and exits non-zero when a case fails.
+#include <algorithm>
+#include <cstdarg>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -9,6 +10,7 @@
 #include "backend_factory.h"
 #include "commands.h"
 #include "flashgs/error.h"
+#include "flashgs/file_write.h"
 #include "flashgs/image_io.h"
 #include "flashgs/stress_check.h"
 #include "flashgs/stress_scenes.h"
@@ -52,10 +54,27 @@ std::vector<Backend> present_backends(const std::string& which) {
   return out;
 }
 
-// Case `c` with one kernel on every backend, both algorithms: prints its rows (and writes them to
-// `csv` and its images) and returns the failures.
+// printf onto the end of `out`.
+__attribute__((format(printf, 2, 3))) void append_format(std::string& out, const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  va_list again;
+  va_copy(again, args);
+  const int size = std::vsnprintf(nullptr, 0, format, args);
+  va_end(args);
+  if (size > 0) {
+    const std::size_t old_size = out.size();
+    out.resize(old_size + static_cast<std::size_t>(size) + 1);
+    std::vsnprintf(&out[old_size], static_cast<std::size_t>(size) + 1, format, again);
+    out.resize(old_size + static_cast<std::size_t>(size));
+  }
+  va_end(again);
+}
+
+// Case `c` with one kernel on every backend, both algorithms: prints its rows (and adds them to
+// `csv` when given, writes its images) and returns the failures.
 int check_case(const StressCase& c, const std::shared_ptr<const Scene>& scene, const SplatKernel& kernel,
-               std::vector<Backend>& backends, const CheckArgs& args, std::FILE* csv) {
+               std::vector<Backend>& backends, const CheckArgs& args, std::string* csv) {
   const std::string& name = c.name;
   int failures = 0;
   const StressReference reference = render_stress_reference(c, kernel);
@@ -80,10 +99,11 @@ int check_case(const StressCase& c, const std::shared_ptr<const Scene>& scene, c
                   r.milliseconds, result.c_str());
       std::fflush(stdout);
       if (csv)
-        std::fprintf(csv, "%s,%s,%s,%s,%d,%llu,%.6e,%.6e,%d,%llu,%.3f,%d,\"%s\"\n", name.c_str(), r.kernel.c_str(),
-                     backend.name.c_str(), r.algorithm.c_str(), r.ran ? 1 : 0, static_cast<unsigned long long>(r.non_finite),
-                     r.max_abs_error, r.bound, r.deterministic ? 1 : 0, static_cast<unsigned long long>(r.kv_pairs),
-                     r.milliseconds, r.pass ? 1 : 0, (r.why_failed + r.error).c_str());
+        append_format(*csv, "%s,%s,%s,%s,%d,%llu,%.6e,%.6e,%d,%llu,%.3f,%d,\"%s\"\n", name.c_str(), r.kernel.c_str(),
+                      backend.name.c_str(), r.algorithm.c_str(), r.ran ? 1 : 0,
+                      static_cast<unsigned long long>(r.non_finite), r.max_abs_error, r.bound, r.deterministic ? 1 : 0,
+                      static_cast<unsigned long long>(r.kv_pairs), r.milliseconds, r.pass ? 1 : 0,
+                      (r.why_failed + r.error).c_str());
       for (std::size_t k = 0; k < images.size(); ++k)
         write_image(images[k], args.images_dir + "/" + name + "_" + r.kernel + "_" + backend.name + "_" +
                                    r.algorithm + "_cam" + std::to_string(k) + ".png");
@@ -96,7 +116,11 @@ int check_case(const StressCase& c, const std::shared_ptr<const Scene>& scene, c
 
 int run(const CheckArgs& args) {
   const std::vector<SplatKernel> kernels = kernels_of(args.kernel);
-  // Output paths first: a failure after the cases have run would waste minutes.
+  // The case names, then the output paths, all before the first case: a failure after the cases
+  // have run would waste minutes. make_stress_case's message names the case and the known ones.
+  const std::vector<std::string> known = stress_case_names();
+  for (const std::string& name : args.cases)
+    if (std::find(known.begin(), known.end(), name) == known.end()) make_stress_case(name);
   if (!args.csv.empty()) check_output_file("--csv", args.csv);
   if (!args.images_dir.empty()) check_output_folder("--images", args.images_dir);
   std::vector<std::string> names = args.cases;
@@ -106,12 +130,9 @@ int run(const CheckArgs& args) {
       names.push_back(name);
     }
   std::vector<Backend> backends = present_backends(args.backend);
-  std::FILE* csv = nullptr;
-  if (!args.csv.empty()) {
-    csv = std::fopen(args.csv.c_str(), "w");
-    if (!csv) throw Error(args.csv + ": cannot open for writing");
-    std::fprintf(csv, "case,kernel,backend,algorithm,ran,nan_inf,max_abs_error,bound,deterministic,kv_pairs,ms,pass,note\n");
-  }
+  // The CSV is written whole once every case has run (write_file_atomically).
+  std::string csv_text = "case,kernel,backend,algorithm,ran,nan_inf,max_abs_error,bound,deterministic,kv_pairs,ms,pass,note\n";
+  std::string* csv = args.csv.empty() ? nullptr : &csv_text;
   std::printf("%-16s %-11s %-5s %-8s %7s %11s %9s %6s %10s %9s  %s\n", "case", "kernel", "back", "algo", "nan/inf",
               "max|err|", "bound", "determ", "kv pairs", "ms", "result");
   int failures = 0;
@@ -127,7 +148,7 @@ int run(const CheckArgs& args) {
     reasons.push_back({name, c.bound_reason});
     for (const SplatKernel& kernel : kernels) failures += check_case(c, scene, kernel, backends, args, csv);
   }
-  if (csv) std::fclose(csv);
+  if (csv) write_file_atomically(args.csv, csv_text);
   if (args.explain) {
     std::printf("\nbounds (max |image - fp64 reference|), why:\n");
     for (const auto& [name, why] : reasons) std::printf("  %-16s %s\n", name.c_str(), why.c_str());

@@ -3,7 +3,6 @@
 #include <filesystem>
 #include <system_error>
 
-#include "atomic_write.h"
 #include "commands.h"
 #include "flashgs/error.h"
 #include "flashgs/io.h"
@@ -50,7 +49,7 @@ void run(const ConvertArgs& args) {
                  "with --kernel %s\n",
                  input_file.c_str(), scene.trained_kernel.kernel.description().c_str(),
                  scene.trained_kernel.source.c_str(), scene.trained_kernel.kernel.spec().c_str());
-  write_atomically(args.output, [&](const std::string& path) { write(scene, path); });
+  write(scene, args.output);
   std::printf("read %s (%s, %zu Gaussians, SH degree %d, decoded in %.3f s), wrote %s\n", input_file.c_str(),
               report.format.c_str(), scene.size(), scene.sh_degree, report.decode_seconds, args.output.c_str());
 }

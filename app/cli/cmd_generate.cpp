@@ -3,9 +3,9 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "atomic_write.h"
 #include "commands.h"
 #include "flashgs/error.h"
+#include "flashgs/file_write.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
 #include "flashgs/scene_formats.h"
@@ -29,21 +29,22 @@ struct GenerateArgs {
 
 namespace fs = std::filesystem;
 
-// Refuses, before any work, an output folder that already holds a scene (unless --force).
+// Refuses, before any work, an output folder that already holds a scene (unless --force), or
+// whose scene files could not be written.
 void check_output_scene(const GenerateArgs& args) {
   check_output_folder("--output", args.output_dir);
-  if (args.force) return;
   for (const char* name : {"point_cloud.ply", "cameras.json"}) {
     const fs::path existing = fs::path(args.output_dir) / name;
-    if (fs::exists(existing))
+    check_output_file("--output", existing.string());
+    if (!args.force && fs::exists(existing))
       throw Error("--output " + args.output_dir + ": already holds " + existing.string() +
                   " (give --force to overwrite it)");
   }
 }
 
 void write_scene(const Scene& scene, const std::vector<Camera>& cameras, const std::string& dir) {
-  write_atomically(dir + "/point_cloud.ply", [&](const std::string& path) { save_ply(scene, path); });
-  write_atomically(dir + "/cameras.json", [&](const std::string& path) { save_cameras(cameras, path); });
+  save_ply(scene, dir + "/point_cloud.ply");
+  save_cameras(cameras, dir + "/cameras.json");
   std::printf("wrote %s/point_cloud.ply (%zu Gaussians, SH degree %d) and %s/cameras.json (%zu cameras)\n",
               dir.c_str(), scene.size(), scene.sh_degree, dir.c_str(), cameras.size());
 }
@@ -91,13 +92,8 @@ void run(const GenerateArgs& given) {
     if (!c.raw_ply.empty()) {
       // The degenerate-file case is the file itself: written byte for byte, NaNs included.
       const std::string ply = args.output_dir + "/point_cloud.ply";
-      write_atomically(ply, [&](const std::string& path) {
-        std::FILE* f = std::fopen(path.c_str(), "wb");
-        const bool written = f && std::fwrite(c.raw_ply.data(), 1, c.raw_ply.size(), f) == c.raw_ply.size();
-        if ((f && std::fclose(f) != 0) || !written) throw Error(path + ": cannot write");
-      });
-      write_atomically(args.output_dir + "/cameras.json",
-                       [&](const std::string& path) { save_cameras(c.cameras, path); });
+      write_file_atomically(ply, c.raw_ply);
+      save_cameras(c.cameras, args.output_dir + "/cameras.json");
       std::printf("wrote %s (raw, with NaN/Inf records) and %s/cameras.json\n", ply.c_str(), args.output_dir.c_str());
     } else {
       write_scene(c.scene, c.cameras, args.output_dir);

@@ -17,6 +17,7 @@
 #include "commands.h"
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
+#include "flashgs/file_write.h"
 #include "flashgs/io.h"
 #include "flashgs/parse.h"
 #include "flashgs/reference_renderer.h"
@@ -62,6 +63,9 @@ std::string fmt(const char* f, double v) {
 std::string psnr_text(double db) { return std::isfinite(db) ? fmt("%.1f", db) : "inf"; }
 // The CSV keeps more digits, so that --replot finds the same Pareto front.
 std::string psnr_csv(double db) { return std::isfinite(db) ? fmt("%.4f", db) : "inf"; }
+
+// What a report writes into its folder, checked before anything is measured.
+constexpr const char* kReportFiles[] = {"report.csv", "report.md", "report_cpu.svg", "report_cuda.svg"};
 
 // A report.csv holds a row per configuration and backend: a few kB.
 constexpr std::size_t kMaxReportCsvBytes = std::size_t{64} << 20;
@@ -119,9 +123,8 @@ void replot(const ReportArgs& args) {
       if (r.backend == bname) subset.push_back(r);
     if (subset.empty()) continue;
     const std::string path = (dir.empty() ? std::string(".") : dir) + "/report_" + bname + ".svg";
-    std::ofstream(path) << plot_svg(subset, "Error vs run time: " + (args.title.empty() ? std::string("report") : args.title) +
-                                                " (" + bname + ")",
-                                    args.subtitle);
+    const std::string title = args.title.empty() ? std::string("report") : args.title;
+    write_file_atomically(path, plot_svg(subset, "Error vs run time: " + title + " (" + bname + ")", args.subtitle));
     std::printf("wrote %s\n", path.c_str());
   }
 }
@@ -130,6 +133,7 @@ void run(const ReportArgs& args) {
   if (!args.replot.empty()) return replot(args);
   // Everything that can be wrong with the arguments is found before the first frame.
   check_output_folder("--output-dir", args.output_dir);
+  for (const char* name : kReportFiles) check_output_file("--output-dir", args.output_dir + "/" + name);
   const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
   const std::string scene_path = args.scene.resolved_scene();
   auto scene = load_scene_verbose(scene_path, args.scene.lod);
@@ -215,7 +219,7 @@ void run(const ReportArgs& args) {
   const std::string stem = args.output_dir + "/report";
   // CSV: one row per (backend, configuration).
   {
-    std::ofstream csv(stem + ".csv");
+    std::ostringstream csv;
     // One column per switch (its label token): 1 where it is in effect.
     csv << "backend,config,group,algorithm,";
     for (const RenderSwitch& s : kRenderSwitches) csv << s.label << ',';
@@ -243,9 +247,10 @@ void run(const ReportArgs& args) {
             << (std::find(front.begin(), front.end(), i) != front.end()) << '\n';
       }
     }
+    write_file_atomically(stem + ".csv", csv.str());
   }
   // Markdown and one plot per backend.
-  std::ofstream md(stem + ".md");
+  std::ostringstream md;
   const std::string title = args.title.empty() ? std::filesystem::path(scene_path).parent_path().filename().string()
                                                : args.title;
   std::string camera_text;
@@ -293,13 +298,14 @@ void run(const ReportArgs& args) {
                                  std::to_string(height) + ", cameras " + camera_text + ", " + device +
                                  (bname == "cpu" ? " on " + cpu_model() : "");
     const std::string svg_path = stem + "_" + bname + ".svg";
-    std::ofstream(svg_path) << plot_svg(subset, "Error vs run time: " + title + " (" + bname + ")", subtitle);
+    write_file_atomically(svg_path, plot_svg(subset, "Error vs run time: " + title + " (" + bname + ")", subtitle));
     plots.push_back("report_" + bname + ".svg");
     std::printf("wrote %s\n", svg_path.c_str());
   }
   md << "\nPlots (error vs median frame time, one point per configuration, Pareto front marked):";
   for (const std::string& p : plots) md << " [" << p << "](" << p << ")";
   md << "\n";
+  write_file_atomically(stem + ".md", md.str());
   std::printf("wrote %s.csv and %s.md\n", stem.c_str(), stem.c_str());
 }
 

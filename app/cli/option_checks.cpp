@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "flashgs/frame_memory.h"
 #include "flashgs/image_io.h"
 
@@ -29,13 +30,11 @@ void check_camera_indices(const std::string& option, const std::vector<int>& ind
 
 void check_output_file(const std::string& option, const std::string& path) {
   if (path.empty()) throw Error(option + ": the output path is empty");
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw Error(option + " " + path + ": is a folder, not a file");
-  const fs::path parent = fs::path(path).parent_path();
-  const std::string folder = parent.empty() ? "." : parent.string();
-  if (!fs::is_directory(folder, ec)) throw Error(option + " " + path + ": the folder " + folder + " does not exist");
-  if (access(folder.c_str(), W_OK) != 0)
-    throw Error(option + " " + path + ": the folder " + folder + " is not writable");
+  try {
+    flashgs::check_output_file(path);
+  } catch (const Error& e) {
+    throw Error(option + " " + e.what());
+  }
 }
 
 void check_output_image(const std::string& option, const std::string& path) {

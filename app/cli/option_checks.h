@@ -21,8 +21,8 @@ using flashgs::finite_in;  // app/common/finite_option.h
 void check_camera_indices(const std::string& option, const std::vector<int>& indices, std::size_t count,
                           const std::string& cameras_path);
 
-// The output file `path` (given with `option`) can be created: a name, not a folder, in a
-// folder that exists and is writable. Throws flashgs::Error otherwise.
+// The output file `path` (given with `option`) may be written: flashgs::check_output_file
+// (file_access.h), its message led by the option. Throws flashgs::Error otherwise.
 void check_output_file(const std::string& option, const std::string& path);
 // Same, and write_image knows the format of its extension.
 void check_output_image(const std::string& option, const std::string& path);

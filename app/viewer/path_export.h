@@ -7,6 +7,8 @@ namespace flashgs::viewer {
 
 class PathExport {
  public:
+  static constexpr const char* kVideoName = "path.mp4";
+
   // Starts an export of `frames` frames over one loop of the path into `folder` (created).
   // Returns an empty string, or why it cannot start (the folder cannot be made, no frames).
   std::string start(const std::string& folder, int frames);
@@ -19,6 +21,8 @@ class PathExport {
   int done_frames() const { return m_next; }
   int total_frames() const { return m_frames; }
   const std::string& folder() const { return m_folder; }
+  // The video the frames are joined into.
+  std::string video_file() const { return m_folder + "/" + kVideoName; }
 
   // The command that makes path.mp4 from the written frames at `fps`, when ffmpeg is on PATH
   // (found at run time), else empty.

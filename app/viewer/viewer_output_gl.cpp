@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/file_access.h"
 #include "flashgs/image_io.h"
 #include "gl_headers_gl.h"
 #include "image_presenter_gl.h"
@@ -27,6 +28,7 @@ void ViewerApp::save_screenshot(const std::string& path) {
   try {
     m_path->present_latest();
     m_presenter->show(m_path->shown_texture());
+    check_output_file(path);  // before the frame may be rendered again for it
     Image image;
     const Image* host = m_path->last_image();
     const std::string ext = std::filesystem::path(path).extension().string();
@@ -128,7 +130,7 @@ void ViewerApp::export_step() {
   if (m_encoding_video) {  // the last step: ffmpeg, beside the frame loop too
     if (!m_export_job.take(&error)) return;
     m_encoding_video = false;
-    set_notice(exported_frames_line() + (error.empty() ? ", video " + m_export.folder() + "/path.mp4" : ", " + error));
+    set_notice(exported_frames_line() + (error.empty() ? ", video " + m_export.video_file() : ", " + error));
     return;
   }
   // The frame in flight, finished: written, or the export stops with why.

@@ -1,13 +1,13 @@
 // cameras.json in the 3DGS training-output format: read with validation, and written back.
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 
 #include <nlohmann/json.hpp>
 
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
+#include "flashgs/file_write.h"
 #include "flashgs/io.h"
 
 namespace flashgs {
@@ -147,9 +147,7 @@ void save_cameras(const std::vector<Camera>& cameras, const std::string& path) {
                    {"fx", cam.fx},
                    {"fy", cam.fy}});
   }
-  std::ofstream file(path);
-  if (!file) throw Error(path + ": cannot open for writing");
-  file << doc.dump(1) << "\n";
+  write_file_atomically(path, doc.dump(1) + "\n");
 }
 
 }  // namespace flashgs

@@ -1,4 +1,5 @@
-// The file-type checks and the non-blocking whole-file read behind every scene and camera file.
+// The file-type checks and the non-blocking whole-file read behind every scene and camera file,
+// and the check of every output file.
 #include "flashgs/file_access.h"
 
 #include <fcntl.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 
 #include "flashgs/error.h"
 #include "flashgs/load_progress.h"
@@ -108,6 +110,33 @@ PathKind path_kind(const std::string& path) {
 }
 
 void check_regular_file(const std::string& path) { check_regular(path, stat_or_fail(path).st_mode); }
+
+void check_output_file(const std::string& path) {
+  if (path.empty()) throw Error("the output path is empty");
+  namespace fs = std::filesystem;
+  struct stat st {};
+  fs::path folder;
+  if (::stat(path.c_str(), &st) == 0) {
+    check_regular(path, st.st_mode);
+    if (::access(path.c_str(), W_OK) != 0) fail(path, std::string("the file is not writable: ") + std::strerror(errno));
+    // The file is replaced beside what a link names, so that the link stays.
+    std::error_code ec;
+    folder = fs::canonical(path, ec).parent_path();
+    if (ec) fail(path, "cannot resolve its path: " + ec.message());
+  } else if (errno == ENOENT) {
+    struct stat link {};
+    if (::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode))
+      fail(path, "a symbolic link whose target does not exist");
+    folder = fs::path(path).parent_path();
+    if (folder.empty()) folder = ".";
+    struct stat dir {};
+    if (::stat(folder.c_str(), &dir) != 0 || !S_ISDIR(dir.st_mode))
+      fail(path, "the folder " + folder.string() + " does not exist");
+  } else {
+    fail_to_open(path, errno);
+  }
+  if (::access(folder.c_str(), W_OK) != 0) fail(path, "the folder " + folder.string() + " is not writable");
+}
 
 std::vector<char> read_file_start(const std::string& path, std::size_t max_bytes) {
   struct stat st {};

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "flashgs/error.h"
+#include "flashgs/file_write.h"
 
 namespace flashgs {
 
@@ -16,22 +17,20 @@ unsigned char to_byte(float v) {
 }
 
 void write_ppm(const Image& image, const std::string& path) {
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw Error(path + ": cannot open for writing");
-  file << "P6\n" << image.width << " " << image.height << "\n255\n";
   std::vector<unsigned char> bytes(image.rgb.size());
   std::transform(image.rgb.begin(), image.rgb.end(), bytes.begin(), to_byte);
-  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (!file) throw Error(path + ": write error");
+  write_file_atomically(path, [&](OutputFile& file) {
+    file.write("P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n");
+    file.write(bytes.data(), bytes.size());
+  });
 }
 
 void write_pfm(const Image& image, const std::string& path) {
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw Error(path + ": cannot open for writing");
-  file << "PF\n" << image.width << " " << image.height << "\n-1.0\n";  // little endian
-  for (int y = image.height - 1; y >= 0; --y)  // PFM stores the bottom row first
-    file.write(reinterpret_cast<const char*>(image.pixel(0, y)), static_cast<std::streamsize>(image.width * 3 * 4));
-  if (!file) throw Error(path + ": write error");
+  write_file_atomically(path, [&](OutputFile& file) {
+    file.write("PF\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n-1.0\n");  // little endian
+    for (int y = image.height - 1; y >= 0; --y)  // PFM stores the bottom row first
+      file.write(image.pixel(0, y), static_cast<std::size_t>(image.width) * 3 * sizeof(float));
+  });
 }
 
 Image read_netpbm(const std::string& path) {

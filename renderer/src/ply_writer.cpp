@@ -2,50 +2,50 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
+#include <sstream>
 #include <vector>
 
-#include "flashgs/error.h"
+#include "flashgs/file_write.h"
 #include "flashgs/io.h"
 #include "kernel_marks.h"
 
 namespace flashgs {
 
 void save_ply(const Scene& scene, const std::string& path) {
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw Error(path + ": cannot open for writing");
   const int rest_n = scene.sh_rest_per_gaussian();
   const int per_channel = rest_n / 3;
-  file << "ply\nformat binary_little_endian 1.0\n";
-  for (const std::string& comment : ply_comments_for(scene.trained_kernel)) file << "comment " << comment << "\n";
-  file << "element vertex " << scene.size() << "\n";
+  std::ostringstream header;
+  header << "ply\nformat binary_little_endian 1.0\n";
+  for (const std::string& comment : ply_comments_for(scene.trained_kernel)) header << "comment " << comment << "\n";
+  header << "element vertex " << scene.size() << "\n";
   for (const char* p : {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"})
-    file << "property float " << p << "\n";
-  for (int k = 0; k < rest_n; ++k) file << "property float f_rest_" << k << "\n";
-  file << "property float opacity\n";
+    header << "property float " << p << "\n";
+  for (int k = 0; k < rest_n; ++k) header << "property float f_rest_" << k << "\n";
+  header << "property float opacity\n";
   for (const char* p : {"scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
-    file << "property float " << p << "\n";
-  file << "end_header\n";
+    header << "property float " << p << "\n";
+  header << "end_header\n";
 
-  std::vector<float> record(static_cast<std::size_t>(9 + rest_n + 8));
-  for (std::size_t i = 0; i < scene.size(); ++i) {
-    float* r = record.data();
-    for (int k = 0; k < 3; ++k) *r++ = scene.positions[i * 3 + k];
-    for (int k = 0; k < 3; ++k) *r++ = 0.0f;  // normals: unused by 3DGS
-    for (int k = 0; k < 3; ++k) *r++ = scene.sh_dc[i * 3 + k];
-    for (int ch = 0; ch < 3; ++ch)  // back to channel-major
-      for (int k = 0; k < per_channel; ++k)
-        *r++ = scene.sh_rest[i * rest_n + k * 3 + ch];
-    // Logit of the opacity, clamped so that 0 and 1 stay finite.
-    const double o = std::min(std::max(static_cast<double>(scene.opacities[i]), 1e-12), 1.0 - 1e-7);
-    *r++ = static_cast<float>(std::log(o / (1.0 - o)));
-    for (int k = 0; k < 3; ++k) *r++ = std::log(scene.scales[i * 3 + k]);
-    for (int k = 0; k < 4; ++k) *r++ = scene.rotations[i * 4 + k];
-    // The file format is little endian; so are all hosts we build for (x86-64, arm64).
-    file.write(reinterpret_cast<const char*>(record.data()),
-               static_cast<std::streamsize>(record.size() * sizeof(float)));
-  }
-  if (!file) throw Error(path + ": write error");
+  write_file_atomically(path, [&](OutputFile& file) {
+    file.write(header.str());
+    std::vector<float> record(static_cast<std::size_t>(9 + rest_n + 8));
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+      float* r = record.data();
+      for (int k = 0; k < 3; ++k) *r++ = scene.positions[i * 3 + k];
+      for (int k = 0; k < 3; ++k) *r++ = 0.0f;  // normals: unused by 3DGS
+      for (int k = 0; k < 3; ++k) *r++ = scene.sh_dc[i * 3 + k];
+      for (int ch = 0; ch < 3; ++ch)  // back to channel-major
+        for (int k = 0; k < per_channel; ++k)
+          *r++ = scene.sh_rest[i * rest_n + k * 3 + ch];
+      // Logit of the opacity, clamped so that 0 and 1 stay finite.
+      const double o = std::min(std::max(static_cast<double>(scene.opacities[i]), 1e-12), 1.0 - 1e-7);
+      *r++ = static_cast<float>(std::log(o / (1.0 - o)));
+      for (int k = 0; k < 3; ++k) *r++ = std::log(scene.scales[i * 3 + k]);
+      for (int k = 0; k < 4; ++k) *r++ = scene.rotations[i * 4 + k];
+      // The file format is little endian; so are all hosts we build for (x86-64, arm64).
+      file.write(record.data(), record.size() * sizeof(float));
+    }
+  });
 }
 
 }  // namespace flashgs

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <vector>
 
 #include "flashgs/error.h"
+#include "flashgs/file_write.h"
 #include "flashgs/model_constants.h"
 #include "flashgs/scene_formats.h"
 #include "format_readers.h"
@@ -69,8 +69,6 @@ Scene parse_splat(const char* data, std::size_t size, const std::string& name, L
 }
 
 void save_splat(const Scene& scene, const std::string& path) {
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw Error(path + ": cannot open for writing");
   std::vector<unsigned char> records(scene.size() * kRecordBytes);
   for (std::size_t i = 0; i < scene.size(); ++i) {
     unsigned char* record = records.data() + i * kRecordBytes;
@@ -84,8 +82,7 @@ void save_splat(const Scene& scene, const std::string& path) {
     record[kColourOffset + 3] = unit_to_byte(scene.opacities[i]);
     for (int k = 0; k < 4; ++k) record[kRotationOffset + k] = component_to_byte(scene.rotations[i * 4 + k]);
   }
-  file.write(reinterpret_cast<const char*>(records.data()), static_cast<std::streamsize>(records.size()));
-  if (!file) throw Error(path + ": write error");
+  write_file_atomically(path, [&](OutputFile& file) { file.write(records.data(), records.size()); });
 }
 
 }  // namespace flashgs

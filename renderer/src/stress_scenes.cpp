@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -15,6 +14,7 @@
 #include <unistd.h>
 
 #include "flashgs/error.h"
+#include "flashgs/file_write.h"
 #include "flashgs/gaussian_math.h"
 #include "flashgs/io.h"
 #include "flashgs/options.h"
@@ -571,11 +571,7 @@ LoadReport load_stress_scene(StressCase& c) {
   const auto path = std::filesystem::temp_directory_path() /
                     ("flashgs_stress_" + c.name + "_" + std::to_string(::getpid()) + "_" +
                      std::to_string(reinterpret_cast<std::uintptr_t>(&c)) + ".ply");
-  {
-    std::ofstream file(path, std::ios::binary);
-    if (!file) throw Error(path.string() + ": cannot write the stress scene");
-    file.write(c.raw_ply.data(), static_cast<std::streamsize>(c.raw_ply.size()));
-  }
+  write_file_atomically(path.string(), c.raw_ply);
   try {
     c.scene = load_ply(path.string(), &report);
   } catch (...) {

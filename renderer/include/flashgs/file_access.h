@@ -1,5 +1,6 @@
-// Checking and reading the files a user names, so that a folder, FIFO, device, symbolic-link
-// loop or oversized file gets one clear message and nothing ever blocks.
+// Checking and reading the files a user names, and checking the files a user asks to have
+// written, so that a folder, FIFO, device, symbolic-link loop or oversized file gets one clear
+// message and nothing ever blocks.
 #pragma once
 
 #include <cstddef>
@@ -21,6 +22,13 @@ PathKind path_kind(const std::string& path);
 // Throws flashgs::Error "<path>: ..." unless `path` names a regular file (after links):
 // folders, FIFOs, devices and sockets are refused without being opened.
 void check_regular_file(const std::string& path);
+
+// Throws flashgs::Error "<path>: ..." unless `path` may be written as an output file: a
+// regular file (after links) that may be written, or nothing yet, in a folder that exists and
+// may be written. Folders, FIFOs (opening one blocks until a reader comes), devices (a link to
+// /dev/full or /dev/null too), sockets, dangling links and link loops are refused without
+// being opened.
+void check_output_file(const std::string& path);
 
 // The whole content of the regular file at `path`, checked as above and opened without
 // blocking; throws flashgs::Error when it holds more than `max_bytes`. With `progress`, the

@@ -8,7 +8,8 @@
 namespace flashgs {
 
 // Writes `image` to `path`; the extension picks the format. 8-bit formats get values clamped
-// to [0, 1] and rounded; EXR/PFM keep the floats. Throws flashgs::Error on failure.
+// to [0, 1] and rounded; EXR/PFM keep the floats. Whole or not at all (write_file_atomically):
+// throws flashgs::Error naming `path` on failure, a refused path or a failed write.
 void write_image(const Image& image, const std::string& path);
 // Reads an image as float RGB (8-bit formats scaled to [0, 1]).
 Image read_image(const std::string& path);

@@ -39,7 +39,8 @@ Scene load_ply(const std::string& path, LoadReport* report = nullptr, LoadProgre
 // Same, from bytes in memory (`name` is used in messages). The fuzz test drives this.
 Scene parse_ply(const char* data, std::size_t size, const std::string& name,
                 LoadReport* report = nullptr, LoadProgress* progress = nullptr);
-// Writes the INRIA layout (binary little endian, logit opacity, log scales).
+// Writes the INRIA layout (binary little endian, logit opacity, log scales), whole or not at
+// all (write_file_atomically).
 void save_ply(const Scene& scene, const std::string& path);
 
 // Reads cameras.json (at most 64 MB, a regular file). Throws flashgs::Error on a missing file,
@@ -48,6 +49,7 @@ void save_ply(const Scene& scene, const std::string& path);
 std::vector<Camera> load_cameras(const std::string& path);
 // Parses the JSON text directly (`name` is used in messages).
 std::vector<Camera> parse_cameras(const std::string& json_text, const std::string& name);
+// Writes cameras.json, whole or not at all (write_file_atomically).
 void save_cameras(const std::vector<Camera>& cameras, const std::string& path);
 
 }  // namespace flashgs

@@ -7,6 +7,7 @@
 
 namespace flashgs {
 
+// The writers go through write_file_atomically: a file whole or not at all.
 void write_ppm(const Image& image, const std::string& path);  // clamped to [0, 1], rounded
 void write_pfm(const Image& image, const std::string& path);  // floats kept
 Image read_netpbm(const std::string& path);                   // P6 or PF

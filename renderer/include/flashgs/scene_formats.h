@@ -31,7 +31,8 @@ Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& n
 
 // Writes `scene` as .splat: 32-byte records of float position and scale, 8-bit RGBA (colour
 // 0.5 + SH_C0 * dc, clamped to [0, 1]; opacity) and 8-bit quaternion (q * 128 + 128, w x y z),
-// each byte rounded to the nearest. SH bands beyond degree 0 are not kept.
+// each byte rounded to the nearest. SH bands beyond degree 0 are not kept. Written whole or not
+// at all (write_file_atomically).
 void save_splat(const Scene& scene, const std::string& path);
 // The writer of the format `path`'s extension names: save_ply for .ply (INRIA PLY),
 // save_splat for .splat; null for any other extension.
