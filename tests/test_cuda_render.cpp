@@ -947,7 +947,7 @@ void check_fp16(const std::string& name, std::shared_ptr<const Scene> scene, con
 
 // The half blend (fp16_blend) changes only the blend's arithmetic: the same pairs and counts,
 // the same bytes twice and from a fresh renderer, an image within kFp16BlendMinPsnr of the
-// exact blend's (53.1 to 72.8 dB on the H200 in session 22, kacytran_try the lowest), and on
+// exact blend's (53.1 to 72.8 dB on an H200, 2026-12-04, kacytran_try the lowest), and on
 // the CPU, which does not honour it, exactly the CPU's flash image. Without the prefetch it is
 // the same kernel loop (the same bytes); without exp2 alpha or for the baseline it is ignored.
 constexpr double kFp16BlendMinPsnr = 45.0;

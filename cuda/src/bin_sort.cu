@@ -29,7 +29,7 @@ constexpr unsigned kNoBin = 0xffffffffu;
 // (CUB's block radix sort, 4 or 8 pairs per thread); a larger one sorts in global memory,
 // radix digits of 8 bits. At most 8 pairs per thread keep the kernel at 56 registers, so that
 // its blocks displace fewer of the blend's beside them (16 took 80 registers and made the
-// frame 10-18 us longer at 4K on the H200, docs/PERFORMANCE.md v27).
+// frame 10-18 us longer at 4K on the H200, docs/PERFORMANCE.md).
 constexpr int kSortWarps = 4;
 constexpr int kSortBlock = kSortWarps * kWarp;
 constexpr int kSmallItems = 4;
@@ -239,8 +239,8 @@ constexpr std::size_t counted_scatter_shared_bytes(unsigned bins) {
 
 // The scatter pass of frames whose emission counted the pairs per bin (bin_tally.cuh): no
 // counting pass, and no block that runs after all others to turn the counts into places (a
-// chain of loads and barriers on one block that took 6-10 us at 1080p, docs/PERFORMANCE.md v30
-// and v33). Each block scans the counts of every bin itself, block 0 writes the bin ranges,
+// chain of loads and barriers on one block that took 6-10 us at 1080p, docs/PERFORMANCE.md).
+// Each block scans the counts of every bin itself, block 0 writes the bin ranges,
 // and each chunk goes out as in bin_scatter_kernel, its places in a bin reserved with one
 // global atomic on the bin's fill (zero at the start).
 __global__ void __launch_bounds__(kPassBlock) bin_scatter_counted_kernel(

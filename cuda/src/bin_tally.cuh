@@ -2,7 +2,7 @@
 // (FrameBuffers::emitted_bin_counts): each block counts its pairs in shared memory and adds
 // its non-zero counts to the frame's once, so that no counting pass reads the pairs again.
 // A global atomic per pair would meet on the same words (a warp's pairs go to a few bins,
-// docs/PERFORMANCE.md v30 and v33); shared counts meet only within the block.
+// docs/PERFORMANCE.md); shared counts meet only within the block.
 #pragma once
 
 #include <cstdint>

@@ -242,7 +242,7 @@ __device__ __forceinline__ __half2 exp2_approx(__half2 x) {
 // and selects would cost a third more): a pixel whose T fell below the minimum goes on until
 // every pixel of its warp has, adding less than that T (1e-4) in all. On Hopper the f16x2 exp2
 // is two MUFU.EX2.F16 and a PRMT: about 19 instructions per Gaussian and lane against the
-// float loop's 29-35 (SASS of session 22), with the exp2 unit then nearly as busy as the issue.
+// float loop's 29-35 (from the SASS), with the exp2 unit then nearly as busy as the issue.
 __device__ __forceinline__ void blend_region_gaussian_half(const HalfRegionGaussian& g, __half2 lane_y,
                                                            __half2 lane_x, __half2 cut, __half2 alpha_max,
                                                            __half2& t, __half2& cr, __half2& cg, __half2& cb) {

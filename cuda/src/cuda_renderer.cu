@@ -304,7 +304,7 @@ class CudaRendererImpl final : public CudaRenderer {
     if (stride_vec4 > 0) new_rest.reserve(n * stride_vec4 * rest_group_bytes, "scene SH bands");
     new_chunks.reserve(std::max<std::size_t>(chunks, 1) * sizeof(cuda::ChunkBound), "scene chunk bounds");
     // A reordered scene is read in its stored order and scattered on the device: gathering it
-    // on the host cost ~0.1 s per million Gaussians (session 29).
+    // on the host cost ~0.1 s per million Gaussians.
     DeviceBuffer places, scatter_staging;  // during the upload only
     if (!order.empty()) {
       new_ids.reserve(n * sizeof(std::uint32_t), "scene order");
@@ -607,7 +607,7 @@ class CudaRendererImpl final : public CudaRenderer {
   }
 
   // Whether counting the pairs per bin in emission (FrameBuffers::emitted_bin_counts) pays over
-  // the counting pass. Measured on an H200 (docs/PERFORMANCE.md, v35): at 1080p (2,040 bins)
+  // the counting pass. Measured on an H200 (docs/PERFORMANCE.md): at 1080p (2,040 bins)
   // pc_playbot 0.280 -> 0.277-0.278 ms and pc_biker 0.190-0.192 -> 0.188-0.189; at 4K (8,160
   // bins) 0.589 -> 0.644-0.648 and 0.371-0.372 -> 0.391-0.392, where every scatter block scans
   // four times as many counts and every preprocess block clears and flushes four times as many.
@@ -640,12 +640,12 @@ class CudaRendererImpl final : public CudaRenderer {
   }
 
   // Whether sorting per bin (launch_bin_pairs, launch_bin_blocks) pays over CUB's radix sort of the whole frame.
-  // Measured on an H200 (docs/PERFORMANCE.md, v16 and v19): sort + ranges 18-41 us shorter at
+  // Measured on an H200 (docs/PERFORMANCE.md): sort + ranges 18-41 us shorter at
   // 1080p on pc_biker and pc_playbot (2,040 bins of 200-400 pairs); at 4K (8,160 bins), since
   // the bin blocks write their tile lists without idle groups, 7-31 us shorter on five real
-  // scenes (v19), with no wait for the host between emission and sort, but not for frames of
-  // frame-covering Gaussians (below, v20); 0.1 ms longer on 7 x pc_playbot at 1080p (about 700
-  // pairs per bin; bins of more than 2,048, since v27 1,024, sort in global memory). Judged on
+  // scenes, with no wait for the host between emission and sort, but not for frames of
+  // frame-covering Gaussians (below); 0.1 ms longer on 7 x pc_playbot at 1080p (about 700
+  // pairs per bin; bins of more than 1,024 sort in global memory). Judged on
   // the last frame's bin pairs and blend records: the emission that this decides comes before
   // this frame's count.
   bool bin_sort_pays(std::uint64_t bins) const {
@@ -662,7 +662,7 @@ class CudaRendererImpl final : public CudaRenderer {
   // Queues the read back of the frame's counters and the event the host waits for (kCounted):
   // on the frame's stream, or with `after` (the event of the work whose counts it reads) on a
   // stream of its own, so that the frame's next kernels do not wait for the copy (2-4 us a
-  // frame on the H200 machine, docs/PERFORMANCE.md v31). Later kernels of the frame write only
+  // frame on the H200 machine, docs/PERFORMANCE.md). Later kernels of the frame write only
   // counters that this read back is not used for, and the next frame resets them only after
   // the host has waited for it.
   void read_back_counts(const cuda::FrameBuffers& b, cudaEvent_t after) {
@@ -761,7 +761,7 @@ class CudaRendererImpl final : public CudaRenderer {
     int end_bit = 64;
     if (key_format_.depth_bits > 0) end_bit = tile_bits + key_format_.depth_bits;
     else if (f.baseline || options.minimal_sort_bits) end_bit = std::min(64, 32 + tile_bits);
-    // An event costs the GPU about a microsecond between kernels (v28): stages that meet with
+    // An event costs the GPU about a microsecond between kernels: stages that meet with
     // nothing between them share one.
     sort_follows_project_[event_set_] = f.sort_follows_project;
     if (!sort_follows_project_[event_set_]) check_cuda(cudaEventRecord(events[kSortBegin], stream_), "event record");
@@ -953,13 +953,13 @@ class CudaRendererImpl final : public CudaRenderer {
     cudaEvent_t* events = events_[event_set_];
     // The bin sort reads the pair count on the device, so a frame of fused emission queues
     // the rest of its work before the host waits for the count: the GPU then runs on instead
-    // of idling while the host reads the count and launches the sort (8-16 us a frame, v14).
+    // of idling while the host reads the count and launches the sort (8-16 us a frame).
     // Nothing it queues waits for the last frame's end (dense_order_pays reads a finished
     // frame's statistics), so frames queued back to back follow each other without a gap.
     const bool queue_before_count = bin_sort_frame_ && fused;
     // Such a frame that goes to the host (whose end the host waits for anyway) reads its counts
     // back at its end, after the blend: a copy between preprocess and sort kept the GPU idle
-    // for 15-25 us on the H200 machine (v22). A surface frame reads them back at once, so that
+    // for 15-25 us on the H200 machine. A surface frame reads them back at once, so that
     // the host can go on while the GPU blends.
     const bool count_at_end = queue_before_count && out;
     separate_emit_[event_set_] = !fused;
@@ -1095,7 +1095,7 @@ class CudaRendererImpl final : public CudaRenderer {
   // Spatial order pays in scenes of a few waves of preprocess blocks and more (pc_playbot in
   // random order: frames 8% / 6% shorter at 1080p / 4K; 10M Gaussians: 15% / 10%, the chunk
   // cull working again). Below, it gathers a small grid's heavy Gaussians into a few blocks
-  // (v3dg_donut, 45k: 3% / 2% longer on the H200, docs/PERFORMANCE.md v31).
+  // (v3dg_donut, 45k: 3% / 2% longer on the H200, docs/PERFORMANCE.md).
   static constexpr std::size_t kSpatialOrderMinGaussians = std::size_t{1} << 18;
   // Compact records a scene's first frame starts with (100 MB): a view of more Gaussians grows
   // them once and runs again.

@@ -542,7 +542,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
 // Blocks of fused preprocess an SM should hold: the kernel is latency-bound (1.2 eligible
 // warps per scheduler at 3 blocks of 80 registers, pc_playbot 1080p on an H200), and 4 blocks
 // (64 registers, a few bytes spilled) made the project stage up to 14 us shorter there
-// (docs/PERFORMANCE.md, v17). Degree 3 (108 registers unbounded) and the separate-emission
+// (docs/PERFORMANCE.md). Degree 3 (108 registers unbounded) and the separate-emission
 // kernel keep the compiler's choice.
 template <int DEGREE, bool FUSED>
 constexpr int kPreprocessBlocksPerSm = FUSED && DEGREE < 3 ? 4 : 1;
@@ -551,7 +551,7 @@ constexpr int kPreprocessBlocksPerSm = FUSED && DEGREE < 3 ? 4 : 1;
 // ran first): a grid over the listed chunks, every gridDim-th. COUNTED: the frame's pairs are
 // counted per bin (bin_tally.cuh; fused emission of a block's own chunk only). One instance of
 // the chunk's code per kernel: with both in one kernel the compiler spilled more, and the
-// project stage took 7-9 us longer on pc_playbot (docs/PERFORMANCE.md, v35).
+// project stage took 7-9 us longer on pc_playbot (docs/PERFORMANCE.md).
 template <int DEGREE, bool FUSED, bool LISTED, bool COUNTED>
 __global__ void __launch_bounds__(kBlock, kPreprocessBlocksPerSm<DEGREE, FUSED>)
     preprocess_kernel(DeviceScene scene, FrameBuffers buf, PreprocessArgs args) {

@@ -298,7 +298,7 @@ void blend_members(const MemberRecords& records, int slot_count, TileState& tile
     tile.slot_members[slot] = 0;
     // No early outs per visit (no lane above power_cut, a lane finishing): the masks below
     // make those lanes no-ops, and the branches mispredicted more than the work they saved
-    // (callgrind on pc_playbot, session 5: 29% fewer mispredicts for 5% more instructions).
+    // (callgrind on pc_playbot: 29% fewer mispredicts for 5% more instructions).
     for (; members != 0; members &= members - 1u) {
       const std::size_t j = hwy::Num0BitsBelowLS1Bit_Nonzero32(members);
       const auto dx = hn::Sub(x, hn::Set(d, centre_row[j]));

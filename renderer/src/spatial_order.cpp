@@ -15,7 +15,7 @@ namespace {
 
 // The order's grid: 128^3 cells. With 64^3, 200 shuffled copies of pc_playbot side by side
 // (100M) kept cells of ~1/4 of a copy across, and their project stage took 0.44 ms against 0.31
-// in PlayCanvas's own order (0.37 with 128^3; PERFORMANCE.md v32).
+// in PlayCanvas's own order (0.37 with 128^3; docs/PERFORMANCE.md).
 constexpr int kCellBits = 7;
 constexpr int kCellsPerAxis = 1 << kCellBits;
 constexpr std::uint32_t kCells = 1u << (3 * kCellBits);
@@ -36,7 +36,7 @@ constexpr int kCompactSpan = 8;
 // stored ones. Small scenes (v3dg_donut, 45k Gaussians; kacytran_try, 9k) are sparse in the
 // grid, so even ordered runs span 15-20 cells; comparing with random pairs' distance instead
 // took shuffled scenes copied side by side for coherent once the copies were many (200 x
-// pc_playbot: project 0.97 ms against 0.31, PERFORMANCE.md v32).
+// pc_playbot: project 0.97 ms against 0.31, docs/PERFORMANCE.md).
 constexpr int kGainFactor = 2;
 
 bool finite_position(const Scene& scene, std::size_t i) {

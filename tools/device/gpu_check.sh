@@ -93,7 +93,7 @@ tests() {  # GPU_TEST_FILTER: a gtest filter (default: every test but the saniti
 }
 
 sanitize() {  # SANITIZERS: the compute-sanitizer tools (default memcheck racecheck; racecheck of every kernel
-  # outgrew 300 s in session 22: RACECHECK_KERNELS="blend_warp_tile preprocess" checks, one run each, only the
+  # outgrew 300 s on an H200: RACECHECK_KERNELS="blend_warp_tile preprocess" checks, one run each, only the
   # kernels whose names hold one of those texts, the others run unchecked at full speed, ~2 minutes a run;
   # SANITIZER_TIMEOUT, default 300 s a run)
   export FLASHGS_SANITIZER_SCENE=pc_biker

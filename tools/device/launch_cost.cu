@@ -1,4 +1,4 @@
-// What a frame's first launches cost the host and the GPU, on the device machine (v22 found the
+// What a frame's first launches cost the host and the GPU, on the GPU machine (it found the
 // first kernel launch of each frame taking 12-25 us of host time, later ones 5-10 us). Each mode
 // runs 50 "frames" from an idle GPU, as `flashgs bench` does, and prints the median host time
 // of each call; run it under gpu_trace.cpp (gpu_check.sh step launch-cost) for the GPU side.

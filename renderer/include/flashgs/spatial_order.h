@@ -3,7 +3,7 @@
 // counting and scatter passes write runs into each bin rather than a word here and there, and
 // the chunk cull sees compact chunks. Scenes in the PlayCanvas formats are stored that way
 // already; raw training output is not (pc_playbot in random order: frames 7-10% longer on the
-// H200, docs/PERFORMANCE.md v31).
+// H200, docs/PERFORMANCE.md).
 #pragma once
 
 #include <cstdint>
