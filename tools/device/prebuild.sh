@@ -3,7 +3,7 @@
 # into .deps/bin, xz-compressed, with the libraries they need beyond the C library in .deps/lib
 # and the sources' stamp (source_stamp.sh). `gpu_check.sh setup` then runs them instead of
 # building, when the stamp matches the tree it runs on and they start there.
-# Run it in the checkout that the device tool sends (not a git worktree elsewhere): the tests
+# Run it in the checkout sent to the GPU machine (not a git worktree elsewhere): the tests
 # keep the source tree's absolute paths (the demo scene, ../shared/scenes), and the device
 # machine has the tree at the same path; binaries built in /tmp/wt failed every scene test.
 set -euo pipefail

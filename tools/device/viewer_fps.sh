@@ -24,7 +24,7 @@
 #     cp -L /usr/lib/x86_64-linux-gnu/libhwy.so.1 .devgl/lib/    # Highway (the CPU blend's SIMD dispatch)
 # The call sends at most 64 MiB in all: debs + binary + the working tree must fit. They may not
 # (debs ~60 MiB, tree ~4-8 MiB, binary ~3 MiB). Carried paths that a later call does not name
-# stay on a warm machine (so the device tool says; not tried here), so the carry can be split
+# stay on a warm machine (not tried here), so the carry can be split
 # over two calls on the same machine:
 #   1) carry [".devgl/debs/xroot"] with command "true"   (Xvfb + Mesa: the bulk)
 #   2) carry [".devgl/debs/gl", ".devgl/debs/client", ".devgl/device-gl", ".devgl/bin", ".devgl/lib"]
