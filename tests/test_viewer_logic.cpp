@@ -609,6 +609,24 @@ TEST(ViewerNavigation, ObjectScenesOrbitAndRoomsFly) {
   // The same cameras inside a room of extent 10: fly.
   EXPECT_FALSE(fv::is_object_sized(glm::vec3(0.5f, -0.2f, 1.0f), 10.0f, orbit(12)));
   EXPECT_TRUE(fv::is_object_sized(glm::vec3(0), 1.0f, {}));
+  // Cameras within the object's extent (0.8 of it) that look at it: still an object...
+  const float target[3] = {0.5f, -0.2f, 1.0f}, up[3] = {0.0f, 1.0f, 0.0f};
+  const auto close = flashgs::make_orbit_cameras(target, up, 3.0f, 1.0f, 12, 1920, 1080, 60.0f);
+  EXPECT_TRUE(fv::is_object_sized(glm::vec3(0.5f, -0.2f, 1.0f), 3.0f / 0.8f, close));
+  // ...but the same cameras turned to look outward stand inside a space.
+  std::vector<flashgs::Camera> outward = close;
+  for (flashgs::Camera& c : outward)
+    for (int k = 0; k < 3; ++k) c.rotation[k] = -c.rotation[k], c.rotation[6 + k] = -c.rotation[6 + k];
+  EXPECT_FALSE(fv::is_object_sized(glm::vec3(0.5f, -0.2f, 1.0f), 3.0f / 0.8f, outward));
+}
+
+// Every shared scene is a scan of an object seen from around: it opens in orbit navigation.
+TEST(ViewerNavigation, TheSharedObjectScansOpenInOrbit) {
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  for (const std::string& name : flashgs::test::shared_scene_names()) {
+    const fv::LoadedScene scene = fv::load_scene(flashgs::test::shared_scene_dir(name) + "/point_cloud.ply");
+    EXPECT_TRUE(fv::is_object_sized(scene.centre, scene.extent, scene.cameras)) << name;
+  }
 }
 
 TEST(ViewerHeatmap, LegendTicksAreRoundValuesAtTheirPlaceOnTheScale) {

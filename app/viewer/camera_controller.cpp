@@ -218,10 +218,22 @@ void CameraController::frame_scene(float fov_x_degrees, float aspect) {
 
 bool is_object_sized(const glm::vec3& centre, float extent, const std::vector<Camera>& cameras) {
   if (cameras.empty()) return true;
-  std::size_t outside = 0;
-  for (const Camera& c : cameras)
-    outside += glm::length(glm::vec3(c.position[0], c.position[1], c.position[2]) - centre) > 1.5f * extent;
-  return 2 * outside > cameras.size();
+  // A capture of an object looks at it from around, often from within its own extent (the
+  // shared scans' cameras stand 0.65-1.07 extents from the centre): cameras that look at the
+  // centre from beyond half an extent, or that stand far outside it.
+  const float cos_converging = std::cos(30.0f * float(M_PI / 180.0));
+  std::size_t looking_in = 0, far_outside = 0;
+  for (const Camera& c : cameras) {
+    const glm::vec3 position(c.position[0], c.position[1], c.position[2]);
+    const glm::vec3 to_centre = centre - position;
+    const float distance = glm::length(to_centre);
+    // The view axis in the world: the third row of the world-to-camera rotation.
+    const glm::vec3 forward(c.rotation[6], c.rotation[7], c.rotation[8]);
+    const bool converging = distance > 0.5f * extent && glm::dot(forward, to_centre) > cos_converging * distance;
+    looking_in += converging;
+    far_outside += distance > 1.5f * extent;
+  }
+  return 3 * looking_in >= 2 * cameras.size() || 2 * far_outside > cameras.size();
 }
 
 bool CameraController::exact_scene_camera(int width, int height, float fov_x_degrees) const {

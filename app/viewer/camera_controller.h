@@ -84,7 +84,8 @@ NavigationInput sanitized(const NavigationInput& input);
 bool is_finite(const Pose& pose);
 
 // Whether a scene is an object seen from around (orbit navigation suits it) rather than a
-// space the cameras stand inside (fly): most cameras farther from `centre` than 1.5 extents.
+// space the cameras stand inside (fly): two thirds of the cameras look at `centre` (within 30
+// degrees) from beyond half an extent, or most stand farther than 1.5 extents from it.
 // Without cameras, an object (generated or single-object scenes).
 bool is_object_sized(const glm::vec3& centre, float extent, const std::vector<Camera>& cameras);
 

@@ -44,7 +44,7 @@ void ViewerApp::install_scene(LoadedScene scene) {
     const bool object = is_object_sized(m_scene.centre, m_scene.extent, m_scene.cameras);
     m_settings.mode = object ? NavigationMode::orbit : NavigationMode::fly;
     std::fprintf(stderr, "flashgs-viewer: navigation: %s (%s)\n", object ? "orbit" : "fly",
-                 object ? "the cameras look at the scene from outside it" : "the cameras stand inside the scene");
+                 object ? "the cameras look at the scene from around it" : "the cameras stand inside the scene");
   }
   // The kernel the scene was trained with, unless --kernel chose one for every scene.
   m_settings.options.kernel = m_args.kernel.resolve(*m_scene.scene);
