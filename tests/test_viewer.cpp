@@ -661,7 +661,7 @@ TEST(Viewer, CtrlOOpensTheSceneChosenInTheDesktopDialog) {
 }
 
 // F1 opens the shortcut table, Tab hides the panels (the window then shows the help and the
-// hint only), Esc quits with exit status 0.
+// hint only), a first Esc asks and a second quits with exit status 0.
 TEST(Viewer, F1ShowsHelpTabHidesThePanelsAndEscQuits) {
 #ifndef FLASHGS_X11_INPUT
   GTEST_SKIP() << "built without libXtst: the input helper is absent";
@@ -672,15 +672,40 @@ TEST(Viewer, F1ShowsHelpTabHidesThePanelsAndEscQuits) {
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
                             "[ $status -eq 0 ] && { hold F1 \" key290 \" && wait_for \"help shown (F1)\" || status=11; }\n"
                             "[ $status -eq 0 ] && { hold Tab \" key258 \" && wait_for \"panels hidden (Tab)\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { hold Escape \" key256 \" && wait_for \"press Esc again to quit\" || status=16; }\n"
+                            "[ $status -eq 0 ] && { kill -0 $pid 2>/dev/null || status=17; }\n"
                             "[ $status -eq 0 ] && { \"$input\" down Escape; \"$input\" up Escape; "
                             "for _ in $(seq 1 1200); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done; "
                             "if kill -0 $pid 2>/dev/null; then status=15; else wait $pid; exit_status=$?; closed=1; fi; }\n"
                             "[ $status -eq 0 ] && [ \"$exit_status\" != 0 ] && status=14\n";
   const RunResult r = run_live_viewer(prefix, "help_keys", "--backend cpu --size 800x450 --log-input", steps, 13);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
-                            << " failed (10 start, 11 no help, 12 panels not hidden, 13 crash, 14 exit status, 15 Esc did not quit)\n"
+                            << " failed (10 start, 11 no help, 12 panels not hidden, 13 crash, 14 exit status, 15 the second "
+                               "Esc did not quit, 16 the first Esc did not ask, 17 the first Esc quit)\n"
                             << r.output;
   EXPECT_NE(r.output.find("quit (Esc / Ctrl+Q)"), std::string::npos) << r.output;
+#endif
+}
+
+// Esc with a combo's list open closes the list, and neither quits nor asks to quit.
+TEST(Viewer, EscClosesAnOpenComboFirst) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string steps =
+      "wait_for \"first frame shown\" || status=10\n"
+      "[ $status -eq 0 ] && { click \"Kernel (K)\" || status=11; }\n"
+      "[ $status -eq 0 ] && { hold Escape \" key256 \" && wait_for \"popup closed (Esc)\" || status=12; }\n"
+      "[ $status -eq 0 ] && { grep -q \"press Esc again\" \"$log\" && status=13; }\n"
+      "[ $status -eq 0 ] && { kill -0 $pid 2>/dev/null || status=15; }\n"
+      "[ $status -eq 0 ] && { close_window || status=16; }\n";
+  const RunResult r = run_live_viewer(prefix, "esc_combo", "--backend cpu --size 1280x800 --log-input", steps, 14);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 click, 12 Esc did not close the list, 13 Esc asked to quit, "
+                               "14 crash, 15 Esc quit, 16 close)\n"
+                            << r.output;
 #endif
 }
 

@@ -31,7 +31,8 @@ inline constexpr Shortcut kShortcuts[] = {
     {"Ctrl+O, or drop a file", "open a scene (PLY, folder or 3DGS output)"},
     {"Tab", "hide / show the panels"},
     {"F1", "this help"},
-    {"Esc, Ctrl+Q", "quit"},
+    {"Esc", "close an open list; else asks, and Esc again quits"},
+    {"Ctrl+Q", "quit"},
 };
 
 // The help window while `*open`; its close button clears it.

@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include <imgui.h>
+#include <imgui_internal.h>  // ClosePopupToLevel: closing popups from outside their window
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #define GLFW_INCLUDE_NONE
@@ -106,5 +107,11 @@ void ImGuiLayer::end_frame() {
 bool ImGuiLayer::wants_mouse() const { return ImGui::GetIO().WantCaptureMouse; }
 bool ImGuiLayer::wants_keyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
 bool ImGuiLayer::widget_held() const { return ImGui::IsAnyItemActive(); }
+
+bool ImGuiLayer::close_popups() {
+  if (!ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId | ImGuiPopupFlags_AnyPopupLevel)) return false;
+  ImGui::ClosePopupToLevel(0, true);
+  return true;
+}
 
 }  // namespace flashgs::viewer

@@ -25,6 +25,8 @@ class ImGuiLayer {
   bool wants_keyboard() const;
   // A widget is held this frame (a slider or drag box being dragged, a field being edited).
   bool widget_held() const;
+  // Closes every open popup (a combo's list, the recent scenes); whether one was open.
+  bool close_popups();
 
  private:
   void update_platform_inputs();

@@ -279,10 +279,14 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   }
   if (pressed(GLFW_KEY_F)) actions.frame_scene = true;
   if (pressed(GLFW_KEY_G)) m_settings.show_grid = !m_settings.show_grid;
-  if (pressed(GLFW_KEY_ESCAPE) || (pressed(GLFW_KEY_Q) && (mods & GLFW_MOD_CONTROL))) {
-    std::fprintf(stderr, "flashgs-viewer: quit (Esc / Ctrl+Q)\n");
-    m_window->request_close();
-  }
+  // Any other key or a click takes back a first Esc (see handle_escape).
+  if (std::any_of(presses.begin(), presses.end(), [](const KeyPress& p) { return p.key != GLFW_KEY_ESCAPE; }) ||
+      m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT) || m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT))
+    m_quit_armed = false;
+  if (pressed(GLFW_KEY_Q) && (mods & GLFW_MOD_CONTROL)) quit_now();
+  // Esc reaches an open popup however ImGui holds the keyboard; otherwise only a free keyboard's.
+  if (std::any_of(presses.begin(), presses.end(), [](const KeyPress& p) { return p.key == GLFW_KEY_ESCAPE; }))
+    handle_escape(keys_free);
   if (pressed(GLFW_KEY_O) && (mods & GLFW_MOD_CONTROL)) actions.open_dialog = true;
   if (pressed(GLFW_KEY_F12)) {
     if (mods & GLFW_MOD_SHIFT) m_pending_window_shot = next_screenshot_path(m_settings.screenshot_folder, "window");
@@ -715,6 +719,26 @@ void ViewerApp::log_option_changes() {
   m_logged_options = m_settings.options;
   m_have_logged_options = true;
   std::fprintf(stderr, "flashgs-viewer: options: %s\n", m_settings.options.label().c_str());
+}
+
+void ViewerApp::quit_now() {
+  std::fprintf(stderr, "flashgs-viewer: quit (Esc / Ctrl+Q)\n");
+  m_window->request_close();
+}
+
+// Esc first closes an open popup; with none open, it asks, and the next Esc quits. One press
+// alone ended the session at once, also while a combo was open or an export ran.
+void ViewerApp::handle_escape(bool keys_free) {
+  if (m_ui && m_ui->close_popups()) {
+    std::fprintf(stderr, "flashgs-viewer: popup closed (Esc)\n");
+    return;
+  }
+  if (!keys_free) return;  // a text field's: ImGui leaves it
+  if (m_quit_armed) return quit_now();
+  m_quit_armed = true;
+  m_status.clear();  // the request is logged again each time it is made
+  set_notice(m_export.active() ? "press Esc again to quit (the path export in progress stops)"
+                               : "press Esc again to quit, any other key to stay");
 }
 
 void ViewerApp::set_notice(const std::string& message) {

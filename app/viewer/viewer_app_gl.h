@@ -84,6 +84,9 @@ class ViewerApp {
   void choose_render_size(int wanted_width, int wanted_height, int* width, int* height);
   void render_failed(int width, int height, const std::string& why);
   void set_notice(const std::string& message);  // logged once and shown in the panel
+  void handle_escape(bool keys_free);
+  void quit_now();
+  bool m_quit_armed = false;  // a first Esc asked whether to quit
   void log_option_changes();
   void log_held_input();  // --log-input
   void ensure_texture(int width, int height);

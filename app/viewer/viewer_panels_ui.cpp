@@ -135,6 +135,7 @@ void kernel_combo(const UiModel& m, ViewerSettings& s) {
       if (ImGui::Selectable(name(k).c_str(), k == s.options.kernel)) s.options.kernel = k;
     ImGui::EndCombo();
   }
+  note_widget_place("Kernel (K)");
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("the footprint model: classic 3DGS, or the anti-aliased kernel of gsplat (eps 0.3) and "
                       "Mip-Splatting (eps 0.1),\nwhich scales opacity by sqrt(det S / det(S + eps I)).\n"
