@@ -197,6 +197,70 @@ TEST(CliOptions, CameraListsAreCheckedAgainstTheFile) {
   EXPECT_FALSE(fs::exists(dir + "/r.png"));
 }
 
+// CLI11 read "" as 0 and "0x1" as 1, and dropped empty list items: each rendered or swept
+// a camera the user did not name instead of saying what is wrong with the value.
+TEST(CliOptions, IntegersListsAndSizesAreStrict) {
+  const std::string dir = scratch_dir("strict_values");
+  const std::string quick = " --backend cpu -r 32x18 ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"render -r 32x18 -o " + dir + "/r.ppm -c ''", "--camera: the value is empty"},
+      {"render -r 32x18 -o " + dir + "/r.ppm -c 0x1", "--camera: \"0x1\" is not a whole number"},
+      {"render -r 32x18 -o " + dir + "/r.ppm -c ' 1'", "--camera: \" 1\" is not a whole number"},
+      {"render -o " + dir + "/r.ppm -r ''", "--resolution: the value is empty; expected WxH"},
+      {"render -r 32x18 -o " + dir + "/r.ppm --repeat 1e1", "--repeat: \"1e1\" is not a whole number"},
+      {"report --camera-list 0,,1" + quick + "-o " + dir, "--camera-list: item 2 of \"0,,1\" is empty"},
+      {"report --camera-list ''" + quick + "-o " + dir, "--camera-list: the list is empty"},
+      {"report --camera-list 0,1," + quick + "-o " + dir, "--camera-list: item 3 of \"0,1,\" is empty"},
+      {"bench --camera-list 0,,1" + quick + "--json " + dir + "/b.json", "--camera-list: item 2 of \"0,,1\" is empty"},
+      {"generate demo --count 0x10 -o " + dir, "--count: \"0x10\" is not a whole number"},
+  };
+  for (const auto& [arguments, fragment] : cases) expect_one_line_error(run_cli(arguments), fragment, arguments);
+  EXPECT_FALSE(fs::exists(dir + "/r.ppm"));
+  EXPECT_FALSE(fs::exists(dir + "/report.csv"));
+  EXPECT_FALSE(fs::exists(dir + "/point_cloud.ply"));
+}
+
+// The range of a coordinate option is float's: printed in full it was dozens of digits.
+TEST(CliOptions, RangeTextIsShort) {
+  const CliResult r = run_cli("render -r 32x18 -o " + scratch_dir("range_text") + "/r.ppm --eye 1e300,0,0 --look-at 0,0,1");
+  expect_one_line_error(r, "--eye: 1e300 is outside [-3.4e+38, 3.4e+38]", "--eye 1e300");
+  EXPECT_LT(r.output.size(), 120u) << r.output;
+}
+
+// What the user typed comes back in messages: an escape sequence in it must not reach the
+// terminal as one.
+TEST(CliOptions, ControlBytesInValuesAreEscaped) {
+  const std::string dir = scratch_dir("control_bytes");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"render --backend '\x1b[31mx' -o " + dir + "/r.ppm", "--backend: \\x1b[31mx"},
+      {"render --tau '\x1b[2J' -o " + dir + "/r.ppm", "\"\\x1b[2J\" is not a number"},
+      {"render -c '1\x1b' -o " + dir + "/r.ppm", "\"1\\x1b\" is not a whole number"},
+      {"info '" + dir + "/\x1b[2Jmissing.ply'", "/\\x1b[2Jmissing.ply: cannot open"},
+  };
+  for (const auto& [arguments, fragment] : cases) {
+    const CliResult r = run_cli(arguments);
+    expect_one_line_error(r, fragment, arguments);
+    EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << arguments;
+  }
+}
+
+// report and generate made their output folder first and left it behind when the scene or
+// the input then failed.
+TEST(CliOutputs, AFailedCommandLeavesNoFolderOfItsOwn) {
+  const std::string dir = scratch_dir("no_folder_left");
+  expect_one_line_error(run_cli("report " + dir + "/missing.ply --backend cpu -r 32x18 -o " + dir + "/rep/sub"),
+                        "missing.ply: cannot open", "report of a missing scene");
+  EXPECT_FALSE(fs::exists(dir + "/rep"));
+  expect_one_line_error(run_cli("generate tile -i " + dir + "/missing.ply -o " + dir + "/gen"),
+                        "missing.ply: cannot open", "tile of a missing scene");
+  EXPECT_FALSE(fs::exists(dir + "/gen"));
+  // A folder that was there before stays, and so does one the command filled.
+  fs::create_directories(dir + "/kept");
+  expect_one_line_error(run_cli("generate tile -i " + dir + "/missing.ply -o " + dir + "/kept"),
+                        "missing.ply: cannot open", "tile into a folder that exists");
+  EXPECT_TRUE(fs::is_directory(dir + "/kept"));
+}
+
 // The demo scene at 51200x28800: 17.7 GB of image alone. Under a 2 GB address-space limit
 // the frame is refused before rendering, with the estimate and what is available (it was a
 // std::bad_alloc inside an OpenMP region: std::terminate, SIGABRT).

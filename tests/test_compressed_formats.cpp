@@ -16,6 +16,7 @@
 #include "flashgs/file_access.h"
 #include "flashgs/io.h"
 #include "flashgs/renderer.h"
+#include "flashgs/scene_formats.h"
 #include "test_support.h"
 
 namespace flashgs {
@@ -549,6 +550,68 @@ TEST(SogLod, HostileLodMetaGetsOneClearMessage) {
   }
   std::ofstream(path) << good.dump();
   EXPECT_NE(error_of([&] { read_sog_lod(path, 1); }).find("level 1 does not exist"), std::string::npos);
+}
+
+// Writes `chunk` into `folder` as meta.json (with `meta_text` as its text) and its textures.
+void write_chunk(const fs::path& folder, const test::SogChunk& chunk, const std::string& meta_text) {
+  fs::create_directories(folder);
+  std::ofstream(folder / "meta.json") << meta_text;
+  for (const auto& [name, bytes] : chunk.files)
+    std::ofstream(folder / name, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// Recognition read the first 64 KB: a valid meta.json padded with whitespace, or a
+// lod-meta.json whose filenames list fills that much before "tree", was "not a scene file".
+TEST(SogRecognition, KeysPastTheFirst64KBAreFound) {
+  std::mt19937 rng(17);
+  const fs::path folder = fs::path(FLASHGS_TEST_OUTPUT_DIR) / "sog_long_json";
+  fs::remove_all(folder);
+  const test::SogChunk chunk = test::random_sog_chunk(40, 0, rng);
+  const std::string padded = "{" + std::string(70 << 10, ' ') + chunk.meta.dump().substr(1);
+  write_chunk(folder / "chunk", chunk, padded);
+  EXPECT_EQ(load_scene_file((folder / "chunk" / "meta.json").string()).size(), 40u);
+
+  // lod-meta.json's keys in nlohmann's order: filenames, lodLevels, tree.
+  const nlohmann::json lod = {
+      {"lodLevels", 1},
+      {"filenames", std::vector<std::string>(5002, "chunk/meta.json")},
+      {"tree", {{"lods", {{"0", {{"file", 0}, {"offset", 0}, {"count", 40}}}}}}}};
+  const std::string lod_text = lod.dump();
+  ASSERT_GT(lod_text.find("\"tree\""), std::size_t{64 << 10});
+  const std::string lod_path = (folder / "lod-meta.json").string();
+  std::ofstream(lod_path) << lod_text;
+  EXPECT_TRUE(is_sog_lod_set(lod_path));
+  EXPECT_EQ(load_scene_file(lod_path).size(), 40u);
+
+  // Anything else is still looked at no further than its start.
+  const std::string garbage = (folder / "garbage.json").string();
+  std::ofstream(garbage) << "{" << std::string(100 << 10, 'x');
+  EXPECT_NE(error_of([&] { load_scene_file(garbage); }).find("not a scene file"), std::string::npos);
+}
+
+// Texture and chunk names come from the JSON: an escape sequence in one reached the terminal
+// in the "cannot open" line.
+TEST(Sog, NamesFromTheJsonAreEscapedInMessages) {
+  std::mt19937 rng(19);
+  const fs::path folder = fs::path(FLASHGS_TEST_OUTPUT_DIR) / "sog_control_names";
+  fs::remove_all(folder);
+  test::SogChunk chunk = test::random_sog_chunk(30, 0, rng);
+  chunk.meta["quats"]["files"][0] = "\x1b[2Jquats.webp";
+  write_chunk(folder / "chunk", chunk, chunk.meta.dump());
+  const std::string texture = error_of([&] { load_scene_file((folder / "chunk" / "meta.json").string()); });
+  EXPECT_EQ(texture.find('\x1b'), std::string::npos) << texture;
+  EXPECT_NE(texture.find("\\x1b[2Jquats.webp: cannot open"), std::string::npos) << texture;
+
+  const nlohmann::json lod = {
+      {"lodLevels", 1},
+      {"filenames", {"\x1b]0;x\x07/meta.json"}},
+      {"tree", {{"lods", {{"0", {{"file", 0}, {"offset", 0}, {"count", 30}}}}}}}};
+  const std::string lod_path = (folder / "lod-meta.json").string();
+  std::ofstream(lod_path) << lod.dump();
+  const std::string chunk_name = error_of([&] { load_scene_file(lod_path); });
+  EXPECT_EQ(chunk_name.find('\x1b'), std::string::npos) << chunk_name;
+  EXPECT_EQ(chunk_name.find('\x07'), std::string::npos) << chunk_name;
+  EXPECT_NE(chunk_name.find("\\x1b]0;x\\x07/meta.json: cannot open"), std::string::npos) << chunk_name;
 }
 
 }  // namespace

@@ -9,8 +9,10 @@
 #include <fstream>
 #include <tuple>
 
+#include "flashgs/generators.h"
 #include "flashgs/error.h"
 #include "flashgs/io.h"
+#include "flashgs/scene_summary.h"
 #include "ply_builder.h"
 #include "test_support.h"
 
@@ -349,6 +351,27 @@ TEST(PrintableFileText, EscapesControlsAndInvalidUtf8KeepsTextAndUnicode) {
   EXPECT_EQ(printable_file_text(std::string("a\0\n\x1b\x7f", 5)), "a\\x00\\x0a\\x1b\\x7f");
   EXPECT_EQ(printable_file_text("\xc2\x85 \xff \xc3"), "\\xc2\\x85 \\xff \\xc3");  // C1 control, invalid bytes
   EXPECT_EQ(printable_file_text(std::string(100, 'z'), 10), "zzzzzzzzzz... (100 bytes)");
+}
+
+TEST(PrintableMessage, EscapesControlsButKeepsTheMessagesOwnQuotes) {
+  EXPECT_EQ(printable_message("--x: \"a\\b\" caf\xc3\xa9"), "--x: \"a\\b\" caf\xc3\xa9");
+  EXPECT_EQ(printable_message("--x: \"\x1b[2J\" \xff"), "--x: \"\\x1b[2J\" \\xff");
+  EXPECT_EQ(printable_message(std::string(500, 'y')), std::string(500, 'y'));  // not cut
+}
+
+// `flashgs info` lists the ignored properties by the names the header gives them: a name
+// holding an escape sequence drove the terminal.
+TEST(SceneSummary, IgnoredPropertyNamesAreEscaped) {
+  const Scene scene = make_demo_scene(10);
+  LoadReport report;
+  report.path = "scene\x1b]0;title\x07.ply";
+  report.ignored_properties = 2;
+  report.ignored_property_names = {"\x1b[31mred", "plain"};
+  const std::string summary = summarize_scene(scene, &report);
+  EXPECT_EQ(summary.find('\x1b'), std::string::npos) << summary;
+  EXPECT_EQ(summary.find('\x07'), std::string::npos) << summary;
+  EXPECT_NE(summary.find("(\\x1b[31mred, plain)"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("scene\\x1b]0;title\\x07.ply"), std::string::npos) << summary;
 }
 
 TEST(PlyMalformed, NotAPlyFile) { expect_error("hello world\n", "not a PLY file"); }

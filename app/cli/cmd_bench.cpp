@@ -30,7 +30,9 @@ struct BenchArgs {
   std::string backend = "auto";
   std::vector<std::string> resolutions = {"1920x1080", "3840x2160"};
   std::vector<std::string> configs = {"all"};
-  std::vector<int> cameras;  // empty: 0, 2, ..., 34 (the 18 views of ANCHORS.md)
+  std::string cameras_text;      // --camera-list as typed
+  CLI::Option* cameras_option = nullptr;
+  // not given: 0, 2, ..., 34 (the 18 views of ANCHORS.md)
   int threads = 0;                 // CPU backend: 0 = every core
   std::string cpu_blend = "simd";  // CPU backend: simd or scalar (the reference kernel)
   int warmup = 3;
@@ -145,10 +147,11 @@ void run(const BenchArgs& args) {
   }
   const std::string cameras_path = args.scene.resolved_cameras();
   const std::vector<Camera> all_cameras = load_cameras(cameras_path);
-  std::vector<int> camera_ids = args.cameras;
-  if (camera_ids.empty())
+  const bool listed = args.cameras_option->count() > 0;
+  std::vector<int> camera_ids = listed ? parse_index_list("--camera-list", args.cameras_text) : std::vector<int>{};
+  if (!listed)
     for (int i = 0; i <= 34; i += 2) camera_ids.push_back(i);
-  check_camera_indices(args.cameras.empty() ? "the default --camera-list" : "--camera-list", camera_ids,
+  check_camera_indices(listed ? "--camera-list" : "the default --camera-list", camera_ids,
                        all_cameras.size(), cameras_path);
   const CpuBlend cpu_blend = args.cpu_blend == "scalar" ? CpuBlend::scalar : CpuBlend::simd;
   auto probe = create_backend(args.backend, args.threads, cpu_blend);
@@ -340,18 +343,19 @@ void register_bench(CLI::App& app) {
   sub->add_option("--backend", args->backend, "cpu, cuda or auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
   sub->add_option("--resolutions,-r", args->resolutions, "WxH list (comma separated)")->delimiter(',');
   sub->add_option("--configs", args->configs, "all, or names:" + known_config_names())->delimiter(',');
-  sub->add_option("--camera-list", args->cameras, "camera indices (default 0,2,...,34)")->delimiter(',');
-  sub->add_option("--threads", args->threads, "CPU backend threads (0: every core)")->check(CLI::Range(0, 1024));
+  // Taken whole, not split by CLI11, which drops empty items ("0,,1" would pass as "0,1").
+  args->cameras_option = sub->add_option("--camera-list", args->cameras_text, "camera indices (default 0,2,...,34)");
+  sub->add_option("--threads", args->threads, "CPU backend threads (0: every core)")->check(whole_number())->check(CLI::Range(0, 1024));
   sub->add_option("--cpu-blend", args->cpu_blend, "CPU backend blend kernel: simd, or scalar (the reference)")
       ->check(CLI::IsMember({"simd", "scalar"}));
-  sub->add_option("--warmup", args->warmup, "untimed frames per camera and config")->check(CLI::NonNegativeNumber);
-  sub->add_option("--repeat", args->repeat, "timed frames per camera and config")->check(CLI::PositiveNumber);
+  sub->add_option("--warmup", args->warmup, "untimed frames per camera and config")->check(whole_number())->check(CLI::NonNegativeNumber);
+  sub->add_option("--repeat", args->repeat, "timed frames per camera and config")->check(whole_number())->check(CLI::PositiveNumber);
   sub->add_option("--frames", args->frames,
                   "queued (default: frames back to back, as the viewer renders them; GPU backends) or waited "
                   "(each frame downloaded and waited for, as render does)")
       ->check(CLI::IsMember({"queued", "waited"}));
   sub->add_option("--tile", args->copies, "render this many copies of the scene on a grid (scale runs)")
-      ->check(CLI::Range(1, 4096));
+      ->check(whole_number())->check(CLI::Range(1, 4096));
   sub->add_option("--json,-o", args->json_path, "JSON output file");
   args->kernel.add_to(sub);
   sub->callback([args] { run(*args); });

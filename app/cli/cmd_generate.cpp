@@ -31,8 +31,9 @@ namespace fs = std::filesystem;
 
 // Refuses, before any work, an output folder that already holds a scene (unless --force), or
 // whose scene files could not be written.
-void check_output_scene(const GenerateArgs& args) {
-  check_output_folder("--output", args.output_dir);
+// Returns the folders it created (check_output_folder).
+std::vector<std::string> check_output_scene(const GenerateArgs& args) {
+  const std::vector<std::string> created = check_output_folder("--output", args.output_dir);
   for (const char* name : {"point_cloud.ply", "cameras.json"}) {
     const fs::path existing = fs::path(args.output_dir) / name;
     check_output_file("--output", existing.string());
@@ -40,6 +41,7 @@ void check_output_scene(const GenerateArgs& args) {
       throw Error("--output " + args.output_dir + ": already holds " + existing.string() +
                   " (give --force to overwrite it)");
   }
+  return created;
 }
 
 void write_scene(const Scene& scene, const std::vector<Camera>& cameras, const std::string& dir) {
@@ -57,10 +59,7 @@ GenerateArgs with_kind(GenerateArgs args) {
   return args;
 }
 
-void run(const GenerateArgs& given) {
-  const GenerateArgs args = with_kind(given);
-  const bool lists_only = args.kind == "stress" && (args.list || args.stress.empty());
-  if (!lists_only && (args.kind == "demo" || args.kind == "tile" || args.kind == "stress")) check_output_scene(args);
+void generate(const GenerateArgs& args) {
   if (args.kind == "demo") {
     const Scene scene = make_demo_scene(args.count);
     const float target[3] = {0, 0.7f, 0}, up[3] = {0, 1, 0};  // the demo scene is y-up
@@ -105,6 +104,21 @@ void run(const GenerateArgs& given) {
   }
 }
 
+void run(const GenerateArgs& given) {
+  const GenerateArgs args = with_kind(given);
+  const bool lists_only = args.kind == "stress" && (args.list || args.stress.empty());
+  std::vector<std::string> created;
+  if (!lists_only && (args.kind == "demo" || args.kind == "tile" || args.kind == "stress"))
+    created = check_output_scene(args);
+  // A folder made here goes again when the input fails (a missing --input, an unknown case).
+  try {
+    generate(args);
+  } catch (...) {
+    remove_created_folders(created);
+    throw;
+  }
+}
+
 }  // namespace
 
 void register_generate(CLI::App& app) {
@@ -118,8 +132,8 @@ void register_generate(CLI::App& app) {
   sub->add_flag("--list", args->list, "stress: list the cases");
   sub->add_option("--output,-o", args->output_dir, "output folder");
   sub->add_option("--input,-i", args->input, "tile: the scene to copy");
-  sub->add_option("--copies,-n", args->copies, "tile: number of copies")->check(CLI::Range(1, 1024));
-  sub->add_option("--count", args->count, "demo: number of Gaussians")->check(CLI::Range(1, 200000000));
+  sub->add_option("--copies,-n", args->copies, "tile: number of copies")->check(whole_number())->check(CLI::Range(1, 1024));
+  sub->add_option("--count", args->count, "demo: number of Gaussians")->check(whole_number())->check(CLI::Range(1, 200000000));
   sub->add_flag("--force", args->force, "overwrite a scene already in the output folder");
   sub->callback([args] { run(*args); });
 }

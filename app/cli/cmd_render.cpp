@@ -54,7 +54,7 @@ void register_render(CLI::App& app) {
   command->render.add_to(sub);
   sub->add_option("--output,-o", command->output, "output image (the extension picks the format)");
   sub->add_option("--repeat", command->repeat, "render this many times (statistics of the last)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number())->check(CLI::PositiveNumber);
   sub->callback([command] { command->run(); });
 }
 

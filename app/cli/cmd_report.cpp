@@ -32,7 +32,8 @@ namespace {
 
 struct ReportArgs {
   SceneArgs scene;
-  std::vector<int> camera_list;  // empty: 0, 2, ..., 34 (as in ANCHORS.md)
+  std::string camera_list_text;  // --camera-list as typed
+  CLI::Option* camera_list_option = nullptr;
   int max_cameras = 0;      // 0: all of the list
   std::string resolution;
   int repeat = 3;
@@ -129,18 +130,17 @@ void replot(const ReportArgs& args) {
   }
 }
 
-void run(const ReportArgs& args) {
-  if (!args.replot.empty()) return replot(args);
-  // Everything that can be wrong with the arguments is found before the first frame.
-  check_output_folder("--output-dir", args.output_dir);
+// The report into the checked output folder.
+void measure(const ReportArgs& args) {
   for (const char* name : kReportFiles) check_output_file("--output-dir", args.output_dir + "/" + name);
   const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
   const std::string scene_path = args.scene.resolved_scene();
   auto scene = load_scene_verbose(scene_path, args.scene.lod);
   const std::string cameras_path = args.scene.resolved_cameras();
   const std::vector<Camera> all_cameras = load_cameras(cameras_path);
-  std::vector<int> kept = args.camera_list;
-  if (kept.empty()) {
+  const bool listed = args.camera_list_option->count() > 0;
+  std::vector<int> kept = listed ? parse_index_list("--camera-list", args.camera_list_text) : std::vector<int>{};
+  if (!listed) {
     // The default list (the views of ANCHORS.md), as far as the file has them.
     for (int i = 0; i <= 34 && i < static_cast<int>(all_cameras.size()); i += 2) kept.push_back(i);
     if (kept.empty()) throw Error(cameras_path + ": holds no camera");
@@ -309,6 +309,19 @@ void run(const ReportArgs& args) {
   std::printf("wrote %s.csv and %s.md\n", stem.c_str(), stem.c_str());
 }
 
+void run(const ReportArgs& args) {
+  if (!args.replot.empty()) return replot(args);
+  // Everything that can be wrong with the arguments is found before the first frame; a
+  // folder made for the report goes again when anything fails (a missing scene, a bad camera).
+  const std::vector<std::string> created = check_output_folder("--output-dir", args.output_dir);
+  try {
+    measure(args);
+  } catch (...) {
+    remove_created_folders(created);
+    throw;
+  }
+}
+
 }  // namespace
 
 void register_report(CLI::App& app) {
@@ -316,16 +329,18 @@ void register_report(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "report", "sweep configurations (error vs run time): CSV, Markdown table and SVG plot with the Pareto front");
   args->scene.add_to(sub);
-  sub->add_option("--camera-list", args->camera_list, "camera indices, e.g. 0,2,4 (default 0,2,...,34)")->delimiter(',');
+  // Taken whole, not split by CLI11, which drops empty items ("0,,1" would pass as "0,1").
+  args->camera_list_option =
+      sub->add_option("--camera-list", args->camera_list_text, "camera indices, e.g. 0,2,4 (default 0,2,...,34)");
   sub->add_option("--max-cameras", args->max_cameras, "use only the first N cameras of the list")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--resolution,-r", args->resolution, "render size WxH (field of view kept)");
-  sub->add_option("--repeat", args->repeat, "timed frames per camera (after one warm-up)")->check(CLI::Range(1, 1000));
+      ->check(whole_number())->check(CLI::NonNegativeNumber);
+  sub->add_option("--resolution,-r", args->resolution, "render size WxH (field of view kept)")->check(resolution_text());
+  sub->add_option("--repeat", args->repeat, "timed frames per camera (after one warm-up)")->check(whole_number())->check(CLI::Range(1, 1000));
   sub->add_option("--backend", args->backend, "all (every backend present), cpu or cuda")
       ->check(CLI::IsMember({"all", "cpu", "cuda"}));
-  sub->add_option("--ref-window", args->ref_window, "side of the fp64 reference windows (px)")->check(CLI::Range(1, 4096));
+  sub->add_option("--ref-window", args->ref_window, "side of the fp64 reference windows (px)")->check(whole_number())->check(CLI::Range(1, 4096));
   sub->add_option("--ref-cameras", args->ref_cameras, "cameras on which the fp64 reference is evaluated")
-      ->check(CLI::Range(0, 1000));
+      ->check(whole_number())->check(CLI::Range(0, 1000));
   sub->add_option("--output-dir,-o", args->output_dir, "folder for report.csv, report.md, report_<backend>.svg");
   sub->add_option("--title", args->title, "title of the table and plots (default: the scene's folder name)");
   sub->add_option("--replot", args->replot, "only redraw the SVG plot(s) from this report.csv (beside it)");

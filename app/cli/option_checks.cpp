@@ -20,6 +20,30 @@ namespace fs = std::filesystem;
 
 constexpr double kFloatMax = 3.4028234663852886e38;
 
+std::vector<int> parse_index_list(const std::string& option, const std::string& text) {
+  if (text.empty()) throw Error(option + ": the list is empty; expected indices such as 0,2,4");
+  std::vector<int> indices;
+  std::size_t begin = 0;
+  for (std::size_t i = 0; i <= text.size(); ++i) {
+    if (i < text.size() && text[i] != ',') continue;
+    const std::string item = text.substr(begin, i - begin);
+    if (item.empty())
+      throw Error(option + ": item " + std::to_string(indices.size() + 1) + " of \"" + printable_file_text(text) +
+                  "\" is empty");
+    if (item.find_first_not_of("0123456789") != std::string::npos || item.size() > 9)
+      throw Error(option + ": \"" + printable_file_text(item) + "\" is not a camera index (decimal digits only)");
+    indices.push_back(std::stoi(item));
+    begin = i + 1;
+  }
+  return indices;
+}
+
+CLI::Validator resolution_text() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string { return text.empty() ? "the value is empty; expected WxH" : ""; }, "WxH",
+      "WxH");
+}
+
 void check_camera_indices(const std::string& option, const std::vector<int>& indices, std::size_t count,
                           const std::string& cameras_path) {
   for (int i : indices)
@@ -44,13 +68,29 @@ void check_output_image(const std::string& option, const std::string& path) {
                 (image_io_has_oiio() ? std::string(".png, .exr, .jpg, .tif, ") : std::string()) + ".ppm or .pfm)");
 }
 
-void check_output_folder(const std::string& option, const std::string& dir) {
+std::vector<std::string> check_output_folder(const std::string& option, const std::string& dir) {
   if (dir.empty()) throw Error(option + ": the output folder is empty");
+  std::vector<std::string> created;  // what create_directories is about to make
   std::error_code ec;
+  for (fs::path p = fs::path(dir).lexically_normal(); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    created.insert(created.begin(), p.string());
+    if (p == p.parent_path()) break;
+  }
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
+  if (ec || !fs::is_directory(dir)) {
+    remove_created_folders(created);
     throw Error(option + " " + dir + ": cannot create the folder (" + ec.message() + ")");
-  if (access(dir.c_str(), W_OK) != 0) throw Error(option + " " + dir + ": the folder is not writable");
+  }
+  if (access(dir.c_str(), W_OK) != 0) {
+    remove_created_folders(created);
+    throw Error(option + " " + dir + ": the folder is not writable");
+  }
+  return created;
+}
+
+void remove_created_folders(const std::vector<std::string>& created) {
+  std::error_code ec;  // fs::remove leaves a folder that is not empty, and that is wanted
+  for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ec);
 }
 
 void check_frame_fits(const Renderer& renderer, const Camera& camera, std::size_t gaussians,

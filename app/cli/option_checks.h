@@ -16,6 +16,13 @@ namespace flashgs::cli {
 
 using flashgs::finite_in;  // app/common/finite_option.h
 
+// The indices of a comma-separated list such as "0,2,4", as typed after `option`: every item
+// decimal digits, none empty. Throws flashgs::Error naming the option otherwise.
+std::vector<int> parse_index_list(const std::string& option, const std::string& text);
+
+// CLI11 validator of a WxH option: an empty value is refused (it would mean "not given").
+CLI::Validator resolution_text();
+
 // Throws flashgs::Error naming `option` and `cameras_path` when an index is not a camera of
 // the file (which holds `count`).
 void check_camera_indices(const std::string& option, const std::vector<int>& indices, std::size_t count,
@@ -27,7 +34,11 @@ void check_output_file(const std::string& option, const std::string& path);
 // Same, and write_image knows the format of its extension.
 void check_output_image(const std::string& option, const std::string& path);
 // Creates the folder `dir` (given with `option`) if needed and checks that it is writable.
-void check_output_folder(const std::string& option, const std::string& dir);
+// Returns the folders it created, outermost first (none when `dir` existed).
+std::vector<std::string> check_output_folder(const std::string& option, const std::string& dir);
+// Removes those of `created` (check_output_folder's) that are still empty, innermost first, so
+// that a command that failed leaves no folder of its own behind.
+void remove_created_folders(const std::vector<std::string>& created);
 
 // Refuses (flashgs::Error naming the option) a frame of `camera` whose estimated working
 // memory on `renderer` exceeds what this process can still allocate; prints the estimate

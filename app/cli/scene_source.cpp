@@ -21,7 +21,7 @@ namespace flashgs::cli {
 void SceneArgs::add_to(CLI::App* command) {
   m_scene_option = command->add_option("scene", scene_path, kSceneArgumentHelp);
   m_cameras_option = command->add_option("--cameras", cameras_path, "cameras.json (default: the scene's own)");
-  command->add_option("--lod", lod, kLodOptionHelp)
+  command->add_option("--lod", lod, kLodOptionHelp)->check(whole_number())
       ->check(CLI::NonNegativeNumber);
 }
 
@@ -103,7 +103,7 @@ void RenderArgs::add_to(CLI::App* command) {
   command->add_option("--tau", tau, "alpha threshold of the opacity-aware extent")->check(finite_in(1e-6, 0.99));
   command->add_option("--background", background, "background colour r,g,b in [0, 1]")
       ->delimiter(',')->expected(3)->check(finite_in(0.0, 1.0));
-  command->add_option("--sh-degree", sh_degree, "use at most this many SH bands")->check(CLI::Range(0, 3));
+  command->add_option("--sh-degree", sh_degree, "use at most this many SH bands")->check(whole_number())->check(CLI::Range(0, 3));
   command->add_flag("--fp16-sh", fp16_sh, "use the SH coefficients as half values (not exact; see flashgs report)");
   command->add_flag("--fp16-shape", fp16_shape,
                     "use each Gaussian's rotation, scale and opacity as half values (not exact; see flashgs report)");
@@ -126,8 +126,8 @@ RenderOptions RenderArgs::options(const Scene& scene) const {
 }
 
 void CameraArgs::add_to(CLI::App* command) {
-  command->add_option("--camera,-c", index, "camera index in cameras.json");
-  command->add_option("--resolution,-r", resolution, "render size WxH (field of view kept)");
+  command->add_option("--camera,-c", index, "camera index in cameras.json")->check(whole_number());
+  command->add_option("--resolution,-r", resolution, "render size WxH (field of view kept)")->check(resolution_text());
   const CLI::Validator coordinate = finite_in(-kMaxCoordinate, kMaxCoordinate);
   auto* eye_option = command->add_option("--eye", eye, "explicit camera: position x,y,z")
       ->delimiter(',')->expected(3)->check(coordinate);

@@ -51,6 +51,20 @@ std::string printable_file_text(std::string_view text, std::size_t max_bytes) {
   return out;
 }
 
+std::string printable_message(std::string_view message) {
+  // Split at '"' and '\\', the only printable bytes printable_file_text changes; both are
+  // ASCII, so no UTF-8 sequence is cut.
+  std::string out;
+  std::size_t begin = 0;
+  for (std::size_t i = 0; i <= message.size(); ++i) {
+    if (i < message.size() && message[i] != '"' && message[i] != '\\') continue;
+    out += printable_file_text(message.substr(begin, i - begin), message.size() * 4 + 1);
+    if (i < message.size()) out += message[i];
+    begin = i + 1;
+  }
+  return out;
+}
+
 std::string error_text(const std::exception& e) {
   return dynamic_cast<const std::bad_alloc*>(&e) ? std::string("out of memory") : std::string(e.what());
 }

@@ -18,7 +18,10 @@
 namespace flashgs {
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const std::string& problem) { throw Error(path + ": " + problem); }
+// The name may come from a file (a texture or chunk named in JSON) or a user's argument.
+[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+  throw Error(printable_file_text(path, kMaxPrintedPathBytes) + ": " + problem);
+}
 
 // Why stat() or open() failed, in words.
 [[noreturn]] void fail_to_open(const std::string& path, int error) {

@@ -20,7 +20,8 @@
 namespace flashgs {
 namespace {
 
-// What a recogniser sees: the file's name and its first kStartBytes (all of them for small files).
+// What a recogniser sees: the file's name and its first kStartBytes (all of them for small
+// files; up to kMaxSogJsonBytes for a JSON object, see read_recognition_start).
 struct FileStart {
   const std::string& name;
   std::string_view bytes;
@@ -156,7 +157,10 @@ Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& n
                         LoadProgress* progress) {
   LoadReport local_report;
   if (!report) report = &local_report;
-  const FormatReader& reader = recognise({name, std::string_view(data, std::min(size, kStartBytes))});
+  // A JSON object may hold its keys past kStartBytes; its bytes are already in memory.
+  const std::size_t start_size =
+      may_be_json_object(std::string_view(data, std::min(size, kStartBytes))) ? kMaxSogJsonBytes : kStartBytes;
+  const FormatReader& reader = recognise({name, std::string_view(data, std::min(size, start_size))});
   if (!reader.parse)
     throw Error(name + ": " + format_name(reader.format) + " reads the files beside this one: open it by its path");
   const auto began = std::chrono::steady_clock::now();
@@ -170,7 +174,7 @@ Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress*
   LoadReport local_report;
   if (!report) report = &local_report;
   // Recognised from its start first: a file of no known format is not read whole.
-  const std::vector<char> start = read_file_start(path, kStartBytes);
+  const std::vector<char> start = read_recognition_start(path, kStartBytes);
   const FormatReader& reader = recognise({path, std::string_view(start.data(), start.size())});
   const auto began = std::chrono::steady_clock::now();
   if (reader.read) {  // reading and decoding interleave: all of it counts as decoding

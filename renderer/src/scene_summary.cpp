@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "flashgs/error.h"
 #include "flashgs/generators.h"
 
 namespace flashgs {
@@ -31,7 +32,7 @@ std::string kernel_summary(const TrainedKernel& kernel) {
 std::string summarize_scene(const Scene& scene, const LoadReport* report) {
   std::ostringstream out;
   const std::size_t n = scene.size();
-  if (report) out << "file:            " << report->path << "\n";
+  if (report) out << "file:            " << printable_file_text(report->path, kMaxPrintedPathBytes) << "\n";
   if (report && !report->format.empty()) {
     char times[120];
     std::snprintf(times, sizeof times, "read %.3f s, decoded in %.3f s\n", report->read_seconds,
@@ -74,7 +75,7 @@ std::string summarize_scene(const Scene& scene, const LoadReport* report) {
     out << "repaired:        " << report->repaired_zero_quaternion << " zero quaternions set to identity\n";
     out << "ignored:         " << report->ignored_properties << " properties";
     for (std::size_t i = 0; i < report->ignored_property_names.size() && i < 8; ++i)
-      out << (i ? ", " : " (") << report->ignored_property_names[i];
+      out << (i ? ", " : " (") << printable_file_text(report->ignored_property_names[i]);  // names from the header
     if (!report->ignored_property_names.empty()) out << (report->ignored_property_names.size() > 8 ? ", ...)" : ")");
     out << "\n";
   }

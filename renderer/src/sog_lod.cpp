@@ -24,7 +24,10 @@ constexpr int kMaxLevels = 32;
 constexpr int kMaxTreeDepth = 64;
 constexpr std::size_t kMaxFileNameBytes = 1024;
 
-[[noreturn]] void fail(const std::string& name, const std::string& problem) { throw Error(name + ": " + problem); }
+// The name may come from a file (a texture or chunk named in JSON) or a user's argument.
+[[noreturn]] void fail(const std::string& name, const std::string& problem) {
+  throw Error(printable_file_text(name, kMaxPrintedPathBytes) + ": " + problem);
+}
 
 // One leaf's share of a level: Gaussians [offset, offset + count) of chunk `file`.
 struct Range {
@@ -91,7 +94,7 @@ void walk(const json& node, int depth, LodMeta& meta, const std::string& name) {
       fail(name, "a tree leaf names level \"" + printable_file_text(key) + "\"; lodLevels is " +
                      std::to_string(meta.levels.size()));
     if (!entry.is_object() || !entry.contains("file") || !entry.contains("offset") || !entry.contains("count"))
-      fail(name, "a tree leaf's level " + key + " lacks file, offset or count");
+      fail(name, "a tree leaf's level " + printable_file_text(key) + " lacks file, offset or count");
     Range range;
     range.file = static_cast<int>(whole(entry.at("file"), meta.files.size() - 1, "a leaf's file index", name));
     range.offset = whole(entry.at("offset"), kMaxSogCount, "a leaf's offset", name);
@@ -145,7 +148,7 @@ void check_level(const LodMeta& meta, int level, const std::string& name) {
 
 bool is_sog_lod_set(const std::string& path) {
   if (path_kind(path) != PathKind::regular_file) return false;
-  const std::vector<char> head = read_file_start(path, 64 << 10);  // opened without blocking
+  const std::vector<char> head = read_recognition_start(path, 64 << 10);  // opened without blocking
   return looks_like_sog_lod_meta(std::string(head.begin(), head.end()));
 }
 

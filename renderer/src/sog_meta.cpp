@@ -8,6 +8,7 @@
 
 #include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "kernel_marks.h"
 
 namespace flashgs {
@@ -19,7 +20,10 @@ constexpr std::size_t kCodebookSize = 256;
 constexpr std::size_t kMaxPaletteSize = 65536;  // labels are 16 bits
 constexpr std::size_t kMaxFileNameBytes = 255;
 
-[[noreturn]] void fail(const std::string& name, const std::string& problem) { throw Error(name + ": " + problem); }
+// The name may come from a file (a texture or chunk named in JSON) or a user's argument.
+[[noreturn]] void fail(const std::string& name, const std::string& problem) {
+  throw Error(printable_file_text(name, kMaxPrintedPathBytes) + ": " + problem);
+}
 
 const json& field(const json& object, const char* key, const std::string& where, const std::string& name) {
   if (!object.is_object() || !object.contains(key)) fail(name, "meta.json has no \"" + where + key + "\"");
@@ -73,8 +77,7 @@ std::vector<std::string> files(const json& property, const std::string& key, std
   return names;
 }
 
-// The first part of a file, enough to see its top-level keys.
-std::string head_of(const std::string& text) { return text.substr(0, 1 << 16); }
+constexpr const char* kJsonSpace = " \t\r\n";
 
 }  // namespace
 
@@ -136,18 +139,32 @@ std::vector<std::string> sog_meta_files(const SogMeta& meta) {
   return names;
 }
 
+// Both look at all of `text`: callers pass a bounded start (read_recognition_start) or a
+// file already read within kMaxSogJsonBytes, and keys may come after any fixed prefix.
 bool looks_like_sog_meta(const std::string& text) {
-  const std::string head = head_of(text);
-  const auto first = head.find_first_not_of(" \t\r\n");
-  return first != std::string::npos && head[first] == '{' && head.find("\"means\"") != std::string::npos &&
-         head.find("\"quats\"") != std::string::npos;
+  const auto first = text.find_first_not_of(kJsonSpace);
+  return first != std::string::npos && text[first] == '{' && text.find("\"means\"") != std::string::npos &&
+         text.find("\"quats\"") != std::string::npos;
 }
 
 bool looks_like_sog_lod_meta(const std::string& text) {
-  const std::string head = head_of(text);
-  const auto first = head.find_first_not_of(" \t\r\n");
-  return first != std::string::npos && head[first] == '{' && head.find("\"lodLevels\"") != std::string::npos &&
-         head.find("\"tree\"") != std::string::npos;
+  const auto first = text.find_first_not_of(kJsonSpace);
+  return first != std::string::npos && text[first] == '{' && text.find("\"lodLevels\"") != std::string::npos &&
+         text.find("\"tree\"") != std::string::npos;
+}
+
+bool may_be_json_object(std::string_view start) {
+  const auto first = start.find_first_not_of(kJsonSpace);
+  return first == std::string_view::npos || start[first] == '{';
+}
+
+std::vector<char> read_recognition_start(const std::string& path, std::size_t start_bytes) {
+  std::vector<char> start = read_file_start(path, start_bytes);
+  // A shorter start is the whole file; only a JSON object earns the longer look.
+  if (start.size() == start_bytes && start_bytes < kMaxSogJsonBytes &&
+      may_be_json_object(std::string_view(start.data(), start.size())))
+    start = read_file_start(path, kMaxSogJsonBytes);
+  return start;
 }
 
 }  // namespace flashgs

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "flashgs/load_progress.h"
@@ -15,6 +16,13 @@ namespace flashgs {
 
 // Real meta.json files are a few tens of KB (three 256-entry codebooks).
 constexpr std::size_t kMaxSogJsonBytes = 16 << 20;
+// The bytes format recognition looks at: the first `start_bytes` of the file, or, when those
+// are whitespace and a JSON object's opening brace, up to kMaxSogJsonBytes of it: a valid
+// meta.json or lod-meta.json may hold its keys past any fixed window (padding, a long
+// filenames list), and anything else is still read no further than `start_bytes`.
+std::vector<char> read_recognition_start(const std::string& path, std::size_t start_bytes);
+// Whether `start` (a file's first bytes) may be a JSON object: whitespace, then '{' or nothing.
+bool may_be_json_object(std::string_view start);
 // A texture of 16384 x 16384 lossless pixels compresses to well under this.
 constexpr std::size_t kMaxSogTextureBytes = std::size_t{1} << 30;
 // The most Gaussians one chunk may declare (a 16384 x 16384 texture).

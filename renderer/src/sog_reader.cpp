@@ -35,7 +35,10 @@ constexpr std::uint64_t kMaxSpareRows = 16;
 // Progress is published and cancellation checked every this many Gaussians.
 constexpr std::size_t kProgressStep = 1 << 16;
 
-[[noreturn]] void fail(const std::string& name, const std::string& problem) { throw Error(name + ": " + problem); }
+// The name may come from a file (a texture or chunk named in JSON) or a user's argument.
+[[noreturn]] void fail(const std::string& name, const std::string& problem) {
+  throw Error(printable_file_text(name, kMaxPrintedPathBytes) + ": " + problem);
+}
 
 void check_cancel(LoadProgress* progress, const std::string& name) {
   if (progress && progress->cancel_requested.load(std::memory_order_relaxed)) throw LoadCancelled(name);

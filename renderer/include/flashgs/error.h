@@ -29,4 +29,13 @@ std::string error_text(const std::exception& e);
 // "..." and its full length, so a message stays one short line whatever the file holds.
 std::string printable_file_text(std::string_view text, std::size_t max_bytes = 80);
 
+// The most of a path that a message shows: a path is outside text too (a user's argument, a
+// name read from a file), yet it must stay whole to be found.
+constexpr std::size_t kMaxPrintedPathBytes = 4096;
+
+// A message already built (it may quote paths, option values or file text) made safe for a
+// terminal: control bytes and invalid UTF-8 become \xNN as printable_file_text writes them,
+// while its own quotes and backslashes stay as they are.
+std::string printable_message(std::string_view message);
+
 }  // namespace flashgs
