@@ -25,7 +25,7 @@ gm::GeometryParams make_geometry_params(const RenderOptions& options) {
   g.opacity_radius = options.uses_opacity_radius();
   g.tight_bbox = options.uses_tight_bbox();
   g.tau = options.tau;
-  g.dilation = options.kernel.epsilon;
+  g.dilation = options.kernel.dilation();
   g.compensate_opacity = options.kernel.compensates_opacity();
   return g;
 }

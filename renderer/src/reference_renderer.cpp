@@ -111,7 +111,7 @@ Image render_reference(const Scene& scene, const Camera& camera, const RenderOpt
   if (window.height < 0) window.height = camera.height;
   const int degree = std::max(0, std::min(scene.sh_degree, options.sh_degree_cap));
   // The kernel's dilation, the float value the backends add, held exactly.
-  const double dilation = options.kernel.epsilon;
+  const double dilation = options.kernel.dilation();
   const bool compensate = options.kernel.compensates_opacity();
   double rot[9], centre[3];
   for (int k = 0; k < 9; ++k) rot[k] = camera.rotation[k];

@@ -25,6 +25,9 @@ struct SplatKernel {
   static SplatKernel classic() { return {}; }
   static SplatKernel antialiased(float epsilon = kGsplatAntialiasEpsilon) { return {KernelMode::antialiased, epsilon}; }
   bool compensates_opacity() const { return mode == KernelMode::antialiased; }
+  // What the footprint adds: 3DGS's 0.3 for classic whatever `epsilon` holds (classic kernels
+  // compare equal), the epsilon for the anti-aliased one.
+  float dilation() const { return compensates_opacity() ? epsilon : kClassicDilation; }
   // "classic", "antialiased" (eps 0.3) or "antialiased=0.1": what parse_splat_kernel reads back.
   std::string spec() const;
   // spec() for messages and the UI: "antialiased (eps 0.1)".
