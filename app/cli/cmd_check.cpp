@@ -13,6 +13,7 @@
 #include "flashgs/file_write.h"
 #include "flashgs/image_io.h"
 #include "flashgs/stress_check.h"
+#include "kernel_option.h"
 #include "flashgs/stress_scenes.h"
 #include "option_checks.h"
 
@@ -171,16 +172,7 @@ void register_check(CLI::App& app) {
   sub->add_option("--images", args->images_dir, "write each rendered image (PNG) into this folder");
   sub->add_flag("--explain", args->explain, "print why each bound is what it is");
   sub->add_option("--kernel", args->kernel, "both (classic and antialiased), or one: classic, antialiased[=EPS]")
-      ->check(CLI::Validator(
-          [](std::string& value) -> std::string {
-            try {
-              kernels_of(value);
-            } catch (const Error& e) {
-              return e.what();
-            }
-            return "";
-          },
-          "both|classic|antialiased[=EPS]", "KERNEL"));
+      ->check(kernel_validator("both"));
   sub->callback([args] {
     const int failures = run(*args);
     if (failures) throw CLI::RuntimeError(1);

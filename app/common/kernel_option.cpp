@@ -5,19 +5,24 @@
 
 namespace flashgs {
 
+CLI::Validator kernel_validator(const std::string& keyword) {
+  return CLI::Validator(
+      [keyword](std::string& value) -> std::string {
+        if (value == keyword) return "";
+        try {
+          parse_splat_kernel(value, "");
+        } catch (const Error& e) {
+          // CLI11 names the option before this: the text without parse_splat_kernel's own prefix.
+          const std::string text = e.what();
+          return text.substr(text.find_first_not_of(' ')) + ", or " + keyword;
+        }
+        return "";
+      },
+      keyword + "|classic|antialiased[=EPS]", "KERNEL");
+}
+
 void KernelOption::add_to(CLI::App* command) {
-  command->add_option("--kernel", text, kKernelOptionHelp)
-      ->check(CLI::Validator(
-          [](std::string& value) -> std::string {
-            if (value == "auto") return "";
-            try {
-              parse_splat_kernel(value, "--kernel");
-            } catch (const Error& e) {
-              return e.what();
-            }
-            return "";
-          },
-          "auto|classic|antialiased[=EPS]", "KERNEL"));
+  command->add_option("--kernel", text, kKernelOptionHelp)->check(kernel_validator("auto"));
 }
 
 std::optional<SplatKernel> KernelOption::chosen() const {
