@@ -695,8 +695,10 @@ TEST(Viewer, EscClosesAnOpenComboFirst) {
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   const std::string steps =
-      "wait_for \"first frame shown\" || status=10\n"
-      "[ $status -eq 0 ] && { click \"Kernel (K)\" || status=11; }\n"
+      // The panels settle over a few frames after the load (auto-sized windows): clicks wait
+      // for them to stand still, or a loaded machine clicks where the combo is not yet.
+      "wait_for \"UI ready\" || status=10\n"
+      "[ $status -eq 0 ] && { click \"Kernel (K)\" && wait_for \"popup open\" || status=11; }\n"
       "[ $status -eq 0 ] && { hold Escape \" key256 \" && wait_for \"popup closed (Esc)\" || status=12; }\n"
       "[ $status -eq 0 ] && { grep -q \"press Esc again\" \"$log\" && status=13; }\n"
       "[ $status -eq 0 ] && { kill -0 $pid 2>/dev/null || status=15; }\n"
@@ -1399,7 +1401,7 @@ TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
   std::filesystem::remove_all(folder);
   // 1024x1000: the export row is on screen below the open sections.
   const std::string steps =
-      "wait_for \"first frame shown\" || status=10\n"
+      "wait_for \"UI ready\" || status=10\n"
       "[ $status -eq 0 ] && { click \"export folder\" && \"$input\" type exportwhilelive || status=11; }\n"
       "close_gate\n"
       "[ $status -eq 0 ] && { click \"Export path\" && wait_for \"path export: 3 frames into\" || status=12; }\n"

@@ -108,8 +108,12 @@ bool ImGuiLayer::wants_mouse() const { return ImGui::GetIO().WantCaptureMouse; }
 bool ImGuiLayer::wants_keyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
 bool ImGuiLayer::widget_held() const { return ImGui::IsAnyItemActive(); }
 
+bool ImGuiLayer::popup_open() const {
+  return ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId | ImGuiPopupFlags_AnyPopupLevel);
+}
+
 bool ImGuiLayer::close_popups() {
-  if (!ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId | ImGuiPopupFlags_AnyPopupLevel)) return false;
+  if (!popup_open()) return false;
   ImGui::ClosePopupToLevel(0, true);
   return true;
 }

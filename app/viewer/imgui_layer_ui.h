@@ -25,7 +25,9 @@ class ImGuiLayer {
   bool wants_keyboard() const;
   // A widget is held this frame (a slider or drag box being dragged, a field being edited).
   bool widget_held() const;
-  // Closes every open popup (a combo's list, the recent scenes); whether one was open.
+  // A popup (a combo's list, the recent scenes) is open.
+  bool popup_open() const;
+  // Closes every open popup; whether one was open.
   bool close_popups();
 
  private:

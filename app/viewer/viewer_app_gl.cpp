@@ -687,6 +687,13 @@ void ViewerApp::draw_and_present(int fb_w, int fb_h) {
     std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start\n", ms_since_start());
 }
 
+void ViewerApp::log_popup_changes() {
+  const bool open = m_ui && m_ui->popup_open();
+  if (open == m_logged_popup_open) return;
+  m_logged_popup_open = open;
+  std::fprintf(stderr, "flashgs-viewer: popup %s\n", open ? "open" : "gone");
+}
+
 void ViewerApp::log_held_input() {
   // One line per frame while anything is held, each held button or key a token between
   // spaces (" mouse0 ", " key257 "): a test holds a button until it has seen two such frames.
@@ -1016,7 +1023,10 @@ int ViewerApp::run() {
     gather_input(nav, actions);
     apply_script_step(nav);
     build_panels(fb_w, fb_h, actions);
-    if (m_args.log_input) log_held_input();
+    if (m_args.log_input) {
+      log_held_input();
+      log_popup_changes();
+    }
     apply_actions(actions);
     log_option_changes();
     finish_pending_load();

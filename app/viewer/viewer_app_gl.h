@@ -89,6 +89,8 @@ class ViewerApp {
   bool m_quit_armed = false;  // a first Esc asked whether to quit
   void log_option_changes();
   void log_held_input();  // --log-input
+  void log_popup_changes();  // --log-input: a test presses Esc only once the list it clicked is open
+  bool m_logged_popup_open = false;
   void ensure_texture(int width, int height);
   void take_screenshot(const std::string& path);  // the rendered image, or with the heat map (setting)
   void legend_rect(int fb_w, int fb_h, float* rect) const;  // the heat-map legend, framebuffer pixels
