@@ -2,146 +2,79 @@
 // level, a range of Gaussians in one of its chunk files; a level is the union of its ranges.
 #include <algorithm>
 #include <filesystem>
-#include <map>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
+#include "flashgs/lod_set.h"
+#include "flashgs/scene_formats.h"
+#include "ply_header.h"
 #include "sog_meta.h"
 
 namespace flashgs {
 namespace {
 
-using nlohmann::json;
 namespace fs = std::filesystem;
 
-constexpr int kMaxLevels = 32;
-// Deeper trees than this are not a spatial hierarchy but a hostile file.
-constexpr int kMaxTreeDepth = 64;
-constexpr std::size_t kMaxFileNameBytes = 1024;
-
-// The name may come from a file (a texture or chunk named in JSON) or a user's argument.
 [[noreturn]] void fail(const std::string& name, const std::string& problem) {
   throw Error(printable_file_text(name, kMaxPrintedPathBytes) + ": " + problem);
 }
 
-// One leaf's share of a level: Gaussians [offset, offset + count) of chunk `file`.
-struct Range {
-  int file = 0;
-  std::size_t offset = 0, count = 0;
-};
+// A set's chunks are SOG chunks (meta.json, as PlayCanvas writes them) or scene files of any
+// format we read (PLY, as `flashgs lod build` writes them).
+bool is_sog_chunk(const std::string& path) { return fs::path(path).extension() == ".json"; }
 
-struct LodMeta {
-  fs::path folder;
-  std::vector<std::string> files;          // chunk meta.json paths, relative to the folder
-  std::vector<std::vector<Range>> levels;  // per level, in tree order
-  std::array<float, 3> bounds_min{}, bounds_max{};
-};
-
-fs::path lod_meta_path(const std::string& path) {
-  return path_kind(path) == PathKind::folder ? fs::path(path) / "lod-meta.json" : fs::path(path);
+std::uint64_t chunk_bytes(const std::string& path) {
+  if (is_sog_chunk(path)) return sog_chunk_texture_bytes(path);
+  std::error_code error;
+  const std::uint64_t bytes = fs::file_size(path, error);
+  return error ? 0 : bytes;
 }
 
-std::size_t whole(const json& value, std::size_t high, const std::string& where, const std::string& name) {
-  if (!value.is_number_unsigned() || value.get<unsigned long long>() > high)
-    fail(name, where + " must be a whole number in 0.." + std::to_string(high));
-  return static_cast<std::size_t>(value.get<unsigned long long>());
-}
-
-// A relative path inside the set's folder: no absolute paths, no "..".
-std::string chunk_file(const json& value, const std::string& where, const std::string& name) {
-  if (!value.is_string()) fail(name, where + " is not a file name");
-  const std::string file = value.get<std::string>();
-  const fs::path path(file);
-  bool escapes = file.empty() || file.size() > kMaxFileNameBytes || path.is_absolute() ||
-                 file.find('\0') != std::string::npos;
-  for (const auto& part : path) escapes |= part == "..";
-  if (escapes) fail(name, where + " \"" + printable_file_text(file) + "\" is not a path inside the set's folder");
-  return file;
-}
-
-void read_bound(const json& node, LodMeta& meta, const std::string& name) {
-  if (!node.contains("bound")) return;
-  const json& bound = node.at("bound");
-  for (const char* key : {"min", "max"}) {
-    if (!bound.is_object() || !bound.contains(key) || !bound.at(key).is_array() || bound.at(key).size() != 3)
-      fail(name, std::string("tree.bound.") + key + " must be an array of 3 numbers");
-    for (int k = 0; k < 3; ++k) {
-      const json& v = bound.at(key)[k];
-      if (!v.is_number()) fail(name, std::string("tree.bound.") + key + " holds a value that is not a number");
-      (key[1] == 'i' ? meta.bounds_min : meta.bounds_max)[k] = v.get<float>();
-    }
+int chunk_sh_degree(const std::string& path) {
+  if (is_sog_chunk(path)) {
+    const std::vector<char> text = read_regular_file(path, kMaxSogJsonBytes);
+    return parse_sog_meta(std::string(text.begin(), text.end()), path).sh_bands;
   }
+  const std::vector<char> head = read_recognition_start(path, 64 << 10);
+  const ply::Header header = ply::parse_header(head.data(), head.size(), path);
+  int rest = 0;
+  for (const ply::Element& e : header.elements)
+    if (e.name == "vertex")
+      for (const ply::Property& p : e.properties) rest += p.name.rfind("f_rest_", 0) == 0;
+  for (int degree = 3; degree > 0; --degree)
+    if (rest >= 3 * (sh_coefficient_count(degree) - 1)) return degree;
+  return 0;
 }
 
-void walk(const json& node, int depth, LodMeta& meta, const std::string& name) {
-  if (depth > kMaxTreeDepth) fail(name, "the tree is deeper than " + std::to_string(kMaxTreeDepth) + " levels");
-  if (!node.is_object()) fail(name, "a tree node is not a JSON object");
-  if (node.contains("children")) {
-    const json& children = node.at("children");
-    if (!children.is_array()) fail(name, "a tree node's \"children\" is not an array");
-    for (const json& child : children) walk(child, depth + 1, meta, name);
-    return;
-  }
-  if (!node.contains("lods") || !node.at("lods").is_object()) fail(name, "a tree leaf has no \"lods\" object");
-  for (const auto& [key, entry] : node.at("lods").items()) {
-    if (key.empty() || key.size() > 2 || key.find_first_not_of("0123456789") != std::string::npos ||
-        std::stoi(key) >= static_cast<int>(meta.levels.size()))
-      fail(name, "a tree leaf names level \"" + printable_file_text(key) + "\"; lodLevels is " +
-                     std::to_string(meta.levels.size()));
-    if (!entry.is_object() || !entry.contains("file") || !entry.contains("offset") || !entry.contains("count"))
-      fail(name, "a tree leaf's level " + printable_file_text(key) + " lacks file, offset or count");
-    Range range;
-    range.file = static_cast<int>(whole(entry.at("file"), meta.files.size() - 1, "a leaf's file index", name));
-    range.offset = whole(entry.at("offset"), kMaxSogCount, "a leaf's offset", name);
-    range.count = whole(entry.at("count"), kMaxSogCount, "a leaf's count", name);
-    meta.levels[std::stoi(key)].push_back(range);
-  }
+Scene read_lod_chunk(const std::string& path, LoadReport* report, LoadProgress* progress) {
+  return is_sog_chunk(path) ? read_sog_chunk(path, report, progress) : load_scene_file(path, report, progress);
 }
 
-LodMeta read_lod_meta(const fs::path& path) {
-  const std::string name = path.string();
-  const std::vector<char> bytes = read_regular_file(name, kMaxSogJsonBytes);
-  json root;
-  try {
-    root = json::parse(bytes.begin(), bytes.end());
-  } catch (const json::exception& e) {
-    fail(name, std::string("not valid JSON (") + printable_file_text(e.what()) + ")");
+// One level of the set: its leaves' ranges, in tree order.
+std::vector<LodRange> level_ranges(const LodSet& set, int level) {
+  std::vector<LodRange> ranges;
+  for (const LodLeaf& leaf : set.leaves) {
+    const LodRange& r = leaf.levels[static_cast<std::size_t>(level)];
+    if (r.file >= 0 && r.count > 0) ranges.push_back(r);
   }
-  if (!root.is_object() || !root.contains("lodLevels") || !root.contains("filenames") || !root.contains("tree"))
-    fail(name, "not a SOG lod-meta.json (it needs lodLevels, filenames and tree)");
-  LodMeta meta;
-  meta.folder = path.parent_path();
-  const std::size_t levels = whole(root.at("lodLevels"), kMaxLevels, "lodLevels", name);
-  if (levels == 0) fail(name, "lodLevels is 0: the set has no level");
-  meta.levels.resize(levels);
-  const json& filenames = root.at("filenames");
-  if (!filenames.is_array() || filenames.empty()) fail(name, "filenames must be a non-empty array");
-  for (std::size_t i = 0; i < filenames.size(); ++i)
-    meta.files.push_back(chunk_file(filenames[i], "filenames[" + std::to_string(i) + "]", name));
-  read_bound(root.at("tree"), meta, name);
-  walk(root.at("tree"), 0, meta, name);
-  for (std::size_t level = 0; level < levels; ++level)
-    if (meta.levels[level].empty()) fail(name, "level " + std::to_string(level) + " has no Gaussians in the tree");
-  return meta;
+  return ranges;
 }
 
 // The chunk files a level reads, by index, in first-use order.
-std::vector<int> level_files(const std::vector<Range>& ranges) {
+std::vector<int> level_files(const std::vector<LodRange>& ranges) {
   std::vector<int> files;
-  for (const Range& r : ranges)
+  for (const LodRange& r : ranges)
     if (std::find(files.begin(), files.end(), r.file) == files.end()) files.push_back(r.file);
   return files;
 }
 
-void check_level(const LodMeta& meta, int level, const std::string& name) {
-  if (level < 0 || level >= static_cast<int>(meta.levels.size()))
+void check_level(const LodSet& set, int level, const std::string& name) {
+  if (level < 0 || level >= set.level_count)
     fail(name, "level " + std::to_string(level) + " does not exist (the set has levels 0.." +
-                   std::to_string(meta.levels.size() - 1) + ")");
+                   std::to_string(set.level_count - 1) + ")");
 }
 
 }  // namespace
@@ -153,21 +86,18 @@ bool is_sog_lod_set(const std::string& path) {
 }
 
 SogLodSet describe_sog_lod(const std::string& path) {
-  const fs::path meta_path = lod_meta_path(path);
-  const LodMeta meta = read_lod_meta(meta_path);
+  const LodSet lod = read_lod_set(path);
   SogLodSet set;
-  set.path = meta_path.string();
-  set.bounds_min = meta.bounds_min;
-  set.bounds_max = meta.bounds_max;
-  for (std::size_t level = 0; level < meta.levels.size(); ++level) {
+  set.path = lod.meta_path;
+  set.bounds_min = lod.bound.min;
+  set.bounds_max = lod.bound.max;
+  for (int level = 0; level < lod.level_count; ++level) {
     SogLodLevel info;
-    info.level = static_cast<int>(level);
-    for (const Range& r : meta.levels[level]) info.gaussians += r.count;
-    for (int file : level_files(meta.levels[level])) {
-      info.files.push_back(meta.files[file]);
-      const std::string chunk = (meta.folder / meta.files[file]).string();
-      const std::vector<char> text = read_regular_file(chunk, kMaxSogJsonBytes);
-      info.sh_degree = std::max(info.sh_degree, parse_sog_meta(std::string(text.begin(), text.end()), chunk).sh_bands);
+    info.level = level;
+    info.gaussians = lod.gaussians(level);
+    for (int file : level_files(level_ranges(lod, level))) {
+      info.files.push_back(lod.files[static_cast<std::size_t>(file)]);
+      info.sh_degree = std::max(info.sh_degree, chunk_sh_degree(lod.file_path(file)));
     }
     set.levels.push_back(info);
   }
@@ -175,14 +105,13 @@ SogLodSet describe_sog_lod(const std::string& path) {
 }
 
 Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadProgress* progress) {
-  const fs::path meta_path = lod_meta_path(path);
-  const std::string name = meta_path.string();
-  const LodMeta meta = read_lod_meta(meta_path);
+  const LodSet meta = read_lod_set(path);
+  const std::string name = meta.meta_path;
   check_level(meta, level, name);
-  const std::vector<Range>& ranges = meta.levels[level];
+  const std::vector<LodRange> ranges = level_ranges(meta, level);
   if (progress) {
     std::uint64_t total = 0;
-    for (int file : level_files(ranges)) total += sog_chunk_texture_bytes((meta.folder / meta.files[file]).string());
+    for (int file : level_files(ranges)) total += chunk_bytes(meta.file_path(file));
     progress->bytes_done.store(0, std::memory_order_relaxed);
     progress->bytes_total.store(total, std::memory_order_relaxed);
   }
@@ -191,9 +120,9 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
   total.path = name;
   bool first = true;
   for (int file : level_files(ranges)) {
-    const std::string chunk_name = (meta.folder / meta.files[file]).string();
+    const std::string chunk_name = meta.file_path(file);
     LoadReport chunk_report;
-    const Scene chunk = read_sog_chunk(chunk_name, &chunk_report, progress);
+    const Scene chunk = read_lod_chunk(chunk_name, &chunk_report, progress);
     if (chunk_report.dropped_non_finite)
       fail(chunk_name, "Gaussians with non-finite values: the level's ranges would no longer line up");
     if (!first && chunk.sh_degree != scene.sh_degree)
@@ -205,11 +134,11 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
       first = false;
     }
     total.sh_degree_in_file = std::max(total.sh_degree_in_file, chunk_report.sh_degree_in_file);
-    for (const Range& r : ranges) {
+    for (const LodRange& r : ranges) {
       if (r.file != file) continue;
       if (r.offset > chunk.size() || r.count > chunk.size() - r.offset)
         fail(name, "level " + std::to_string(level) + " takes Gaussians " + std::to_string(r.offset) + ".." +
-                       std::to_string(r.offset + r.count) + " of " + meta.files[file] + ", which has " +
+                       std::to_string(r.offset + r.count) + " of " + meta.files[static_cast<std::size_t>(file)] + ", which has " +
                        std::to_string(chunk.size()));
       Scene part;
       part.sh_degree = chunk.sh_degree;

@@ -1,0 +1,176 @@
+// lod-meta.json read into a LodSet (leaves with bounds and per-level ranges) and written from one.
+#include "flashgs/lod_set.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <limits>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "flashgs/error.h"
+#include "flashgs/file_access.h"
+#include "flashgs/file_write.h"
+#include "sog_meta.h"
+
+namespace flashgs {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+constexpr int kMaxLevels = 32;
+// Deeper trees than this are not a spatial hierarchy but a hostile file.
+constexpr int kMaxTreeDepth = 64;
+constexpr std::size_t kMaxFileNameBytes = 1024;
+
+// The name may come from a file (a chunk named in JSON) or a user's argument.
+[[noreturn]] void fail(const std::string& name, const std::string& problem) {
+  throw Error(printable_file_text(name, kMaxPrintedPathBytes) + ": " + problem);
+}
+
+std::uint64_t whole(const json& value, std::uint64_t high, const std::string& where, const std::string& name) {
+  if (!value.is_number_unsigned() || value.get<unsigned long long>() > high)
+    fail(name, where + " must be a whole number in 0.." + std::to_string(high));
+  return value.get<unsigned long long>();
+}
+
+// A relative path inside the set's folder: no absolute paths, no "..".
+std::string chunk_file(const json& value, const std::string& where, const std::string& name) {
+  if (!value.is_string()) fail(name, where + " is not a file name");
+  const std::string file = value.get<std::string>();
+  const fs::path path(file);
+  bool escapes = file.empty() || file.size() > kMaxFileNameBytes || path.is_absolute() ||
+                 file.find('\0') != std::string::npos;
+  for (const auto& part : path) escapes |= part == "..";
+  if (escapes) fail(name, where + " \"" + printable_file_text(file) + "\" is not a path inside the set's folder");
+  return file;
+}
+
+LodBox read_bound(const json& node, const LodBox& inherited, const std::string& name) {
+  if (!node.contains("bound")) return inherited;
+  const json& bound = node.at("bound");
+  LodBox box;
+  for (const char* key : {"min", "max"}) {
+    if (!bound.is_object() || !bound.contains(key) || !bound.at(key).is_array() || bound.at(key).size() != 3)
+      fail(name, std::string("tree.bound.") + key + " must be an array of 3 numbers");
+    for (int k = 0; k < 3; ++k) {
+      const json& v = bound.at(key)[k];
+      if (!v.is_number() || !std::isfinite(v.get<double>()))
+        fail(name, std::string("tree.bound.") + key + " holds a value that is not a finite number");
+      (key[1] == 'i' ? box.min : box.max)[k] = v.get<float>();
+    }
+  }
+  return box;
+}
+
+void walk(const json& node, const LodBox& parent_bound, int depth, LodSet& set, const std::string& name) {
+  if (depth > kMaxTreeDepth) fail(name, "the tree is deeper than " + std::to_string(kMaxTreeDepth) + " levels");
+  if (!node.is_object()) fail(name, "a tree node is not a JSON object");
+  const LodBox bound = read_bound(node, parent_bound, name);
+  if (node.contains("children")) {
+    const json& children = node.at("children");
+    if (!children.is_array()) fail(name, "a tree node's \"children\" is not an array");
+    for (const json& child : children) walk(child, bound, depth + 1, set, name);
+    return;
+  }
+  if (!node.contains("lods") || !node.at("lods").is_object()) fail(name, "a tree leaf has no \"lods\" object");
+  LodLeaf leaf;
+  leaf.bound = bound;
+  leaf.levels.resize(static_cast<std::size_t>(set.level_count));
+  for (const auto& [key, entry] : node.at("lods").items()) {
+    if (key.empty() || key.size() > 2 || key.find_first_not_of("0123456789") != std::string::npos ||
+        std::stoi(key) >= set.level_count)
+      fail(name, "a tree leaf names level \"" + printable_file_text(key) + "\"; lodLevels is " +
+                     std::to_string(set.level_count));
+    if (!entry.is_object() || !entry.contains("file") || !entry.contains("offset") || !entry.contains("count"))
+      fail(name, "a tree leaf's level " + printable_file_text(key) + " lacks file, offset or count");
+    LodRange& range = leaf.levels[static_cast<std::size_t>(std::stoi(key))];
+    range.file = static_cast<int>(whole(entry.at("file"), set.files.size() - 1, "a leaf's file index", name));
+    range.offset = whole(entry.at("offset"), kMaxSogCount, "a leaf's offset", name);
+    range.count = whole(entry.at("count"), kMaxSogCount, "a leaf's count", name);
+  }
+  set.leaves.push_back(std::move(leaf));
+}
+
+json box_json(const LodBox& box) {
+  return json{{"min", {box.min[0], box.min[1], box.min[2]}}, {"max", {box.max[0], box.max[1], box.max[2]}}};
+}
+
+LodBox union_of(const LodSet& set, int first, int count) {
+  LodBox box;
+  box.min.fill(std::numeric_limits<float>::max());
+  box.max.fill(std::numeric_limits<float>::lowest());
+  for (int i = first; i < first + count; ++i)
+    for (int k = 0; k < 3; ++k) {
+      box.min[k] = std::min(box.min[k], set.leaves[static_cast<std::size_t>(i)].bound.min[k]);
+      box.max[k] = std::max(box.max[k], set.leaves[static_cast<std::size_t>(i)].bound.max[k]);
+    }
+  return box;
+}
+
+json node_json(const LodSet& set, const std::vector<LodTreeNode>& nodes, int index) {
+  const LodTreeNode& node = nodes.at(static_cast<std::size_t>(index));
+  json out{{"bound", box_json(union_of(set, node.first_leaf, node.leaf_count))}};
+  if (node.children[0] >= 0) {
+    out["children"] = json::array({node_json(set, nodes, node.children[0]), node_json(set, nodes, node.children[1])});
+    return out;
+  }
+  json lods = json::object();
+  const LodLeaf& leaf = set.leaves.at(static_cast<std::size_t>(node.first_leaf));
+  for (std::size_t level = 0; level < leaf.levels.size(); ++level) {
+    const LodRange& r = leaf.levels[level];
+    if (r.file >= 0) lods[std::to_string(level)] = {{"file", r.file}, {"offset", r.offset}, {"count", r.count}};
+  }
+  out["lods"] = lods;
+  return out;
+}
+
+}  // namespace
+
+std::uint64_t LodSet::gaussians(int level) const {
+  std::uint64_t total = 0;
+  for (const LodLeaf& leaf : leaves) total += leaf.levels[static_cast<std::size_t>(level)].count;
+  return total;
+}
+
+std::string LodSet::file_path(int file) const {
+  return (fs::path(folder) / files.at(static_cast<std::size_t>(file))).string();
+}
+
+LodSet read_lod_set(const std::string& path) {
+  const fs::path meta_path = path_kind(path) == PathKind::folder ? fs::path(path) / "lod-meta.json" : fs::path(path);
+  const std::string name = meta_path.string();
+  const std::vector<char> bytes = read_regular_file(name, kMaxSogJsonBytes);
+  json root;
+  try {
+    root = json::parse(bytes.begin(), bytes.end());
+  } catch (const json::exception& e) {
+    fail(name, std::string("not valid JSON (") + printable_file_text(e.what()) + ")");
+  }
+  if (!root.is_object() || !root.contains("lodLevels") || !root.contains("filenames") || !root.contains("tree"))
+    fail(name, "not a SOG lod-meta.json (it needs lodLevels, filenames and tree)");
+  LodSet set;
+  set.meta_path = name;
+  set.folder = meta_path.parent_path().string();
+  set.level_count = static_cast<int>(whole(root.at("lodLevels"), kMaxLevels, "lodLevels", name));
+  if (set.level_count == 0) fail(name, "lodLevels is 0: the set has no level");
+  const json& filenames = root.at("filenames");
+  if (!filenames.is_array() || filenames.empty()) fail(name, "filenames must be a non-empty array");
+  for (std::size_t i = 0; i < filenames.size(); ++i)
+    set.files.push_back(chunk_file(filenames[i], "filenames[" + std::to_string(i) + "]", name));
+  set.bound = read_bound(root.at("tree"), LodBox{}, name);
+  walk(root.at("tree"), set.bound, 0, set, name);
+  for (int level = 0; level < set.level_count; ++level)
+    if (set.gaussians(level) == 0) fail(name, "level " + std::to_string(level) + " has no Gaussians in the tree");
+  return set;
+}
+
+void write_lod_meta(const LodSet& set, const std::vector<LodTreeNode>& nodes, const std::string& path) {
+  json root{{"lodLevels", set.level_count}, {"environment", nullptr}, {"filenames", set.files},
+            {"tree", node_json(set, nodes, 0)}};
+  const std::string text = root.dump();
+  write_file_atomically(path, [&](OutputFile& file) { file.write(text); });
+}
+
+}  // namespace flashgs
