@@ -12,5 +12,6 @@ void register_generate(CLI::App& app);
 void register_bench(CLI::App& app);
 void register_check(CLI::App& app);
 void register_report(CLI::App& app);
+void register_lod(CLI::App& app);
 
 }  // namespace flashgs::cli

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   flashgs::cli::register_bench(app);
   flashgs::cli::register_check(app);
   flashgs::cli::register_report(app);
+  flashgs::cli::register_lod(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -2,6 +2,7 @@
 #include "flashgs/lod_set.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -11,6 +12,8 @@
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
 #include "flashgs/file_write.h"
+#include "flashgs/scene_formats.h"
+#include "ply_header.h"
 #include "sog_meta.h"
 
 namespace flashgs {
@@ -93,6 +96,41 @@ void walk(const json& node, const LodBox& parent_bound, int depth, LodSet& set, 
   set.leaves.push_back(std::move(leaf));
 }
 
+// A set's chunks are SOG chunks (meta.json, as PlayCanvas writes them) or scene files of any
+// format we read (PLY, as `flashgs lod build` writes them).
+bool is_sog_chunk(const std::string& path) { return fs::path(path).extension() == ".json"; }
+
+std::uint64_t chunk_bytes_internal(const std::string& path) {
+  if (is_sog_chunk(path)) return sog_chunk_texture_bytes(path);
+  std::error_code error;
+  const std::uint64_t bytes = fs::file_size(path, error);
+  return error ? 0 : bytes;
+}
+
+int chunk_sh_degree(const std::string& path) {
+  if (is_sog_chunk(path)) {
+    const std::vector<char> text = read_regular_file(path, kMaxSogJsonBytes);
+    return parse_sog_meta(std::string(text.begin(), text.end()), path).sh_bands;
+  }
+  const std::vector<char> head = read_recognition_start(path, 64 << 10);
+  const ply::Header header = ply::parse_header(head.data(), head.size(), path);
+  int rest = 0;
+  bool vertex = false;
+  for (const ply::Element& e : header.elements)
+    if (e.name == "vertex") {
+      vertex = true;
+      for (const ply::Property& p : e.properties) rest += p.name.rfind("f_rest_", 0) == 0;
+    }
+  if (!vertex) fail(path, "the header declares no vertex element");
+  for (int degree = 3; degree > 0; --degree)
+    if (rest >= 3 * (sh_coefficient_count(degree) - 1)) return degree;
+  return 0;
+}
+
+Scene read_chunk_internal(const std::string& path, LoadReport* report, LoadProgress* progress) {
+  return is_sog_chunk(path) ? read_sog_chunk(path, report, progress) : load_scene_file(path, report, progress);
+}
+
 json box_json(const LodBox& box) {
   return json{{"min", {box.min[0], box.min[1], box.min[2]}}, {"max", {box.max[0], box.max[1], box.max[2]}}};
 }
@@ -127,6 +165,12 @@ json node_json(const LodSet& set, const std::vector<LodTreeNode>& nodes, int ind
 }
 
 }  // namespace
+
+std::uint64_t lod_chunk_bytes(const std::string& path) { return chunk_bytes_internal(path); }
+int lod_chunk_sh_degree(const std::string& path) { return chunk_sh_degree(path); }
+Scene read_lod_chunk(const std::string& path, LoadReport* report, LoadProgress* progress) {
+  return read_chunk_internal(path, report, progress);
+}
 
 std::uint64_t LodSet::gaussians(int level) const {
   std::uint64_t total = 0;
@@ -168,7 +212,7 @@ LodSet read_lod_set(const std::string& path) {
 
 void write_lod_meta(const LodSet& set, const std::vector<LodTreeNode>& nodes, const std::string& path) {
   json root{{"lodLevels", set.level_count}, {"environment", nullptr}, {"filenames", set.files},
-            {"tree", node_json(set, nodes, 0)}};
+            {"tree", node_json(set, nodes, static_cast<int>(nodes.size()) - 1)}};
   const std::string text = root.dump();
   write_file_atomically(path, [&](OutputFile& file) { file.write(text); });
 }

@@ -9,8 +9,6 @@
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
 #include "flashgs/lod_set.h"
-#include "flashgs/scene_formats.h"
-#include "ply_header.h"
 #include "sog_meta.h"
 
 namespace flashgs {
@@ -20,37 +18,6 @@ namespace fs = std::filesystem;
 
 [[noreturn]] void fail(const std::string& name, const std::string& problem) {
   throw Error(printable_file_text(name, kMaxPrintedPathBytes) + ": " + problem);
-}
-
-// A set's chunks are SOG chunks (meta.json, as PlayCanvas writes them) or scene files of any
-// format we read (PLY, as `flashgs lod build` writes them).
-bool is_sog_chunk(const std::string& path) { return fs::path(path).extension() == ".json"; }
-
-std::uint64_t chunk_bytes(const std::string& path) {
-  if (is_sog_chunk(path)) return sog_chunk_texture_bytes(path);
-  std::error_code error;
-  const std::uint64_t bytes = fs::file_size(path, error);
-  return error ? 0 : bytes;
-}
-
-int chunk_sh_degree(const std::string& path) {
-  if (is_sog_chunk(path)) {
-    const std::vector<char> text = read_regular_file(path, kMaxSogJsonBytes);
-    return parse_sog_meta(std::string(text.begin(), text.end()), path).sh_bands;
-  }
-  const std::vector<char> head = read_recognition_start(path, 64 << 10);
-  const ply::Header header = ply::parse_header(head.data(), head.size(), path);
-  int rest = 0;
-  for (const ply::Element& e : header.elements)
-    if (e.name == "vertex")
-      for (const ply::Property& p : e.properties) rest += p.name.rfind("f_rest_", 0) == 0;
-  for (int degree = 3; degree > 0; --degree)
-    if (rest >= 3 * (sh_coefficient_count(degree) - 1)) return degree;
-  return 0;
-}
-
-Scene read_lod_chunk(const std::string& path, LoadReport* report, LoadProgress* progress) {
-  return is_sog_chunk(path) ? read_sog_chunk(path, report, progress) : load_scene_file(path, report, progress);
 }
 
 // One level of the set: its leaves' ranges, in tree order.
@@ -97,7 +64,7 @@ SogLodSet describe_sog_lod(const std::string& path) {
     info.gaussians = lod.gaussians(level);
     for (int file : level_files(level_ranges(lod, level))) {
       info.files.push_back(lod.files[static_cast<std::size_t>(file)]);
-      info.sh_degree = std::max(info.sh_degree, chunk_sh_degree(lod.file_path(file)));
+      info.sh_degree = std::max(info.sh_degree, lod_chunk_sh_degree(lod.file_path(file)));
     }
     set.levels.push_back(info);
   }
@@ -111,7 +78,7 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
   const std::vector<LodRange> ranges = level_ranges(meta, level);
   if (progress) {
     std::uint64_t total = 0;
-    for (int file : level_files(ranges)) total += chunk_bytes(meta.file_path(file));
+    for (int file : level_files(ranges)) total += lod_chunk_bytes(meta.file_path(file));
     progress->bytes_done.store(0, std::memory_order_relaxed);
     progress->bytes_total.store(total, std::memory_order_relaxed);
   }

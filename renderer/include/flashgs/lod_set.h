@@ -7,6 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/load_progress.h"
+#include "flashgs/scene.h"
+
 namespace flashgs {
 
 struct LodBox {
@@ -41,13 +44,20 @@ struct LodSet {
 // a missing field, a level or file index out of range, or a path leaving the set's folder.
 LodSet read_lod_set(const std::string& path);
 
+// A chunk file: SOG (meta.json, as PlayCanvas writes sets) or a scene file of any format we read
+// (PLY, as `flashgs lod build` writes them). Its bytes to read (the textures, for SOG), its SH
+// degree from its header alone, and its Gaussians.
+std::uint64_t lod_chunk_bytes(const std::string& path);
+int lod_chunk_sh_degree(const std::string& path);
+Scene read_lod_chunk(const std::string& path, LoadReport* report = nullptr, LoadProgress* progress = nullptr);
+
 // The tree written into lod-meta.json: internal nodes split the leaves in two, as the builder's
 // k-d tree did; each node's bound is the union of its leaves'.
 struct LodTreeNode {
   int first_leaf = 0, leaf_count = 0;  // the leaves below it, consecutive in tree order
   int children[2] = {-1, -1};          // node indices; -1 for a leaf node
 };
-// Writes `set` as lod-meta.json at `path` (whole or not at all). `nodes[0]` is the root.
+// Writes `set` as lod-meta.json at `path` (whole or not at all). The last node is the root.
 void write_lod_meta(const LodSet& set, const std::vector<LodTreeNode>& nodes, const std::string& path);
 
 }  // namespace flashgs

@@ -1,0 +1,249 @@
+// `flashgs lod build IN OUT`: a scene turned into a streamed LOD set; `flashgs lod fly SET`: the
+// set streamed along a camera path under memory caps, with frame times, stalls and memory.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <unistd.h>
+
+#include "backend_factory.h"
+#include "commands.h"
+#include "finite_option.h"
+#include "flashgs/compressed_formats.h"
+#include "flashgs/error.h"
+#include "flashgs/io.h"
+#include "flashgs/lod_build.h"
+#include "flashgs/lod_stream.h"
+#include "flashgs/parse.h"
+#include "flashgs/percentile.h"
+#include "flashgs/renderer.h"
+#include "flashgs/scene_formats.h"
+#include "option_checks.h"
+
+namespace flashgs::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+
+struct BuildArgs {
+  std::string input, output;
+  std::uint64_t leaf = 16384, file = 262144;
+  int levels = 0;
+  std::uint64_t memory_mb = 2048;
+};
+
+void run_build(const BuildArgs& args) {
+  LodBuildOptions options;
+  options.leaf_gaussians = args.leaf;
+  options.file_gaussians = args.file;
+  options.levels = args.levels;
+  options.memory_bytes = args.memory_mb << 20;
+  const bool tty = isatty(STDERR_FILENO);
+  const char* last_stage = "";
+  int last_percent = -1;
+  options.progress = [&](const char* stage, std::uint64_t done, std::uint64_t total) {
+    const int percent = total ? static_cast<int>(100.0 * static_cast<double>(done) / static_cast<double>(total)) : 100;
+    if (std::string(stage) == last_stage && (percent == last_percent || (!tty && percent / 25 == last_percent / 25))) return;
+    if (tty) std::fprintf(stderr, "\r%-9s %3d%% (%llu of %llu Gaussians)", stage, percent, static_cast<unsigned long long>(done),
+                          static_cast<unsigned long long>(total));
+    else std::fprintf(stderr, "%s %d%%\n", stage, percent);
+    if (tty && percent == 100) std::fprintf(stderr, "\n");
+    last_stage = stage;
+    last_percent = percent;
+  };
+  const std::string input = locate_scene(args.input).ply;
+  const auto t0 = Clock::now();
+  const LodBuildReport r = build_lod_set(input, args.output, options);
+  const double seconds = ms_between(t0, Clock::now()) / 1000.0;
+  std::printf("built %s from %s: %llu Gaussians (%s), %d leaves, %d levels, %d chunk files, %.1f MB written, %.1f s\n",
+              args.output.c_str(), input.c_str(), static_cast<unsigned long long>(r.gaussians),
+              r.streamed ? "streamed from the disk" : "read whole", r.leaves, r.levels, r.files,
+              static_cast<double>(r.bytes_written) / 1e6, seconds);
+  for (std::size_t level = 0; level < r.level_gaussians.size(); ++level)
+    std::printf("level %zu: %llu Gaussians\n", level, static_cast<unsigned long long>(r.level_gaussians[level]));
+}
+
+// A rotation (world-to-camera rows) as a unit quaternion and back, for the path's blends.
+void to_quaternion(const float m[9], double q[4]) {
+  const double t = m[0] + m[4] + m[8];
+  if (t > 0) {
+    const double s = 2 * std::sqrt(t + 1);
+    q[0] = 0.25 * s, q[1] = (m[7] - m[5]) / s, q[2] = (m[2] - m[6]) / s, q[3] = (m[3] - m[1]) / s;
+  } else if (m[0] > m[4] && m[0] > m[8]) {
+    const double s = 2 * std::sqrt(1 + m[0] - m[4] - m[8]);
+    q[0] = (m[7] - m[5]) / s, q[1] = 0.25 * s, q[2] = (m[1] + m[3]) / s, q[3] = (m[2] + m[6]) / s;
+  } else if (m[4] > m[8]) {
+    const double s = 2 * std::sqrt(1 + m[4] - m[0] - m[8]);
+    q[0] = (m[2] - m[6]) / s, q[1] = (m[1] + m[3]) / s, q[2] = 0.25 * s, q[3] = (m[5] + m[7]) / s;
+  } else {
+    const double s = 2 * std::sqrt(1 + m[8] - m[0] - m[4]);
+    q[0] = (m[3] - m[1]) / s, q[1] = (m[2] + m[6]) / s, q[2] = (m[5] + m[7]) / s, q[3] = 0.25 * s;
+  }
+}
+
+void to_matrix(const double q[4], float m[9]) {
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+                       2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                       2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+  for (int k = 0; k < 9; ++k) m[k] = static_cast<float>(r[k]);
+}
+
+// The path through `cameras` in their order, `steps` frames from each to the next: positions
+// blended linearly, rotations by normalised quaternion blend.
+std::vector<Camera> fly_path(const std::vector<Camera>& cameras, int steps, int width, int height) {
+  std::vector<Camera> path;
+  for (std::size_t i = 0; i + 1 < cameras.size(); ++i) {
+    const Camera a = cameras[i].resized(width, height), b = cameras[i + 1].resized(width, height);
+    double qa[4], qb[4];
+    to_quaternion(a.rotation, qa);
+    to_quaternion(b.rotation, qb);
+    if (qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3] < 0)
+      for (double& c : qb) c = -c;
+    for (int s = 0; s < steps; ++s) {
+      const double t = static_cast<double>(s) / steps;
+      Camera c = a;
+      double q[4], n = 0;
+      for (int k = 0; k < 4; ++k) {
+        q[k] = (1 - t) * qa[k] + t * qb[k];
+        n += q[k] * q[k];
+      }
+      for (double& v : q) v /= std::sqrt(n);
+      to_matrix(q, c.rotation);
+      for (int k = 0; k < 3; ++k) c.position[k] = static_cast<float>((1 - t) * a.position[k] + t * b.position[k]);
+      path.push_back(c);
+    }
+  }
+  if (!cameras.empty()) path.push_back(cameras.back().resized(width, height));
+  return path;
+}
+
+struct FlyArgs {
+  std::string set, cameras, backend = "auto", resolution = "1280x720";
+  int steps = 30, threads = 2;
+  std::uint64_t budget = 0, host_mb = 0, gpu_mb = 0;
+  float max_error_px = 1.0f;
+  int psnr_every = 0;
+};
+
+void run_fly(const FlyArgs& args) {
+  LodStreamOptions options;
+  options.cut.budget = args.budget;
+  options.cut.max_error_px = args.max_error_px;
+  options.host_bytes = args.host_mb << 20;
+  options.device_bytes = args.gpu_mb << 20;
+  options.threads = args.threads;
+  LodSet set = read_lod_set(args.set);
+  const std::string cameras_path = args.cameras.empty() ? (std::filesystem::path(set.folder) / "cameras.json").string() : args.cameras;
+  const std::vector<Camera> cameras = load_cameras(cameras_path);
+  if (cameras.empty()) throw Error(cameras_path + ": holds no camera");
+  const Resolution size = parse_resolution(args.resolution);
+  const std::vector<Camera> path = fly_path(cameras, args.steps, size.width, size.height);
+  std::unique_ptr<Renderer> renderer = create_backend(args.backend);
+  std::unique_ptr<Renderer> reference_renderer;
+  std::shared_ptr<const Scene> full;
+  if (args.psnr_every > 0) {
+    full = std::make_shared<Scene>(read_sog_lod(args.set, 0));
+    reference_renderer = create_backend(args.backend);
+    reference_renderer->set_scene(full);
+  }
+  LodStreamer streamer(std::move(set), options);
+  const LodSet& lod = streamer.set();
+  std::printf("set %s: %zu leaves, %d levels, level 0 %llu Gaussians; path of %zu frames at %dx%d through %zu cameras\n",
+              lod.meta_path.c_str(), lod.leaves.size(), lod.level_count, static_cast<unsigned long long>(lod.gaussians(0)),
+              path.size(), size.width, size.height, cameras.size());
+
+  RenderOptions render_options;
+  Image image, reference;
+  std::vector<double> frame_ms, psnrs;
+  std::vector<std::uint64_t> drawn;
+  std::shared_ptr<const Scene> shown;
+  const auto start = Clock::now();
+  double first_second_ms = 0, longest_after_first_second = 0;
+  int missing_frames = 0, swaps = 0;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const auto t0 = Clock::now();
+    std::shared_ptr<const Scene> scene = streamer.update(path[i]);
+    if (scene != shown) {
+      renderer->set_scene(scene);
+      shown = scene;
+      ++swaps;
+    }
+    if (scene->size() > 0) renderer->render(path[i], render_options, image, nullptr);
+    const auto t1 = Clock::now();
+    const double ms = ms_between(t0, t1);
+    frame_ms.push_back(ms);
+    drawn.push_back(scene->size());
+    if (ms_between(start, t0) < 1000.0) first_second_ms = std::max(first_second_ms, ms);
+    else longest_after_first_second = std::max(longest_after_first_second, ms);
+    const LodStreamStats s = streamer.stats();
+    missing_frames += s.leaves_missing > 0;
+    for (const std::string& line : streamer.take_errors()) std::fprintf(stderr, "warning: %s\n", line.c_str());
+    if (reference_renderer && scene->size() > 0 && i % static_cast<std::size_t>(args.psnr_every) == 0) {
+      reference_renderer->render(path[i], render_options, reference, nullptr);
+      psnrs.push_back(compare_images(image, reference).psnr_db);
+    }
+  }
+  const double seconds = ms_between(start, Clock::now()) / 1000.0;
+  const LodStreamStats s = streamer.stats();
+  std::vector<double> drawn_d(drawn.begin(), drawn.end());
+  std::printf("frames %zu in %.2f s: median %.2f ms, p99 %.2f ms, longest %.2f ms (%.2f ms in the first second)\n",
+              frame_ms.size(), seconds, percentile(frame_ms, 0.5), percentile(frame_ms, 0.99), longest_after_first_second,
+              first_second_ms);
+  std::printf("drawn Gaussians: median %.0f, max %.0f (budget after the caps: %s); scene swaps %d; frames with a leaf "
+              "not yet in memory %d\n",
+              percentile(drawn_d, 0.5), percentile(drawn_d, 1.0), s.budget ? std::to_string(s.budget).c_str() : "none", swaps,
+              missing_frames);
+  std::printf("host memory: high-water %.1f MB of a %s cap; chunk bytes read %.1f MB (%.1f MB/s); files resident %d, failed %d\n",
+              static_cast<double>(s.host_high_water) / 1e6,
+              args.host_mb ? (std::to_string(args.host_mb) + " MiB").c_str() : "no",
+              static_cast<double>(s.bytes_read) / 1e6, static_cast<double>(s.bytes_read) / 1e6 / seconds, s.files_resident,
+              s.files_failed);
+  if (!psnrs.empty()) {
+    // Identical frames have an infinite PSNR: held at 999 dB so that the order statistics stay defined.
+    for (double& p : psnrs) p = std::min(p, 999.0);
+    std::printf("PSNR against the full-detail scene (%zu frames): median %.2f dB, min %.2f dB (999: identical)\n",
+                psnrs.size(), percentile(psnrs, 0.5), percentile(psnrs, 0.0));
+  }
+}
+
+}  // namespace
+
+void register_lod(CLI::App& app) {
+  CLI::App* lod = app.add_subcommand("lod", "build a streamed level-of-detail set, or fly through one");
+  lod->require_subcommand(1);
+
+  auto build = std::make_shared<BuildArgs>();
+  CLI::App* b = lod->add_subcommand("build", "split a scene into spatial chunks with coarser merged levels (out of core)");
+  b->add_option("IN", build->input, "the scene: any format the tool reads (binary PLY is streamed from the disk)")->required();
+  b->add_option("OUT", build->output, "the folder to write lod-meta.json and the chunk files into (new or empty)")->required();
+  b->add_option("--leaf-size", build->leaf, "Gaussians of a leaf cell at level 0, about")->check(whole_number())->check(CLI::Range(1, 1 << 26));
+  b->add_option("--levels", build->levels, "levels (default: until about 256 Gaussians per leaf)")->check(whole_number())->check(CLI::Range(1, 16));
+  b->add_option("--file-size", build->file, "Gaussians per chunk file, at most")->check(whole_number())->check(CLI::Range(1, 1 << 28));
+  b->add_option("--memory", build->memory_mb, "MiB the builder may hold at once")->check(whole_number())->check(CLI::Range(16, 1 << 22));
+  b->callback([build] { run_build(*build); });
+
+  auto fly = std::make_shared<FlyArgs>();
+  CLI::App* f = lod->add_subcommand("fly", "stream a LOD set along a camera path and report frame times, stalls and memory");
+  f->add_option("SET", fly->set, "the set's lod-meta.json or its folder")->required();
+  f->add_option("--cameras", fly->cameras, "cameras.json whose cameras the path visits in order (default: beside the set)");
+  f->add_option("--steps", fly->steps, "frames from one camera to the next")->check(whole_number())->check(CLI::Range(1, 10000));
+  f->add_option("--resolution,-r", fly->resolution, "WxH")->check(resolution_text());
+  f->add_option("--backend", fly->backend, "cpu | cuda | auto");
+  f->add_option("--budget", fly->budget, "Gaussians drawn at most (default: no limit but the caps)")->check(whole_number());
+  f->add_option("--max-error-px", fly->max_error_px, "detail bound: a leaf is refined while its error is larger")
+      ->check(finite_in(0.0, 1e6));
+  f->add_option("--host-memory", fly->host_mb, "MiB for chunks and drawn scenes (default: no cap)")->check(whole_number());
+  f->add_option("--gpu-memory", fly->gpu_mb, "MiB of GPU memory for the drawn scene (default: no cap)")->check(whole_number());
+  f->add_option("--threads", fly->threads, "chunk loader threads")->check(whole_number())->check(CLI::Range(1, 64));
+  f->add_option("--psnr-every", fly->psnr_every, "compare every Nth frame with the full-detail scene held whole (0: never)")
+      ->check(whole_number());
+  f->callback([fly] { run_fly(*fly); });
+}
+
+}  // namespace flashgs::cli

@@ -1,0 +1,34 @@
+// `flashgs lod build`: a scene file turned into a streamed LOD set (lod-meta.json + chunk files),
+// out of core: memory follows the options, not the scene's size.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace flashgs {
+
+struct LodBuildOptions {
+  std::uint64_t leaf_gaussians = 16384;    // a leaf cell's Gaussians at level 0, about
+  int levels = 0;                          // 0: enough for about 256 Gaussians per leaf at the coarsest
+  std::uint64_t file_gaussians = 262144;   // Gaussians per chunk file and level, at most
+  std::uint64_t memory_bytes = 2ull << 30; // what the builder may hold at once (buckets, chunk buffers)
+  // Called as the build goes: a stage name ("sampling", "sorting", "building"), done and total.
+  std::function<void(const char* stage, std::uint64_t done, std::uint64_t total)> progress;
+};
+
+struct LodBuildReport {
+  std::uint64_t gaussians = 0;  // read (Gaussians with NaN or Inf dropped)
+  int leaves = 0, levels = 0, files = 0;
+  std::vector<std::uint64_t> level_gaussians;
+  std::uint64_t bytes_written = 0;
+  std::uint64_t bucket_bytes = 0;  // the largest bucket held at once
+  bool streamed = false;           // the input was read from the disk batch by batch
+};
+
+// Builds the set in `out_folder` (created; it must be empty or absent) from the scene file
+// `input`. Throws flashgs::Error with one line naming the file or folder and the problem.
+LodBuildReport build_lod_set(const std::string& input, const std::string& out_folder, const LodBuildOptions& options);
+
+}  // namespace flashgs

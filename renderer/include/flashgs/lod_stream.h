@@ -1,0 +1,92 @@
+// Streaming a LOD set by view: each frame's cut is drawn from the chunks in memory (a leaf whose
+// chunk has not arrived is drawn at a coarser level that has), while background threads load
+// what the cut asks for, under a host memory cap with least-recently-used eviction.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "flashgs/camera.h"
+#include "flashgs/lod_cut.h"
+#include "flashgs/lod_set.h"
+#include "flashgs/scene.h"
+
+namespace flashgs {
+
+struct LodStreamOptions {
+  LodCutOptions cut;
+  std::uint64_t host_bytes = 0;    // memory for chunks and the drawn scene; 0 = no cap
+  std::uint64_t device_bytes = 0;  // GPU memory for the drawn scene; 0 = no cap (CPU backend)
+  int threads = 2;                 // chunk loaders
+  bool prefetch = true;            // also load what the view will need if the camera keeps moving
+};
+
+struct LodStreamStats {
+  std::uint64_t budget = 0;          // the Gaussians a cut may take after the caps
+  std::uint64_t drawn_gaussians = 0; // in the scene update() returned
+  std::vector<std::uint64_t> drawn_per_level;
+  int leaves_drawn = 0;
+  int leaves_coarser = 0;  // drawn coarser than the cut wants: their chunk is on its way
+  int leaves_missing = 0;  // in the cut but with no level in memory yet
+  int files_resident = 0, files_queued = 0, files_failed = 0;
+  std::uint64_t host_bytes = 0, host_high_water = 0;  // chunks, loads in flight and drawn scenes
+  std::uint64_t bytes_read = 0;                        // chunk file bytes read so far
+  float worst_error_px = 0;                            // of the cut wanted
+};
+
+class LodStreamer {
+ public:
+  LodStreamer(LodSet set, LodStreamOptions options);
+  ~LodStreamer();
+  LodStreamer(const LodStreamer&) = delete;
+  LodStreamer& operator=(const LodStreamer&) = delete;
+
+  // Chooses the cut for `camera`, asks for the chunks it lacks and returns the scene to draw:
+  // the same pointer as before while nothing drawn changed. Never waits for a chunk.
+  std::shared_ptr<const Scene> update(const Camera& camera);
+  LodStreamStats stats() const;
+  // Blocks until no chunk is queued or loading (tests; a benchmark's warm start).
+  void wait_until_idle();
+  // One line per chunk that could not be read since the last call (the rest keeps rendering).
+  std::vector<std::string> take_errors();
+  const LodSet& set() const { return m_set; }
+
+ private:
+  struct Chunk;
+  void load_loop();
+  std::uint64_t chunk_estimate(int file) const;
+  bool make_room(std::uint64_t bytes, std::unique_lock<std::mutex>& lock);
+  void request(const std::vector<int>& files);
+
+  LodSet m_set;
+  LodStreamOptions m_options;
+  std::uint64_t m_bytes_per_gaussian = 0;
+  std::uint64_t m_budget = 0, m_chunk_cap = 0;
+  std::vector<std::uint64_t> m_file_gaussians;  // the largest range end of each file
+  std::vector<bool> m_pinned;                   // the coarsest level's files
+
+  mutable std::mutex m_mutex;
+  std::condition_variable m_wake, m_idle;
+  std::vector<Chunk> m_chunks;
+  std::vector<int> m_queue;  // files to load, most wanted first
+  int m_loading = 0;
+  bool m_stop = false;
+  std::uint64_t m_frame = 0;
+  std::uint64_t m_chunk_bytes = 0, m_reserved = 0, m_drawn_bytes = 0, m_high_water = 0, m_bytes_read = 0;
+  std::vector<std::string> m_errors;
+
+  LodCut m_cut;
+  std::vector<LodRange> m_drawn;  // what m_scene holds, in leaf order
+  std::shared_ptr<const Scene> m_scene;
+  LodStreamStats m_stats;
+  bool m_have_last_position = false;
+  float m_last_position[3] = {0, 0, 0};
+  std::vector<std::thread> m_threads;
+};
+
+}  // namespace flashgs

@@ -1,0 +1,177 @@
+// Moment-matching merges of Gaussians (Hierarchical 3DGS's rule) for the coarser LOD levels.
+#include "lod_merge.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+
+namespace flashgs {
+namespace {
+
+using Mat3 = std::array<std::array<double, 3>, 3>;
+
+Mat3 rotation_of(const float* q_in) {
+  double w = q_in[0], x = q_in[1], y = q_in[2], z = q_in[3];
+  const double n = std::sqrt(w * w + x * x + y * y + z * z);
+  if (n > 0) w /= n, x /= n, y /= n, z /= n;
+  else w = 1, x = y = z = 0;
+  return Mat3{{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+               {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+               {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
+}
+
+// Jacobi eigen-decomposition of a symmetric 3x3 matrix: a = V diag(values) V^T, V's columns
+// the eigenvectors.
+void symmetric_eigen(Mat3 a, std::array<double, 3>& values, Mat3& v) {
+  v = Mat3{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  for (int sweep = 0; sweep < 32; ++sweep) {
+    const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    const double scale = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+    if (off <= 1e-30 * scale || off == 0.0) break;
+    for (int p = 0; p < 2; ++p)
+      for (int q = p + 1; q < 3; ++q) {
+        if (a[p][q] == 0.0) continue;
+        const double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+        const double t = (theta >= 0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1));
+        const double c = 1 / std::sqrt(t * t + 1), s = t * c;
+        for (int k = 0; k < 3; ++k) {  // a = J^T a J
+          const double akp = a[k][p], akq = a[k][q];
+          a[k][p] = c * akp - s * akq;
+          a[k][q] = s * akp + c * akq;
+        }
+        for (int k = 0; k < 3; ++k) {
+          const double apk = a[p][k], aqk = a[q][k];
+          a[p][k] = c * apk - s * aqk;
+          a[q][k] = s * apk + c * aqk;
+        }
+        for (int k = 0; k < 3; ++k) {
+          const double vkp = v[k][p], vkq = v[k][q];
+          v[k][p] = c * vkp - s * vkq;
+          v[k][q] = s * vkp + c * vkq;
+        }
+      }
+  }
+  for (int k = 0; k < 3; ++k) values[k] = a[k][k];
+}
+
+// The unit quaternion (w, x, y, z) of a rotation matrix with determinant +1.
+std::array<double, 4> quaternion_of(const Mat3& m) {
+  const double trace = m[0][0] + m[1][1] + m[2][2];
+  std::array<double, 4> q;
+  if (trace > 0) {
+    const double s = 2 * std::sqrt(trace + 1);
+    q = {0.25 * s, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s};
+  } else if (m[0][0] > m[1][1] && m[0][0] > m[2][2]) {
+    const double s = 2 * std::sqrt(1 + m[0][0] - m[1][1] - m[2][2]);
+    q = {(m[2][1] - m[1][2]) / s, 0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s};
+  } else if (m[1][1] > m[2][2]) {
+    const double s = 2 * std::sqrt(1 + m[1][1] - m[0][0] - m[2][2]);
+    q = {(m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s};
+  } else {
+    const double s = 2 * std::sqrt(1 + m[2][2] - m[0][0] - m[1][1]);
+    q = {(m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s};
+  }
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  for (double& c : q) c /= n;
+  return q;
+}
+
+double section_area(double s0, double s1, double s2) { return s0 * s1 + s1 * s2 + s2 * s0; }
+
+// 10 bits per axis of a point's place inside `bound`, interleaved.
+std::uint32_t morton_code(const float* p, const LodBox& bound) {
+  std::uint32_t code = 0;
+  std::uint32_t cell[3];
+  for (int k = 0; k < 3; ++k) {
+    const float extent = bound.max[k] - bound.min[k];
+    const float t = extent > 0 ? (p[k] - bound.min[k]) / extent : 0.0f;
+    cell[k] = static_cast<std::uint32_t>(std::clamp(t, 0.0f, 1.0f) * 1023.0f);
+  }
+  for (int bit = 9; bit >= 0; --bit)
+    for (int k = 0; k < 3; ++k) code = (code << 1) | ((cell[k] >> bit) & 1u);
+  return code;
+}
+
+}  // namespace
+
+double merge_weight(const Scene& scene, std::size_t i) {
+  const float* s = &scene.scales[i * 3];
+  return scene.opacities[i] * section_area(s[0], s[1], s[2]);
+}
+
+void append_merged(const Scene& scene, const std::uint32_t* indices, std::size_t count, Scene& out) {
+  const int rest_n = scene.sh_rest_per_gaussian();
+  std::vector<double> weights(count);
+  double total = 0;
+  for (std::size_t j = 0; j < count; ++j) total += weights[j] = merge_weight(scene, indices[j]);
+  if (!(total > 0)) {  // all transparent or flat: plain means
+    std::fill(weights.begin(), weights.end(), 1.0);
+    total = static_cast<double>(count);
+  }
+  std::array<double, 3> mean{};
+  for (std::size_t j = 0; j < count; ++j)
+    for (int k = 0; k < 3; ++k) mean[k] += weights[j] * scene.positions[indices[j] * 3 + k];
+  for (double& m : mean) m /= total;
+  Mat3 cov{};
+  std::vector<double> colour(static_cast<std::size_t>(3 + rest_n), 0.0);
+  for (std::size_t j = 0; j < count; ++j) {
+    const std::size_t i = indices[j];
+    const Mat3 r = rotation_of(&scene.rotations[i * 4]);
+    double d[3], s2[3];
+    for (int k = 0; k < 3; ++k) {
+      d[k] = scene.positions[i * 3 + k] - mean[k];
+      s2[k] = double(scene.scales[i * 3 + k]) * scene.scales[i * 3 + k];
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        double rsr = 0;  // (R S^2 R^T)[a][b]
+        for (int k = 0; k < 3; ++k) rsr += r[a][k] * s2[k] * r[b][k];
+        cov[a][b] += weights[j] * (rsr + d[a] * d[b]);
+      }
+    for (int k = 0; k < 3; ++k) colour[k] += weights[j] * scene.sh_dc[i * 3 + k];
+    for (int k = 0; k < rest_n; ++k) colour[3 + k] += weights[j] * scene.sh_rest[i * rest_n + k];
+  }
+  for (auto& row : cov)
+    for (double& c : row) c /= total;
+  std::array<double, 3> values;
+  Mat3 v;
+  symmetric_eigen(cov, values, v);
+  const double det = v[0][0] * (v[1][1] * v[2][2] - v[1][2] * v[2][1]) - v[0][1] * (v[1][0] * v[2][2] - v[1][2] * v[2][0]) +
+                     v[0][2] * (v[1][0] * v[2][1] - v[1][1] * v[2][0]);
+  if (det < 0)
+    for (auto& row : v) row[2] = -row[2];
+  std::array<double, 3> scale;
+  for (int k = 0; k < 3; ++k) scale[k] = std::sqrt(std::max(values[k], 0.0));
+  // A merge of flat Gaussians stays flat but not degenerate: the smallest axis keeps a sliver.
+  const double largest = std::max({scale[0], scale[1], scale[2]});
+  for (double& s : scale) s = std::max(s, largest * 1e-6);
+  const std::array<double, 4> q = quaternion_of(v);
+  double mass = 0;
+  for (std::size_t j = 0; j < count; ++j) mass += merge_weight(scene, indices[j]);
+  const double opacity = std::min(1.0, mass / section_area(scale[0], scale[1], scale[2]));
+
+  for (int k = 0; k < 3; ++k) out.positions.push_back(static_cast<float>(mean[k]));
+  for (int k = 0; k < 3; ++k) out.scales.push_back(static_cast<float>(scale[k]));
+  for (int k = 0; k < 4; ++k) out.rotations.push_back(static_cast<float>(q[k]));
+  out.opacities.push_back(static_cast<float>(opacity));
+  for (int k = 0; k < 3; ++k) out.sh_dc.push_back(static_cast<float>(colour[k] / total));
+  for (int k = 0; k < rest_n; ++k) out.sh_rest.push_back(static_cast<float>(colour[3 + k] / total));
+}
+
+Scene coarser_level(const Scene& level, const LodBox& bound) {
+  const std::size_t n = level.size();
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::vector<std::uint32_t> codes(n);
+  for (std::size_t i = 0; i < n; ++i) codes[i] = morton_code(&level.positions[i * 3], bound);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return codes[a] < codes[b]; });
+  Scene out;
+  out.sh_degree = level.sh_degree;
+  out.trained_kernel = level.trained_kernel;
+  out.reserve((n + 1) / 2);
+  for (std::size_t i = 0; i < n; i += 2) append_merged(level, &order[i], std::min<std::size_t>(2, n - i), out);
+  return out;
+}
+
+}  // namespace flashgs

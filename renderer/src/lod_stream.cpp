@@ -1,0 +1,315 @@
+// The LOD streamer: cut per frame, chunk loads on background threads under a host cap (least
+// recently used chunks go first), and the drawn scene assembled from what is in memory.
+#include "flashgs/lod_stream.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <system_error>
+
+#include "flashgs/error.h"
+
+namespace flashgs {
+
+enum class ChunkState { absent, queued, loading, resident, failed };
+
+struct LodStreamer::Chunk {
+  ChunkState state = ChunkState::absent;
+  std::shared_ptr<const Scene> scene;
+  std::uint64_t bytes = 0;       // of the scene in memory
+  std::uint64_t file_bytes = 0;  // on the disk
+  std::uint64_t last_used = 0;   // the frame that last drew from it
+};
+
+namespace {
+
+// GPU memory of a drawn scene per byte of its Gaussians: the scene itself, the per-Gaussian
+// records of the preprocess and the sort's keys (about; the CUDA renderer sizes them to the scene).
+constexpr std::uint64_t kDeviceBytesPerSceneByte = 3;
+// Frames of the camera's last step to look ahead when prefetching.
+constexpr float kPrefetchFrames = 8.0f;
+
+std::uint64_t bytes_per_gaussian(int sh_degree) {
+  return sizeof(float) * (14 + 3 * static_cast<std::uint64_t>(sh_coefficient_count(sh_degree) - 1));
+}
+
+}  // namespace
+
+LodStreamer::LodStreamer(LodSet set, LodStreamOptions options) : m_set(std::move(set)), m_options(options) {
+  const int files = static_cast<int>(m_set.files.size());
+  m_chunks.resize(static_cast<std::size_t>(files));
+  m_file_gaussians.assign(static_cast<std::size_t>(files), 0);
+  m_pinned.assign(static_cast<std::size_t>(files), false);
+  for (const LodLeaf& leaf : m_set.leaves) {
+    for (const LodRange& r : leaf.levels)
+      if (r.file >= 0)
+        m_file_gaussians[static_cast<std::size_t>(r.file)] =
+            std::max(m_file_gaussians[static_cast<std::size_t>(r.file)], r.offset + r.count);
+    for (auto r = leaf.levels.rbegin(); r != leaf.levels.rend(); ++r)
+      if (r->file >= 0) {
+        m_pinned[static_cast<std::size_t>(r->file)] = true;
+        break;
+      }
+  }
+  for (int f = 0; f < files; ++f) {
+    std::error_code error;
+    m_chunks[static_cast<std::size_t>(f)].file_bytes = std::filesystem::file_size(m_set.file_path(f), error);
+  }
+  // The set's SH degree from the first chunk whose header reads (a broken one fails when loaded).
+  for (int f = 0; f < files && m_bytes_per_gaussian == 0; ++f) {
+    try {
+      m_bytes_per_gaussian = bytes_per_gaussian(lod_chunk_sh_degree(m_set.file_path(f)));
+    } catch (const Error&) {
+    }
+  }
+  if (m_bytes_per_gaussian == 0) throw Error(m_set.meta_path + ": none of the set's chunk files can be read");
+  // Two drawn scenes (the one drawn and the next) take at most half of the host cap; the
+  // chunks the rest.
+  m_budget = options.cut.budget ? options.cut.budget : std::numeric_limits<std::uint64_t>::max();
+  if (options.host_bytes) m_budget = std::min(m_budget, options.host_bytes / 4 / m_bytes_per_gaussian);
+  if (options.device_bytes)
+    m_budget = std::min(m_budget, options.device_bytes / (kDeviceBytesPerSceneByte * m_bytes_per_gaussian));
+  m_chunk_cap = options.host_bytes ? options.host_bytes - std::min(options.host_bytes, 2 * m_budget * m_bytes_per_gaussian)
+                                   : std::numeric_limits<std::uint64_t>::max();
+  for (int t = 0; t < std::max(1, options.threads); ++t) m_threads.emplace_back([this] { load_loop(); });
+}
+
+LodStreamer::~LodStreamer() {
+  {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_stop = true;
+  }
+  m_wake.notify_all();
+  for (std::thread& t : m_threads) t.join();
+}
+
+std::uint64_t LodStreamer::chunk_estimate(int file) const {
+  // The file's bytes while they are decoded, and the decoded Gaussians.
+  const Chunk& c = m_chunks[static_cast<std::size_t>(file)];
+  return c.file_bytes + m_file_gaussians[static_cast<std::size_t>(file)] * m_bytes_per_gaussian;
+}
+
+bool LodStreamer::make_room(std::uint64_t bytes, std::unique_lock<std::mutex>&) {
+  while (m_chunk_bytes + m_reserved + bytes > m_chunk_cap) {
+    // The least recently used chunk that this frame does not draw; unpinned ones first.
+    int victim = -1;
+    for (int pass = 0; pass < 2 && victim < 0; ++pass)
+      for (std::size_t f = 0; f < m_chunks.size(); ++f) {
+        const Chunk& c = m_chunks[f];
+        if (c.state != ChunkState::resident || c.last_used >= m_frame || (pass == 0 && m_pinned[f])) continue;
+        if (victim < 0 || c.last_used < m_chunks[static_cast<std::size_t>(victim)].last_used) victim = static_cast<int>(f);
+      }
+    if (victim < 0) return false;
+    Chunk& c = m_chunks[static_cast<std::size_t>(victim)];
+    m_chunk_bytes -= c.bytes;
+    c.scene.reset();
+    c.bytes = 0;
+    c.state = ChunkState::absent;
+  }
+  return true;
+}
+
+void LodStreamer::load_loop() {
+  std::unique_lock<std::mutex> lock(m_mutex);
+  for (;;) {
+    m_wake.wait(lock, [this] { return m_stop || !m_queue.empty(); });
+    if (m_stop) return;
+    const int file = m_queue.front();
+    m_queue.erase(m_queue.begin());
+    Chunk& chunk = m_chunks[static_cast<std::size_t>(file)];
+    if (chunk.state != ChunkState::queued) continue;
+    const std::uint64_t estimate = chunk_estimate(file);
+    if (!make_room(estimate, lock)) {
+      chunk.state = ChunkState::absent;  // asked for again by a later frame, when room may be made
+      if (m_loading == 0) m_idle.notify_all();
+      continue;
+    }
+    chunk.state = ChunkState::loading;
+    m_reserved += estimate;
+    m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
+    ++m_loading;
+    lock.unlock();
+    std::shared_ptr<Scene> scene;
+    std::string problem;
+    const std::string path = m_set.file_path(file);
+    try {
+      scene = std::make_shared<Scene>(read_lod_chunk(path));
+      if (scene->size() < m_file_gaussians[static_cast<std::size_t>(file)])
+        problem = printable_file_text(path, kMaxPrintedPathBytes) + ": holds " + std::to_string(scene->size()) +
+                  " Gaussians but the set's tree takes " + std::to_string(m_file_gaussians[static_cast<std::size_t>(file)]) +
+                  " from it";
+      else if (scene->byte_size() / std::max<std::size_t>(1, scene->size()) != m_bytes_per_gaussian)
+        problem = printable_file_text(path, kMaxPrintedPathBytes) + ": its SH degree differs from the set's first chunk";
+    } catch (const Error& e) {
+      problem = e.what();
+    } catch (const std::bad_alloc&) {
+      problem = printable_file_text(path, kMaxPrintedPathBytes) + ": out of memory while reading the chunk";
+    }
+    lock.lock();
+    --m_loading;
+    m_reserved -= estimate;
+    m_bytes_read += chunk.file_bytes;
+    if (!problem.empty()) {
+      chunk.state = ChunkState::failed;
+      m_errors.push_back(problem + " (the set draws that part coarser or not at all)");
+    } else if (make_room(scene->byte_size(), lock)) {
+      chunk.bytes = scene->byte_size();
+      chunk.scene = std::move(scene);
+      chunk.state = ChunkState::resident;
+      chunk.last_used = m_frame;
+      m_chunk_bytes += chunk.bytes;
+      m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
+    } else {
+      chunk.state = ChunkState::absent;
+    }
+    if (m_queue.empty() && m_loading == 0) m_idle.notify_all();
+  }
+}
+
+void LodStreamer::request(const std::vector<int>& files) {
+  // Called with the lock held: the queue becomes `files` (most wanted first); chunks no longer
+  // wanted leave it.
+  for (int f : m_queue)
+    if (m_chunks[static_cast<std::size_t>(f)].state == ChunkState::queued) m_chunks[static_cast<std::size_t>(f)].state = ChunkState::absent;
+  m_queue.clear();
+  for (int f : files) {
+    Chunk& c = m_chunks[static_cast<std::size_t>(f)];
+    if (c.state != ChunkState::absent) continue;
+    c.state = ChunkState::queued;
+    m_queue.push_back(f);
+  }
+}
+
+std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
+  LodCutOptions cut_options = m_options.cut;
+  cut_options.budget = m_budget == std::numeric_limits<std::uint64_t>::max() ? 0 : m_budget;
+  LodCut cut = choose_lod_cut(m_set, camera, cut_options, &m_cut);
+  // Where the camera will be if it keeps moving: its chunks are asked for after the cut's.
+  LodCut ahead;
+  if (m_options.prefetch && m_have_last_position) {
+    Camera next = camera;
+    for (int k = 0; k < 3; ++k) next.position[k] += kPrefetchFrames * (camera.position[k] - m_last_position[k]);
+    if (next.position[0] != camera.position[0] || next.position[1] != camera.position[1] || next.position[2] != camera.position[2])
+      ahead = choose_lod_cut(m_set, next, cut_options, &cut);
+  }
+  for (int k = 0; k < 3; ++k) m_last_position[k] = camera.position[k];
+  m_have_last_position = true;
+
+  const int levels = m_set.level_count;
+  std::vector<LodRange> drawn;
+  std::vector<std::shared_ptr<const Scene>> sources;
+  LodStreamStats stats;
+  stats.budget = cut_options.budget;
+  stats.drawn_per_level.assign(static_cast<std::size_t>(levels), 0);
+  stats.worst_error_px = cut.worst_error_px;
+  {
+    std::unique_lock<std::mutex> lock(m_mutex);
+    ++m_frame;
+    auto resident = [&](int file) { return file >= 0 && m_chunks[static_cast<std::size_t>(file)].state == ChunkState::resident; };
+    std::vector<std::pair<float, int>> wanted;  // (priority, file)
+    for (std::size_t f = 0; f < m_chunks.size(); ++f)
+      if (m_pinned[f]) wanted.emplace_back(std::numeric_limits<float>::infinity(), static_cast<int>(f));
+    for (std::size_t leaf = 0; leaf < cut.level.size(); ++leaf) {
+      const int want = cut.level[leaf];
+      if (want < 0) continue;
+      const LodLeaf& l = m_set.leaves[leaf];
+      int draw = -1;
+      if (resident(l.levels[static_cast<std::size_t>(want)].file)) draw = want;
+      for (int c = want + 1; draw < 0 && c < levels; ++c)
+        if (resident(l.levels[static_cast<std::size_t>(c)].file)) draw = c;
+      for (int c = want - 1; draw < 0 && c >= 0; --c)
+        if (resident(l.levels[static_cast<std::size_t>(c)].file)) draw = c;
+      if (draw != want) {
+        const float error = lod_leaf_error_px(m_set, static_cast<int>(leaf), draw < 0 ? levels - 1 : draw, camera);
+        wanted.emplace_back(draw < 0 ? std::numeric_limits<float>::max() : error, l.levels[static_cast<std::size_t>(want)].file);
+      }
+      if (draw < 0) {
+        ++stats.leaves_missing;
+        continue;
+      }
+      stats.leaves_coarser += draw > want;
+      ++stats.leaves_drawn;
+      const LodRange& range = l.levels[static_cast<std::size_t>(draw)];
+      Chunk& chunk = m_chunks[static_cast<std::size_t>(range.file)];
+      chunk.last_used = m_frame;
+      drawn.push_back(range);
+      sources.push_back(chunk.scene);
+      stats.drawn_per_level[static_cast<std::size_t>(draw)] += range.count;
+    }
+    std::stable_sort(wanted.begin(), wanted.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<int> files;
+    for (const auto& w : wanted) files.push_back(w.second);
+    for (std::size_t leaf = 0; leaf < ahead.level.size(); ++leaf)
+      if (ahead.level[leaf] >= 0) files.push_back(m_set.leaves[leaf].levels[static_cast<std::size_t>(ahead.level[leaf])].file);
+    request(files);
+    if (!m_queue.empty()) m_wake.notify_all();
+  }
+  m_cut = std::move(cut);
+
+  const bool same = drawn.size() == m_drawn.size() &&
+                    std::equal(drawn.begin(), drawn.end(), m_drawn.begin(), [](const LodRange& a, const LodRange& b) {
+                      return a.file == b.file && a.offset == b.offset && a.count == b.count;
+                    });
+  if (!same || !m_scene) {
+    auto scene = std::make_shared<Scene>();
+    scene->sh_degree = sources.empty() ? 0 : sources.front()->sh_degree;
+    scene->trained_kernel = sources.empty() ? TrainedKernel{} : sources.front()->trained_kernel;
+    std::uint64_t total = 0;
+    for (const LodRange& r : drawn) total += r.count;
+    {
+      std::lock_guard<std::mutex> lock(m_mutex);  // the next scene is held beside the one drawn now
+      m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes + total * m_bytes_per_gaussian);
+    }
+    scene->reserve(total);
+    for (std::size_t i = 0; i < drawn.size(); ++i) {
+      const Scene& from = *sources[i];
+      const LodRange& r = drawn[i];
+      const std::size_t rest = static_cast<std::size_t>(from.sh_rest_per_gaussian());
+      auto take = [&r](const std::vector<float>& v, std::size_t per, std::vector<float>& to) {
+        to.insert(to.end(), v.begin() + static_cast<std::ptrdiff_t>(r.offset * per),
+                  v.begin() + static_cast<std::ptrdiff_t>((r.offset + r.count) * per));
+      };
+      take(from.positions, 3, scene->positions);
+      take(from.scales, 3, scene->scales);
+      take(from.rotations, 4, scene->rotations);
+      take(from.opacities, 1, scene->opacities);
+      take(from.sh_dc, 3, scene->sh_dc);
+      if (rest) take(from.sh_rest, rest, scene->sh_rest);
+    }
+    m_scene = std::move(scene);
+    m_drawn = std::move(drawn);
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_drawn_bytes = m_scene->size() * m_bytes_per_gaussian;
+  }
+  stats.drawn_gaussians = m_scene->size();
+  m_stats = stats;
+  return m_scene;
+}
+
+LodStreamStats LodStreamer::stats() const {
+  std::lock_guard<std::mutex> lock(m_mutex);
+  LodStreamStats s = m_stats;
+  for (const Chunk& c : m_chunks) {
+    s.files_resident += c.state == ChunkState::resident;
+    s.files_queued += c.state == ChunkState::queued || c.state == ChunkState::loading;
+    s.files_failed += c.state == ChunkState::failed;
+  }
+  s.host_bytes = m_chunk_bytes + m_reserved + m_drawn_bytes;
+  s.host_high_water = m_high_water;
+  s.bytes_read = m_bytes_read;
+  return s;
+}
+
+void LodStreamer::wait_until_idle() {
+  std::unique_lock<std::mutex> lock(m_mutex);
+  m_idle.wait(lock, [this] { return m_queue.empty() && m_loading == 0; });
+}
+
+std::vector<std::string> LodStreamer::take_errors() {
+  std::lock_guard<std::mutex> lock(m_mutex);
+  std::vector<std::string> out;
+  out.swap(m_errors);
+  return out;
+}
+
+}  // namespace flashgs

@@ -1,0 +1,300 @@
+// The LOD set builder, the cut through it and the streamer: merges keep opacity mass and bounds,
+// the cut is deterministic and within its budget, streamed frames equal the in-memory renderer's
+// at full detail, caps hold, and a broken chunk costs only its part of the scene.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+
+#include <gtest/gtest.h>
+
+#include "flashgs/demo_scene.h"
+#include "flashgs/error.h"
+#include "flashgs/io.h"
+#include "flashgs/lod_build.h"
+#include "flashgs/lod_cut.h"
+#include "flashgs/lod_stream.h"
+#include "flashgs/renderer.h"
+#include "lod_merge.h"
+#include "test_support.h"
+
+namespace flashgs {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string fresh_folder(const std::string& name) {
+  const std::string dir = std::string(FLASHGS_TEST_OUTPUT_DIR) + "/lod_" + name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+// A set built once per process from the demo scene: 30,000 Gaussians in cells of about 2,048.
+const std::string& demo_set() {
+  static const std::string dir = [] {
+    const std::string out = fresh_folder("demo");
+    LodBuildOptions options;
+    options.leaf_gaussians = 2048;
+    options.file_gaussians = 8192;
+    build_lod_set(demo_scene_path(), out, options);
+    return out;
+  }();
+  return dir;
+}
+
+double opacity_mass(const Scene& s) {
+  double mass = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) mass += merge_weight(s, i);
+  return mass;
+}
+
+Scene two_gaussians(float opacity, float distance) {
+  Scene s;
+  s.positions = {0, 0, 0, distance, 0.5f, 0};
+  s.scales = {0.2f, 0.1f, 0.05f, 0.1f, 0.3f, 0.02f};
+  s.rotations = {1, 0, 0, 0, 0.9238795f, 0, 0.3826834f, 0};
+  s.opacities = {opacity, opacity * 0.5f};
+  s.sh_dc = {1, 0, 0, 0, 1, 0};
+  return s;
+}
+
+TEST(LodMerge, KeepsOpacityMassAndStaysInsideTheBounds) {
+  const Scene s = two_gaussians(0.2f, 3.0f);
+  const std::uint32_t both[2] = {0, 1};
+  Scene merged;
+  append_merged(s, both, 2, merged);
+  ASSERT_EQ(merged.size(), 1u);
+  EXPECT_LT(merged.opacities[0], 1.0f);  // no clamp here: the mass is kept
+  EXPECT_NEAR(opacity_mass(merged), opacity_mass(s), 1e-6 * opacity_mass(s));
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GE(merged.positions[k], std::min(s.positions[k], s.positions[3 + k]));
+    EXPECT_LE(merged.positions[k], std::max(s.positions[k], s.positions[3 + k]));
+  }
+  // The merged covariance spans both: its largest axis is at least half the centres' distance.
+  EXPECT_GT(*std::max_element(merged.scales.begin(), merged.scales.end()), 1.0f);
+  // Colour: the weighted mean lies between the two.
+  EXPECT_GT(merged.sh_dc[0], 0.0f);
+  EXPECT_GT(merged.sh_dc[1], 0.0f);
+  EXPECT_NEAR(merged.sh_dc[0] + merged.sh_dc[1], 1.0f, 1e-6f);
+}
+
+// Two opaque Gaussians on top of each other cover no more than one: the merge clamps opacity at
+// 1 and keeps as much mass as its area holds.
+TEST(LodMerge, OpacityClampsAtOneWhereTheMassExceedsTheMergedArea) {
+  Scene s = two_gaussians(0.95f, 0.0f);
+  s.positions[4] = 0.0f;
+  s.opacities[1] = 0.95f;
+  const std::uint32_t both[2] = {0, 1};
+  Scene merged;
+  append_merged(s, both, 2, merged);
+  EXPECT_EQ(merged.opacities[0], 1.0f);
+  EXPECT_NEAR(opacity_mass(merged), merge_weight(merged, 0), 1e-9);
+  EXPECT_LT(opacity_mass(merged), opacity_mass(s));
+}
+
+TEST(LodMerge, ASingleGaussianMergesIntoItself) {
+  const Scene s = two_gaussians(0.7f, 1.0f);
+  const std::uint32_t second = 1;
+  Scene merged;
+  append_merged(s, &second, 1, merged);
+  EXPECT_NEAR(merged.opacities[0], s.opacities[1], 1e-6f);
+  std::vector<float> a(s.scales.begin() + 3, s.scales.end()), b(merged.scales.begin(), merged.scales.end());
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(a[k], b[k], 1e-5f * a[2]);
+}
+
+TEST(LodBuild, Level0HoldsEveryGaussianAndCoarserLevelsHalveAndStayInTheirCells) {
+  const Scene input = load_ply(demo_scene_path());
+  const LodSet set = read_lod_set(demo_set());
+  ASSERT_GE(set.level_count, 3);
+  ASSERT_GT(set.leaves.size(), 8u);
+  EXPECT_EQ(set.gaussians(0), input.size());
+  for (int level = 1; level < set.level_count; ++level) {
+    EXPECT_LE(set.gaussians(level), set.gaussians(level - 1) / 2 + set.leaves.size()) << "level " << level;
+    EXPECT_GE(set.gaussians(level), set.gaussians(level - 1) / 2) << "level " << level;
+  }
+  // The root bound is the input's bound of centres.
+  for (int k = 0; k < 3; ++k) {
+    float lo = input.positions[k], hi = input.positions[k];
+    for (std::size_t i = 0; i < input.size(); ++i) {
+      lo = std::min(lo, input.positions[i * 3 + k]);
+      hi = std::max(hi, input.positions[i * 3 + k]);
+    }
+    EXPECT_EQ(set.bound.min[k], lo);
+    EXPECT_EQ(set.bound.max[k], hi);
+  }
+  // Every level of every leaf: its centres inside the leaf's cell, its opacity mass at most the
+  // finest level's and not less than half of it (merges keep the mass unless opacity clamps at 1).
+  std::vector<Scene> chunks;
+  for (std::size_t f = 0; f < set.files.size(); ++f) chunks.push_back(read_lod_chunk(set.file_path(static_cast<int>(f))));
+  std::vector<double> level_mass(static_cast<std::size_t>(set.level_count), 0.0);
+  for (const LodLeaf& leaf : set.leaves)
+    for (int level = 0; level < set.level_count; ++level) {
+      const LodRange& r = leaf.levels[static_cast<std::size_t>(level)];
+      ASSERT_GE(r.file, 0);
+      const Scene& c = chunks[static_cast<std::size_t>(r.file)];
+      ASSERT_LE(r.offset + r.count, c.size());
+      for (std::uint64_t i = r.offset; i < r.offset + r.count; ++i) {
+        level_mass[static_cast<std::size_t>(level)] += merge_weight(c, i);
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_GE(c.positions[i * 3 + k], leaf.bound.min[k] - 1e-4f);
+          EXPECT_LE(c.positions[i * 3 + k], leaf.bound.max[k] + 1e-4f);
+        }
+      }
+    }
+  // Merges keep the mass where opacity stays below 1; overlapping opaque pairs lose what their
+  // overlap covered twice, so each level holds at most its finer level's mass.
+  std::printf("opacity mass per level relative to level 0:");
+  for (double m : level_mass) std::printf(" %.4f", m / level_mass[0]);
+  std::printf("\n");
+  EXPECT_NEAR(level_mass[0], opacity_mass(input), 1e-4 * level_mass[0]);
+  for (std::size_t level = 1; level < level_mass.size(); ++level) {
+    EXPECT_LE(level_mass[level], level_mass[level - 1] * (1 + 1e-5));
+    EXPECT_GT(level_mass[level], 0.0);
+  }
+}
+
+TEST(LodBuild, RefusesAFolderThatIsNotEmptyAndAMissingInput) {
+  const std::string dir = fresh_folder("occupied");
+  fs::create_directories(dir);
+  std::ofstream(dir + "/keep.txt") << "x";
+  try {
+    build_lod_set(demo_scene_path(), dir, LodBuildOptions{});
+    FAIL() << "built into a folder that holds a file";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is not empty"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::exists(dir + "/keep.txt"));
+  EXPECT_THROW(build_lod_set(dir + "/none.ply", fresh_folder("missing_input"), LodBuildOptions{}), Error);
+}
+
+TEST(LodBuild, ASmallMemoryCapBucketsTheSceneOnTheDisk) {
+  const std::string dir = fresh_folder("small_memory");
+  LodBuildOptions options;
+  options.leaf_gaussians = 1024;
+  options.memory_bytes = 1 << 20;  // 1 MiB: the 30,000 Gaussians (2.2 MB as records) cannot be held at once
+  const LodBuildReport report = build_lod_set(demo_scene_path(), dir, options);
+  EXPECT_TRUE(report.streamed);
+  EXPECT_EQ(report.gaussians, 30000u);
+  EXPECT_LE(report.bucket_bytes, (1u << 20) / 4 + 4096) << "a bucket larger than a quarter of the cap";
+  EXPECT_EQ(read_lod_set(dir).gaussians(0), 30000u);
+  EXPECT_FALSE(fs::exists(dir + "/.lod-build-tmp"));
+}
+
+TEST(LodCut, IsDeterministicWithinItsBudgetAndFinerForASmallerError) {
+  const LodSet set = read_lod_set(demo_set());
+  const Camera camera = test::load_demo_cameras()[3].resized(640, 360);
+  LodCutOptions options;
+  options.max_error_px = 0.5f;
+  const LodCut a = choose_lod_cut(set, camera, options), b = choose_lod_cut(set, camera, options);
+  EXPECT_EQ(a.level, b.level);
+  EXPECT_EQ(a.gaussians, b.gaussians);
+  options.budget = a.gaussians / 3;
+  const LodCut tight = choose_lod_cut(set, camera, options);
+  EXPECT_LE(tight.gaussians, options.budget);
+  EXPECT_TRUE(tight.budget_bound);
+  EXPECT_EQ(tight.level, choose_lod_cut(set, camera, options).level);
+  options.budget = 0;
+  options.max_error_px = 8.0f;
+  const LodCut coarse = choose_lod_cut(set, camera, options);
+  EXPECT_LT(coarse.gaussians, a.gaussians);
+  options.max_error_px = 0.0f;
+  const LodCut full = choose_lod_cut(set, camera, options);
+  for (std::size_t leaf = 0; leaf < full.level.size(); ++leaf) EXPECT_LE(full.level[leaf], 0) << "leaf " << leaf;
+}
+
+// Every leaf in view at level 0 is the whole scene; the frame must then be the in-memory one.
+TEST(LodStream, AtFullDetailTheFrameEqualsTheInMemoryRenderersFrame) {
+  LodStreamOptions options;
+  options.cut.max_error_px = 0.0f;
+  LodStreamer streamer(read_lod_set(demo_set()), options);
+  const std::vector<Camera> cameras = test::load_demo_cameras();
+  auto renderer = make_cpu_renderer(2);
+  auto reference = make_cpu_renderer(2);
+  reference->set_scene(test::load_demo_scene());
+  for (int index : {0, 11, 23}) {
+    const Camera camera = cameras[static_cast<std::size_t>(index)].resized(320, 180);
+    streamer.update(camera);
+    streamer.wait_until_idle();
+    const std::shared_ptr<const Scene> scene = streamer.update(camera);
+    EXPECT_EQ(streamer.stats().leaves_coarser, 0);
+    EXPECT_EQ(streamer.stats().leaves_missing, 0);
+    renderer->set_scene(scene);
+    Image streamed, whole;
+    renderer->render(camera, RenderOptions{}, streamed, nullptr);
+    reference->render(camera, RenderOptions{}, whole, nullptr);
+    const ImageDifference d = compare_images(streamed, whole);
+    std::printf("camera %d: %zu Gaussians drawn, PSNR %.1f dB, max |difference| %.2e\n", index, scene->size(), d.psnr_db,
+                d.max_abs);
+    // The chunks hold the Gaussians as PLY does (log scale, logit opacity): a float round trip.
+    EXPECT_GT(d.psnr_db, 90.0) << "camera " << index;
+    EXPECT_LT(d.max_abs, 1e-3) << "camera " << index;
+  }
+}
+
+TEST(LodStream, UnderATinyCapEveryFrameStillRendersAndTheCapHolds) {
+  const LodSet set = read_lod_set(demo_set());
+  LodStreamOptions options;
+  options.cut.max_error_px = 0.0f;
+  options.host_bytes = 2u << 20;  // 2 MiB: the coarsest level's file fits, the finest level (2.8 MB) never
+  LodStreamer streamer(set, options);
+  const std::vector<Camera> cameras = test::load_demo_cameras();
+  for (std::size_t i = 0; i < 12; ++i) {
+    const Camera camera = cameras[i * 3].resized(160, 90);
+    streamer.update(camera);
+    streamer.wait_until_idle();
+    const std::shared_ptr<const Scene> scene = streamer.update(camera);
+    const LodStreamStats s = streamer.stats();
+    EXPECT_GT(scene->size(), 0u) << "camera " << i * 3;
+    EXPECT_LE(s.host_high_water, options.host_bytes) << "camera " << i * 3;
+    EXPECT_LE(scene->size(), s.budget);
+    EXPECT_EQ(s.drawn_per_level[0], 0u) << "the finest level cannot be in memory";
+  }
+}
+
+TEST(LodStream, ACorruptChunkIsOneLineAndTheRestKeepsRendering) {
+  const std::string dir = fresh_folder("corrupt");
+  fs::copy(demo_set(), dir, fs::copy_options::recursive);
+  LodSet set = read_lod_set(dir);
+  const std::string broken = set.file_path(0);  // a level-0 chunk
+  std::ofstream(broken, std::ios::trunc | std::ios::binary) << "ply\nformat binary_little_endian 1.0\nend_header\n";
+  LodStreamOptions options;
+  options.cut.max_error_px = 0.0f;
+  LodStreamer streamer(std::move(set), options);
+  const Camera camera = test::load_demo_cameras()[0].resized(160, 90);
+  streamer.update(camera);
+  streamer.wait_until_idle();
+  const std::shared_ptr<const Scene> scene = streamer.update(camera);
+  const std::vector<std::string> errors = streamer.take_errors();
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find(broken), std::string::npos) << errors[0];
+  EXPECT_EQ(errors[0].find('\n'), std::string::npos);
+  EXPECT_GT(scene->size(), 0u);
+  EXPECT_GT(streamer.stats().leaves_coarser, 0) << "the broken chunk's leaves are drawn at a coarser level";
+  EXPECT_EQ(streamer.stats().files_failed, 1);
+}
+
+// A set written by PlayCanvas's tools (SOG chunks) streams the same way.
+TEST(LodStream, StreamsAPlayCanvasSogSet) {
+  const std::string sog = test::shared_format_file("playbot_sog");
+  if (sog.empty()) GTEST_SKIP() << "../shared/scenes/formats/playbot_sog is absent";
+  LodStreamOptions options;
+  options.cut.max_error_px = 2.0f;
+  options.cut.budget = 200000;
+  LodStreamer streamer(read_lod_set(sog), options);
+  const Camera camera = test::load_shared_cameras("pc_playbot").empty()
+                            ? Camera{}
+                            : test::load_shared_cameras("pc_playbot")[0].resized(320, 180);
+  if (camera.width == 0) GTEST_SKIP() << "pc_playbot's cameras are absent";
+  streamer.update(camera);
+  streamer.wait_until_idle();
+  const std::shared_ptr<const Scene> scene = streamer.update(camera);
+  EXPECT_GT(scene->size(), 0u);
+  EXPECT_LE(scene->size(), 200000u);
+  EXPECT_TRUE(streamer.take_errors().empty());
+}
+
+}  // namespace
+}  // namespace flashgs
