@@ -16,6 +16,7 @@
 #include "flashgs/image.h"
 #include "flashgs/image_io.h"
 #include "flashgs/frame_memory.h"
+#include "flashgs/lod_build.h"
 #include "heatmap_legend.h"
 #include "camera_controller.h"
 #include "memory_budget.h"
@@ -1031,6 +1032,33 @@ TEST(Viewer, TheLodOptionOpensThatLevelAndABadOneIsNamed) {
   const RunResult both = run(viewer() + " --lod 1 --generate-demo 1000");  // refused before any window
   EXPECT_NE(both.exit_code, 0) << both.output;
   EXPECT_NE(both.output.find("--lod excludes --generate-demo"), std::string::npos) << both.output;
+}
+
+// --stream draws a LOD set at the detail each view needs: with a zero error bound that is every
+// cell at level 0, the frame of the scene the set was built from; a scene that is no LOD set is
+// drawn whole, with one line saying so.
+TEST(Viewer, StreamingALodSetAtFullDetailShowsTheSourceScenesFrame) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir(), set = dir + "/stream_demo_set";
+  std::filesystem::remove_all(set);
+  flashgs::LodBuildOptions options;
+  options.leaf_gaussians = 2048;
+  flashgs::build_lod_set(flashgs::demo_scene_path(), set, options);
+  std::filesystem::copy_file(flashgs::demo_cameras_path(), set + "/cameras.json");
+  const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --camera 7 --frames 2 --exit ";
+  const RunResult streamed = run(common + "'" + set + "' --stream --max-error-px 0 --screenshot " + dir + "/streamed.pfm");
+  ASSERT_EQ(streamed.exit_code, 0) << streamed.output;
+  EXPECT_NE(streamed.output.find("streaming " + set + "/lod-meta.json by view"), std::string::npos) << streamed.output;
+  EXPECT_NE(streamed.output.find("stream settled: 30.0k drawn (levels 0:30.0k)"), std::string::npos) << streamed.output;
+  const RunResult whole = run(common + "--screenshot " + dir + "/whole.pfm");
+  ASSERT_EQ(whole.exit_code, 0) << whole.output;
+  const flashgs::ImageDifference d =
+      flashgs::compare_images(flashgs::read_image(dir + "/streamed.pfm"), flashgs::read_image(dir + "/whole.pfm"));
+  std::printf("streamed at full detail vs the source scene: %.1f dB, max |difference| %.2e\n", d.psnr_db, d.max_abs);
+  EXPECT_GT(d.psnr_db, 90.0);  // the chunks keep log scale and logit opacity: a float round trip
+  const RunResult not_a_set = run(common + "--stream");
+  EXPECT_EQ(not_a_set.exit_code, 0) << not_a_set.output;
+  EXPECT_NE(not_a_set.output.find("is not a LOD set: drawn whole"), std::string::npos) << not_a_set.output;
 }
 
 // Frames and scenes too large for this machine are refused with their figures, before any

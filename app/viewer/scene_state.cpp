@@ -70,7 +70,9 @@ LoadedScene load_scene(const std::string& path, const std::string& cameras_path,
   }
   if (is_sog_lod_set(location.ply)) {
     const SogLodSet set = describe_sog_lod(location.ply);
-    const int level = lod_level >= 0 ? lod_level : choose_sog_lod_level(set, available_host_memory().bytes);
+    const int level = lod_level >= 0                  ? lod_level
+                      : lod_level == kCoarsestLodLevel ? static_cast<int>(set.levels.size()) - 1
+                                                       : choose_sog_lod_level(set, available_host_memory().bytes);
     if (level >= static_cast<int>(set.levels.size()))
       throw Error(location.ply + ": LOD level " + std::to_string(level) + " asked for, the set has levels 0.." +
                   std::to_string(set.levels.size() - 1));

@@ -34,7 +34,9 @@ struct LoadedScene {
 // regular file (a FIFO would block); a missing, broken or irregular cameras.json is not fatal
 // (noted).
 // `progress` (may be null) gets the file's size at once and whatever the reader reports.
-// A SOG LOD set loads level `lod_level` (-1: the finest that fits in host memory).
+// A SOG LOD set loads level `lod_level` (-1: the finest that fits in host memory;
+// kCoarsestLodLevel: its coarsest, the view a streamed set starts from).
+constexpr int kCoarsestLodLevel = -2;
 LoadedScene load_scene(const std::string& path, const std::string& cameras_path = "", LoadProgress* progress = nullptr,
                        int lod_level = -1);
 // The procedural demo scene (`count` Gaussians) with orbit cameras, for runs where no file can travel.

@@ -544,7 +544,8 @@ void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
   request.options = m_settings.options;
   request.options.collect_tile_counts = m_settings.heatmap;  // counts cost a copy: only when shown
   request.reduced = reduced;
-  const bool changed = !m_have_request || !same_camera(request.camera, m_requested.camera) ||
+  const bool streamed = m_stream.active() && update_stream(request.camera);
+  const bool changed = streamed || !m_have_request || !same_camera(request.camera, m_requested.camera) ||
                        request.options != m_requested.options;
   const bool again = m_scripted || (m_settings.continuous && !m_path->busy());
   if (!changed && !again) return;
@@ -869,7 +870,8 @@ bool ViewerApp::open_window() {
 bool ViewerApp::begin_frame(int* fb_w, int* fb_h, float* dt) {
   // Waits for events only when nothing moves or renders every frame; a frame finished on the
   // worker wakes the loop (glfwPostEmptyEvent), and a load in progress redraws its bar.
-  const bool idle = !m_scripted && !m_settings.continuous && !m_playing && !m_moving && m_arrived_textures == 0;
+  const bool idle = !m_scripted && !m_settings.continuous && !m_playing && !m_moving && m_arrived_textures == 0 &&
+                    !m_stream.loading();  // a streamed set's chunks show as they arrive
   double wait_s = !idle ? 0.0 : m_loader.busy() || comparing() ? 0.1 : 0.5;  // progress redrawn
   const double settle_left_ms = kSettleMs - ms_since(m_last_motion);
   if (wait_s > 0 && settle_left_ms > 0) wait_s = std::min(wait_s, settle_left_ms / 1000.0 + 0.001);  // then the full frame
@@ -905,6 +907,7 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.trained_kernel = m_scene.scene ? kernel_summary(m_scene.scene->trained_kernel) : std::string();
   model.lod_gaussians = m_scene.lod_gaussians.empty() ? nullptr : &m_scene.lod_gaussians;
   model.lod_level = m_scene.lod_level;
+  model.stream_summary = m_stream.summary();
   model.camera_count = static_cast<int>(m_scene.cameras.size());
   model.scene_note = m_scene.cameras_note;
   model.load_error = m_load_error;

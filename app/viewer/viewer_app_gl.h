@@ -14,6 +14,7 @@
 #include "file_browser_ui.h"
 #include "file_dialog.h"
 #include "heatmap_legend.h"
+#include "lod_stream_view.h"
 #include "path_export.h"
 #include "frame_path.h"
 #include "scripted_run.h"
@@ -58,7 +59,10 @@ class ViewerApp {
   bool apply_start_options();  // --tile (scripted), --render-size, --camera; false: a scripted run must stop
   bool open_scene(const std::string& path);  // loads now; false (error kept) on failure
   void request_open(const std::string& path);  // loads in the background (interactive runs)
-  void request_lod_level(int level);  // another level of the SOG LOD set shown, loaded like a new file
+  void request_lod_level(int level);
+  void start_stream();  // --stream, for the scene just installed
+  // The streamed scene for this view; true when what is drawn changed (a new frame is needed).
+  bool update_stream(const Camera& camera);  // another level of the SOG LOD set shown, loaded like a new file
   void finish_pending_load();
   void report_failed_load(const std::string& error);
   void install_scene(LoadedScene scene);
@@ -129,6 +133,8 @@ class ViewerApp {
   bool m_path_is_cpu = true;
 
   LoadedScene m_scene;
+  LodStreamView m_stream;       // --stream: the set drawn at the detail each view needs
+  bool m_stream_was_loading = false;
   std::string m_load_error;  // the last failed load and what is shown instead
   SceneLoader m_loader;
   bool m_first_load_pending = false;  // the first scene loads in the background

@@ -47,6 +47,18 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
       ->excludes(lod);
   app.add_option("--tile", a->tile, "render K copies of the scene on a grid (large-scene benchmarks)")
       ->check(CLI::Range(1, 1024));
+  app.add_flag("--stream", a->stream,
+               "stream a LOD set by view (lod-meta.json of PlayCanvas or of `flashgs lod build`): the detail the view needs, "
+               "within --budget and the memory caps")
+      ->excludes(lod);
+  app.add_option("--budget", a->stream_budget, "--stream: Gaussians drawn at most (default: what the caps allow)")
+      ->check(whole_number());
+  app.add_option("--max-error-px", a->stream_max_error_px, "--stream: refine a cell while its error in pixels is larger")
+      ->check(finite_in(kStreamErrorRange));
+  app.add_option("--host-memory", a->host_memory_mb, "--stream: MiB of host memory for chunks and drawn scenes (default: no cap)")
+      ->check(whole_number());
+  app.add_option("--gpu-memory", a->gpu_memory_mb, "--stream: MiB of GPU memory for the drawn scene (default: no cap)")
+      ->check(whole_number());
   app.add_option("--size", size, "window size WxH in screen points (default 1280x800)");
   app.add_option("--render-size", render_size, "render at exactly WxH whatever the window size");
   app.add_option("--scale", a->scale, "render resolution = framebuffer size * scale")->check(finite_in(kRenderScaleRange));

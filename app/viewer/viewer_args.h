@@ -1,6 +1,7 @@
 // ViewerArgs: the viewer's command line (scene, window, backend, render options, and the scripted mode).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,10 @@ struct ViewerArgs {
   long generate_demo = 0;     // > 0: a procedural demo scene of this many Gaussians instead of a file
   int lod = -1;               // >= 0: this level of a SOG LOD set; -1: the finest that fits in memory
   int tile = 1;               // copies of the scene on a grid (large-scene benchmarks)
+  bool stream = false;        // stream a LOD set by view instead of loading one level whole
+  std::uint64_t stream_budget = 0;     // --budget: Gaussians drawn at most (0: the caps' only)
+  float stream_max_error_px = 1.0f;    // --max-error-px
+  std::uint64_t host_memory_mb = 0, gpu_memory_mb = 0;  // --host-memory, --gpu-memory (0: no cap)
   int window_width = 1280, window_height = 800;
   int render_width = 0, render_height = 0;  // > 0: render at exactly this size
   float scale = 1.0f;

@@ -159,13 +159,27 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
       return "level " + std::to_string(level) + ": " + human_count(double((*m.lod_gaussians)[level])) + " Gaussians";
     };
     ImGui::SetNextItemWidth(ui(260));
-    if (ImGui::BeginCombo("LOD", level_name(m.lod_level).c_str())) {
+    // While streamed, every cell has its own level; choosing one loads that level whole.
+    const std::string shown = m.stream_summary.empty() ? level_name(m.lod_level) : "streamed by view";
+    if (ImGui::BeginCombo("LOD", shown.c_str())) {
       for (int level = 0; level < static_cast<int>(m.lod_gaussians->size()); ++level)
-        if (ImGui::Selectable(level_name(level).c_str(), level == m.lod_level) && level != m.lod_level)
+        if (ImGui::Selectable(level_name(level).c_str(), level == m.lod_level && m.stream_summary.empty()) &&
+            (level != m.lod_level || !m.stream_summary.empty()))
           a.lod_level = level;
       ImGui::EndCombo();
     }
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("level 0 is the finest; a coarser level has fewer Gaussians");
+  }
+  if (!m.stream_summary.empty()) {
+    // Streamed by view: each cell at the level the view needs; chunks arrive in the background.
+    ImGui::TextWrapped("streamed: %s", m.stream_summary.c_str());
+    ImGui::SetNextItemWidth(ui(200));
+    ImGui::SliderFloat("max error (px)", &s.stream_max_error_px, 0.0f, 16.0f, "%.1f");
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("a cell is drawn finer while its Gaussians' spacing, projected, is larger than this");
+    ImGui::SetNextItemWidth(ui(200));
+    ImGui::SliderFloat("budget (M)", &s.stream_budget_millions, 0.0f, 100.0f, s.stream_budget_millions > 0 ? "%.2f M" : "caps only");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Gaussians drawn at most, in millions (0: what the memory caps allow)");
   }
   if (!m.scene_note.empty()) ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.scene_note.c_str());
   ImGui::SetNextItemWidth(ui(-170));

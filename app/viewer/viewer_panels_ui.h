@@ -30,6 +30,7 @@ struct UiModel {
   std::string trained_kernel;     // ...and where that came from (kernel_summary)
   const std::vector<std::size_t>* lod_gaussians = nullptr;  // a SOG LOD set's levels, else null
   int lod_level = -1;
+  std::string stream_summary;  // a LOD set streamed by view: what is drawn and in memory; empty otherwise
   int camera_count = 0;
   std::string scene_note;         // loader report / cameras problem
   std::string load_error;         // the last failed load and what is shown instead, one sentence

@@ -18,6 +18,7 @@ namespace flashgs::viewer {
 
 void ViewerApp::install_scene(LoadedScene scene) {
   m_path->set_scene(scene.scene);  // throws on failure: the old scene stays
+  m_stream.stop();  // a new scene, or a level chosen by hand
   // Another level of the same LOD set: the same place, seen from where the user stands.
   const bool same_place = !scene.lod_gaussians.empty() && scene.path == m_scene.path && m_scene.scene;
   m_scene = std::move(scene);
@@ -63,6 +64,60 @@ void ViewerApp::install_scene(LoadedScene scene) {
                m_scene.cameras.size(), m_settings.options.kernel.description().c_str(),
                m_args.kernel.chosen() ? "--kernel" : kernel_summary(m_scene.scene->trained_kernel).c_str(),
                note.empty() ? "" : "; ", note.c_str());
+  if (m_args.stream) start_stream();
+}
+
+void ViewerApp::start_stream() {
+  if (m_scene.lod_gaussians.empty()) {
+    set_notice("--stream: " + m_scene.path + " is not a LOD set: drawn whole (`flashgs lod build` makes one)");
+    return;
+  }
+  StreamSettings settings;
+  settings.budget = m_args.stream_budget;
+  settings.max_error_px = m_args.stream_max_error_px;
+  settings.host_bytes = m_args.host_memory_mb << 20;
+  settings.device_bytes = m_path_is_cpu ? 0 : m_args.gpu_memory_mb << 20;
+  m_settings.stream_max_error_px = settings.max_error_px;
+  m_settings.stream_budget_millions = static_cast<float>(static_cast<double>(settings.budget) / 1e6);
+  try {
+    m_stream.start(m_scene.path, settings);
+  } catch (const std::exception& e) {
+    set_notice("--stream refused, level " + std::to_string(m_scene.lod_level) + " drawn whole: " + error_text(e));
+    return;
+  }
+  m_stream_was_loading = true;
+  std::fprintf(stderr, "flashgs-viewer: streaming %s by view (max error %.1f px, budget %s, host cap %s)\n",
+               m_scene.path.c_str(), settings.max_error_px,
+               settings.budget ? human_count(double(settings.budget)).c_str() : "the caps'",
+               settings.host_bytes ? (std::to_string(m_args.host_memory_mb) + " MiB").c_str() : "none");
+}
+
+bool ViewerApp::update_stream(const Camera& camera) {
+  StreamSettings wanted = m_stream.settings();
+  wanted.max_error_px = m_settings.stream_max_error_px;
+  wanted.budget = static_cast<std::uint64_t>(double(m_settings.stream_budget_millions) * 1e6);
+  try {
+    m_stream.change(wanted);
+  } catch (const std::exception& e) {  // the set's files went away: the stream stops, the last cut stays
+    set_notice("streaming stopped: " + error_text(e));
+    m_stream.stop();
+    return false;
+  }
+  const std::shared_ptr<const Scene> scene = m_stream.update(camera, m_scripted);
+  for (const std::string& line : m_stream.take_errors()) set_notice(line);
+  const bool loading = m_stream.loading();
+  if (m_stream_was_loading && !loading)  // tests and users see when the view's chunks are all in
+    std::fprintf(stderr, "flashgs-viewer: stream settled: %s\n", m_stream.summary().c_str());
+  m_stream_was_loading = loading;
+  if (!scene || scene == m_scene.scene || scene->size() == 0) return false;
+  try {
+    m_path->set_scene(scene);
+  } catch (const std::exception& e) {  // out of GPU memory: the last drawn scene stays
+    set_notice("streamed scene refused: " + error_text(e));
+    return false;
+  }
+  m_scene.scene = scene;
+  return true;
 }
 
 void ViewerApp::report_failed_load(const std::string& error) {
@@ -163,7 +218,8 @@ LoadedScene load_start_scene(const ViewerArgs& args, LoadProgress* progress) {
   } else {
     const std::string path = args.scene.empty() ? demo_scene_path() : args.scene;
     try {
-      scene = load_scene(path, args.cameras, progress, args.lod);  // lod -1: the finest that fits
+      // lod -1: the finest that fits; a streamed set starts from its coarsest level.
+      scene = load_scene(path, args.cameras, progress, args.stream ? kCoarsestLodLevel : args.lod);
     } catch (const LoadCancelled&) {
       throw;
     } catch (const std::exception& e) {

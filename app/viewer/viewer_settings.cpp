@@ -23,6 +23,8 @@ void keep_settings_valid(ViewerSettings& s, const ViewerSettings& before) {
   for (int c = 0; c < 3; ++c) o.background[c] = kBackgroundRange.clamp(o.background[c], before.options.background[c]);
   o.sh_degree_cap = std::clamp(o.sh_degree_cap, 0, kMaxShDegree);
   s.up_axis = std::clamp(s.up_axis, 0, kUpAxisCount - 1);
+  s.stream_max_error_px = kStreamErrorRange.clamp(s.stream_max_error_px, before.stream_max_error_px);
+  s.stream_budget_millions = kStreamBudgetRange.clamp(s.stream_budget_millions, before.stream_budget_millions);
 }
 
 void switch_algorithm(RenderOptions& options, Algorithm to) { options.algorithm = to; }

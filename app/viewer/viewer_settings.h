@@ -29,6 +29,8 @@ struct ValueRange {
 
 inline constexpr ValueRange kFovRange{1.0f, 170.0f};             // horizontal degrees
 inline constexpr ValueRange kRenderScaleRange{0.05f, 4.0f};
+inline constexpr ValueRange kStreamErrorRange{0.0f, 16.0f};       // pixels
+inline constexpr ValueRange kStreamBudgetRange{0.0f, 100.0f};     // millions of Gaussians
 inline constexpr ValueRange kMoveSpeedRange{1e-4f, 1e4f};        // scene extents per second
 inline constexpr ValueRange kLookSensitivityRange{1e-5f, 1.0f};  // radians per window point
 inline constexpr ValueRange kHeatmapOpacityRange{0.1f, 1.0f};
@@ -41,6 +43,8 @@ struct ViewerSettings {
   RenderOptions options;            // algorithm, every optimisation, tau, background, SH cap
   NavigationMode mode = NavigationMode::fly;
   float fov_x_degrees = 60.0f;      // horizontal field of view of the viewer camera
+  float stream_max_error_px = 1.0f;      // a streamed LOD set: refine while a cell's error is larger
+  float stream_budget_millions = 0.0f;   // a streamed LOD set: Gaussians drawn at most (0: the caps')
   float render_scale = 1.0f;        // render resolution = framebuffer size * scale
   bool adaptive_resolution = true;  // fewer pixels while moving when a full frame takes > 33 ms
   int forced_width = 0, forced_height = 0;  // > 0: render at exactly this size (scripted runs)

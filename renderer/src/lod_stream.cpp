@@ -3,9 +3,7 @@
 #include "flashgs/lod_stream.h"
 
 #include <algorithm>
-#include <filesystem>
 #include <map>
-#include <system_error>
 
 #include "flashgs/error.h"
 
@@ -52,8 +50,11 @@ LodStreamer::LodStreamer(LodSet set, LodStreamOptions options) : m_set(std::move
       }
   }
   for (int f = 0; f < files; ++f) {
-    std::error_code error;
-    m_chunks[static_cast<std::size_t>(f)].file_bytes = std::filesystem::file_size(m_set.file_path(f), error);
+    try {  // a SOG chunk's bytes are its textures'
+      m_chunks[static_cast<std::size_t>(f)].file_bytes = lod_chunk_bytes(m_set.file_path(f));
+    } catch (const Error&) {
+      // read when its turn comes, and then reported
+    }
   }
   // The set's SH degree from the first chunk whose header reads (a broken one fails when loaded).
   for (int f = 0; f < files && m_bytes_per_gaussian == 0; ++f) {

@@ -1,0 +1,65 @@
+// Streaming a LOD set in the viewer: the streamer made from the set and the settings, its summary.
+#include "lod_stream_view.h"
+
+#include <cstdio>
+
+#include "count_text.h"
+#include "flashgs/lod_set.h"
+
+namespace flashgs::viewer {
+namespace {
+
+LodStreamOptions stream_options(const StreamSettings& s) {
+  LodStreamOptions options;
+  options.cut.budget = s.budget;
+  options.cut.max_error_px = s.max_error_px;
+  options.host_bytes = s.host_bytes;
+  options.device_bytes = s.device_bytes;
+  return options;
+}
+
+}  // namespace
+
+void LodStreamView::start(const std::string& meta_path, const StreamSettings& settings) {
+  auto streamer = std::make_unique<LodStreamer>(read_lod_set(meta_path), stream_options(settings));
+  m_streamer = std::move(streamer);
+  m_meta_path = meta_path;
+  m_settings = settings;
+}
+
+std::shared_ptr<const Scene> LodStreamView::update(const Camera& camera, bool settle) {
+  if (!m_streamer) return nullptr;
+  if (!settle) return m_streamer->update(camera);
+  m_streamer->update(camera);
+  m_streamer->wait_until_idle();
+  return m_streamer->update(camera);
+}
+
+void LodStreamView::change(const StreamSettings& settings) {
+  if (!m_streamer || (settings.budget == m_settings.budget && settings.max_error_px == m_settings.max_error_px)) return;
+  start(m_meta_path, settings);
+}
+
+LodStreamStats LodStreamView::stats() const { return m_streamer ? m_streamer->stats() : LodStreamStats{}; }
+
+bool LodStreamView::loading() const { return m_streamer && m_streamer->stats().files_queued > 0; }
+
+std::string LodStreamView::summary() const {
+  if (!m_streamer) return "";
+  const LodStreamStats s = m_streamer->stats();
+  std::string levels;
+  for (std::size_t l = 0; l < s.drawn_per_level.size(); ++l)
+    if (s.drawn_per_level[l]) levels += (levels.empty() ? "" : " ") + std::to_string(l) + ":" + human_count(double(s.drawn_per_level[l]));
+  char text[320];
+  std::snprintf(text, sizeof text, "%s drawn (levels %s), %d chunks in memory, %d coming%s, %.0f MB (high %.0f MB)",
+                human_count(double(s.drawn_gaussians)).c_str(), levels.empty() ? "none" : levels.c_str(), s.files_resident,
+                s.files_queued, s.files_failed ? (", " + std::to_string(s.files_failed) + " unreadable").c_str() : "",
+                static_cast<double>(s.host_bytes) / 1e6, static_cast<double>(s.host_high_water) / 1e6);
+  return text;
+}
+
+std::vector<std::string> LodStreamView::take_errors() {
+  return m_streamer ? m_streamer->take_errors() : std::vector<std::string>{};
+}
+
+}  // namespace flashgs::viewer

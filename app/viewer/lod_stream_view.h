@@ -1,0 +1,47 @@
+// The viewer's streaming of a LOD set by view: the streamer, its live budget and error bound,
+// and the one-line summary the panel shows and the log keeps.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "flashgs/camera.h"
+#include "flashgs/lod_stream.h"
+#include "flashgs/scene.h"
+
+namespace flashgs::viewer {
+
+struct StreamSettings {
+  std::uint64_t budget = 0;   // Gaussians drawn at most, 0: the caps' only
+  float max_error_px = 1.0f;  // refine while a leaf's error is larger
+  std::uint64_t host_bytes = 0, device_bytes = 0;  // 0: no cap
+};
+
+class LodStreamView {
+ public:
+  // Starts streaming the set at `meta_path` (lod-meta.json). Throws flashgs::Error naming the
+  // file when it cannot be read; the previous stream, if any, then stays.
+  void start(const std::string& meta_path, const StreamSettings& settings);
+  void stop() { m_streamer.reset(); }
+  bool active() const { return m_streamer != nullptr; }
+  // The scene to draw for `camera`: a new pointer when what is drawn changed, else the last one.
+  // `settle`: wait for the view's chunks first (scripted runs, whose frames must not depend on
+  // how fast the disk was).
+  std::shared_ptr<const Scene> update(const Camera& camera, bool settle);
+  // Budget and error bound changed live (the streamer is made again; its chunks are read again).
+  void change(const StreamSettings& settings);
+  const StreamSettings& settings() const { return m_settings; }
+  LodStreamStats stats() const;
+  // Chunks are on their way: the window keeps drawing so that they show as they arrive.
+  bool loading() const;
+  std::string summary() const;  // "1.2M drawn (levels 0:.. 1:..), 14 chunks in memory, 3 coming, 512 MB"
+  std::vector<std::string> take_errors();
+
+ private:
+  std::string m_meta_path;
+  StreamSettings m_settings;
+  std::unique_ptr<LodStreamer> m_streamer;
+};
+
+}  // namespace flashgs::viewer
