@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "flashgs/error.h"
+#include "flashgs/city_scene.h"
 #include "flashgs/file_write.h"
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
@@ -51,6 +52,45 @@ void write_scene(const Scene& scene, const std::vector<Camera>& cameras, const s
               dir.c_str(), scene.size(), scene.sh_degree, dir.c_str(), cameras.size());
 }
 
+// --input "SCENE[:UP],...": each scene (any format; a LOD set at its finest level that fits) and
+// its up axis (+z when not given).
+std::vector<CitySource> city_sources(const std::string& list) {
+  std::vector<CitySource> sources;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t end = std::min(list.find(',', start), list.size());
+    const std::string item = list.substr(start, end - start);
+    if (item.empty()) throw Error("--input \"" + printable_file_text(list) + "\": an empty scene name in the list");
+    CitySource source;
+    const std::size_t colon = item.rfind(':');
+    const bool has_up = colon != std::string::npos && item.size() - colon == 3 && (item[colon + 1] == '+' || item[colon + 1] == '-');
+    source.name = has_up ? item.substr(0, colon) : item;
+    if (has_up) source.up = item.substr(colon + 1);
+    LoadReport report;
+    source.scene = load_scene_at_level(locate_scene(source.name).ply, -1, &report);
+    std::fprintf(stderr, "read %s: %zu Gaussians, up %s\n", source.name.c_str(), source.scene.size(), source.up.c_str());
+    sources.push_back(std::move(source));
+    start = end + 1;
+  }
+  return sources;
+}
+
+void generate_city(const GenerateArgs& args) {
+  if (args.input.empty()) throw Error("generate city: give the scenes to lay out with --input A[:UP],B[:UP],...");
+  const std::vector<CitySource> sources = city_sources(args.input);
+  std::vector<Camera> path;
+  const std::string ply = args.output_dir + "/point_cloud.ply";
+  const CityReport r = write_city_scene(sources, args.copies, ply, 60, 1920, 1080, &path);
+  save_cameras(path, args.output_dir + "/cameras.json");
+  std::printf("wrote %s: %llu Gaussians in %d blocks of %.1f units (%.2f GB; %.2f GB in memory as floats) and %s/cameras.json "
+              "(%zu cameras from street level to an overview)\n",
+              ply.c_str(), static_cast<unsigned long long>(r.gaussians), r.blocks, r.block_size, double(r.bytes) / 1e9,
+              double(r.gaussians) * 56 / 1e9, args.output_dir.c_str(), path.size());
+  if (r.dropped_sh)
+    std::printf("note: the copies are turned, and view-dependent colour (SH bands 1-3) is not rotated with them: the "
+                "city keeps each Gaussian's base colour\n");
+}
+
 // The kind asked for: --list goes with stress alone (it wrote a demo scene before).
 GenerateArgs with_kind(GenerateArgs args) {
   if (args.list && !args.kind.empty() && args.kind != "stress")
@@ -80,6 +120,8 @@ void generate(const GenerateArgs& args) {
         camera.position[k] = centre + (camera.position[k] - centre) * side;
       }
     write_scene(scene, cameras, args.output_dir);
+  } else if (args.kind == "city") {
+    generate_city(args);
   } else if (args.kind == "stress") {
     if (args.list || args.stress.empty()) {
       for (const std::string& name : stress_case_names())
@@ -100,7 +142,7 @@ void generate(const GenerateArgs& args) {
     std::printf("%s: %s\nbound vs fp64 reference: flash %.3g, baseline %.3g (%s)\n", c.name.c_str(),
                 c.description.c_str(), c.bound_flash, c.bound_baseline, c.bound_reason.c_str());
   } else {
-    throw Error("generate: unknown kind \"" + args.kind + "\" (demo, tile or stress)");
+    throw Error("generate: unknown kind \"" + args.kind + "\" (demo, tile, city or stress)");
   }
 }
 
@@ -108,7 +150,7 @@ void run(const GenerateArgs& given) {
   const GenerateArgs args = with_kind(given);
   const bool lists_only = args.kind == "stress" && (args.list || args.stress.empty());
   std::vector<std::string> created;
-  if (!lists_only && (args.kind == "demo" || args.kind == "tile" || args.kind == "stress"))
+  if (!lists_only && (args.kind == "demo" || args.kind == "tile" || args.kind == "city" || args.kind == "stress"))
     created = check_output_scene(args);
   // A folder made here goes again when the input fails (a missing --input, an unknown case).
   try {
@@ -124,15 +166,19 @@ void run(const GenerateArgs& given) {
 void register_generate(CLI::App& app) {
   auto args = std::make_shared<GenerateArgs>();
   CLI::App* sub = app.add_subcommand("generate", "write a procedural or tiled scene with cameras.json");
-  sub->add_option("kind", args->kind, "demo | tile | stress");
+  sub->add_option("kind", args->kind, "demo | tile | city | stress");
   sub->add_option("name", args->stress, "stress: the case (see --list)");
   sub->add_option("--stress", args->stress, "same as `generate stress NAME`")->each([args](const std::string&) {
     args->kind = "stress";
   });
   sub->add_flag("--list", args->list, "stress: list the cases");
   sub->add_option("--output,-o", args->output_dir, "output folder");
-  sub->add_option("--input,-i", args->input, "tile: the scene to copy");
-  sub->add_option("--copies,-n", args->copies, "tile: number of copies")->check(whole_number())->check(CLI::Range(1, 1024));
+  sub->add_option("--input,-i", args->input,
+                  "tile: the scene to copy; city: the scenes to lay out, SCENE[:UP],... (UP one of +x -x +y -y +z -z, "
+                  "default +z)");
+  sub->add_option("--copies,-n", args->copies, "tile: number of copies; city: number of blocks")
+      ->check(whole_number())
+      ->check(CLI::Range(1, 1024));
   sub->add_option("--count", args->count, "demo: number of Gaussians")->check(whole_number())->check(CLI::Range(1, 200000000));
   sub->add_flag("--force", args->force, "overwrite a scene already in the output folder");
   sub->callback([args] { run(*args); });

@@ -21,6 +21,7 @@
 #include "flashgs/parse.h"
 #include "flashgs/percentile.h"
 #include "flashgs/renderer.h"
+#include "flashgs/rotation.h"
 #include "flashgs/scene_formats.h"
 #include "option_checks.h"
 
@@ -69,41 +70,16 @@ void run_build(const BuildArgs& args) {
     std::printf("level %zu: %llu Gaussians\n", level, static_cast<unsigned long long>(r.level_gaussians[level]));
 }
 
-// A rotation (world-to-camera rows) as a unit quaternion and back, for the path's blends.
-void to_quaternion(const float m[9], double q[4]) {
-  const double t = m[0] + m[4] + m[8];
-  if (t > 0) {
-    const double s = 2 * std::sqrt(t + 1);
-    q[0] = 0.25 * s, q[1] = (m[7] - m[5]) / s, q[2] = (m[2] - m[6]) / s, q[3] = (m[3] - m[1]) / s;
-  } else if (m[0] > m[4] && m[0] > m[8]) {
-    const double s = 2 * std::sqrt(1 + m[0] - m[4] - m[8]);
-    q[0] = (m[7] - m[5]) / s, q[1] = 0.25 * s, q[2] = (m[1] + m[3]) / s, q[3] = (m[2] + m[6]) / s;
-  } else if (m[4] > m[8]) {
-    const double s = 2 * std::sqrt(1 + m[4] - m[0] - m[8]);
-    q[0] = (m[2] - m[6]) / s, q[1] = (m[1] + m[3]) / s, q[2] = 0.25 * s, q[3] = (m[5] + m[7]) / s;
-  } else {
-    const double s = 2 * std::sqrt(1 + m[8] - m[0] - m[4]);
-    q[0] = (m[3] - m[1]) / s, q[1] = (m[2] + m[6]) / s, q[2] = (m[5] + m[7]) / s, q[3] = 0.25 * s;
-  }
-}
-
-void to_matrix(const double q[4], float m[9]) {
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                       2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                       2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-  for (int k = 0; k < 9; ++k) m[k] = static_cast<float>(r[k]);
-}
-
 // The path through `cameras` in their order, `steps` frames from each to the next: positions
 // blended linearly, rotations by normalised quaternion blend.
 std::vector<Camera> fly_path(const std::vector<Camera>& cameras, int steps, int width, int height) {
   std::vector<Camera> path;
   for (std::size_t i = 0; i + 1 < cameras.size(); ++i) {
     const Camera a = cameras[i].resized(width, height), b = cameras[i + 1].resized(width, height);
-    double qa[4], qb[4];
-    to_quaternion(a.rotation, qa);
-    to_quaternion(b.rotation, qb);
+    double ra[9], rb[9], qa[4], qb[4];
+    for (int k = 0; k < 9; ++k) ra[k] = a.rotation[k], rb[k] = b.rotation[k];
+    quaternion_from_matrix(ra, qa);
+    quaternion_from_matrix(rb, qb);
     if (qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3] < 0)
       for (double& c : qb) c = -c;
     for (int s = 0; s < steps; ++s) {
@@ -115,7 +91,9 @@ std::vector<Camera> fly_path(const std::vector<Camera>& cameras, int steps, int 
         n += q[k] * q[k];
       }
       for (double& v : q) v /= std::sqrt(n);
-      to_matrix(q, c.rotation);
+      double m[9];
+      matrix_from_quaternion(q, m);
+      for (int k = 0; k < 9; ++k) c.rotation[k] = static_cast<float>(m[k]);
       for (int k = 0; k < 3; ++k) c.position[k] = static_cast<float>((1 - t) * a.position[k] + t * b.position[k]);
       path.push_back(c);
     }

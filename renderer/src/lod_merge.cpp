@@ -6,19 +6,18 @@
 #include <cmath>
 #include <numeric>
 
+#include "flashgs/rotation.h"
+
 namespace flashgs {
 namespace {
 
 using Mat3 = std::array<std::array<double, 3>, 3>;
 
 Mat3 rotation_of(const float* q_in) {
-  double w = q_in[0], x = q_in[1], y = q_in[2], z = q_in[3];
-  const double n = std::sqrt(w * w + x * x + y * y + z * z);
-  if (n > 0) w /= n, x /= n, y /= n, z /= n;
-  else w = 1, x = y = z = 0;
-  return Mat3{{{1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
-               {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
-               {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)}}};
+  const double q[4] = {q_in[0], q_in[1], q_in[2], q_in[3]};
+  double m[9];
+  matrix_from_quaternion(q, m);
+  return Mat3{{{m[0], m[1], m[2]}, {m[3], m[4], m[5]}, {m[6], m[7], m[8]}}};
 }
 
 // Jacobi eigen-decomposition of a symmetric 3x3 matrix: a = V diag(values) V^T, V's columns
@@ -53,28 +52,6 @@ void symmetric_eigen(Mat3 a, std::array<double, 3>& values, Mat3& v) {
       }
   }
   for (int k = 0; k < 3; ++k) values[k] = a[k][k];
-}
-
-// The unit quaternion (w, x, y, z) of a rotation matrix with determinant +1.
-std::array<double, 4> quaternion_of(const Mat3& m) {
-  const double trace = m[0][0] + m[1][1] + m[2][2];
-  std::array<double, 4> q;
-  if (trace > 0) {
-    const double s = 2 * std::sqrt(trace + 1);
-    q = {0.25 * s, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s};
-  } else if (m[0][0] > m[1][1] && m[0][0] > m[2][2]) {
-    const double s = 2 * std::sqrt(1 + m[0][0] - m[1][1] - m[2][2]);
-    q = {(m[2][1] - m[1][2]) / s, 0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s};
-  } else if (m[1][1] > m[2][2]) {
-    const double s = 2 * std::sqrt(1 + m[1][1] - m[0][0] - m[2][2]);
-    q = {(m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s};
-  } else {
-    const double s = 2 * std::sqrt(1 + m[2][2] - m[0][0] - m[1][1]);
-    q = {(m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s};
-  }
-  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  for (double& c : q) c /= n;
-  return q;
 }
 
 double section_area(double s0, double s1, double s2) { return s0 * s1 + s1 * s2 + s2 * s0; }
@@ -146,7 +123,9 @@ void append_merged(const Scene& scene, const std::uint32_t* indices, std::size_t
   // A merge of flat Gaussians stays flat but not degenerate: the smallest axis keeps a sliver.
   const double largest = std::max({scale[0], scale[1], scale[2]});
   for (double& s : scale) s = std::max(s, largest * 1e-6);
-  const std::array<double, 4> q = quaternion_of(v);
+  const double rows[9] = {v[0][0], v[0][1], v[0][2], v[1][0], v[1][1], v[1][2], v[2][0], v[2][1], v[2][2]};
+  double q[4];
+  quaternion_from_matrix(rows, q);
   double mass = 0;
   for (std::size_t j = 0; j < count; ++j) mass += merge_weight(scene, indices[j]);
   const double opacity = std::min(1.0, mass / section_area(scale[0], scale[1], scale[2]));
