@@ -93,3 +93,27 @@ TEST(Repository, NoRoundLabelsInTheSourceTree) {
   EXPECT_TRUE(offences.empty()) << offences.size() << " lines label text by development round:\n"
                                 << report;
 }
+
+// Every environment variable the code reads to tune a frame is a row of docs/TUNING.md: a knob
+// added without its row (default, what it trades, where it was measured) fails here.
+TEST(Repository, EveryTuningVariableIsDocumented) {
+  const fs::path root(FLASHGS_PROJECT_SOURCE_DIR);
+  const std::string table = read_all(root / "docs" / "TUNING.md");
+  ASSERT_FALSE(table.empty()) << "docs/TUNING.md is missing";
+  const std::regex read_variable(std::string("getenv\\(\"(FLASHGS_") + "[A-Z0-9_]+)\"\\)");
+  std::vector<std::string> found, missing;
+  for (const char* part : {"cuda", "renderer", "app"})
+    for (const fs::directory_entry& entry : fs::recursive_directory_iterator(root / part)) {
+      if (!entry.is_regular_file()) continue;
+      const std::string text = read_all(entry.path());
+      for (std::sregex_iterator it(text.begin(), text.end(), read_variable), end; it != end; ++it) {
+        const std::string name = (*it)[1].str();
+        found.push_back(name);
+        if (table.find("| `" + name + "` |") == std::string::npos) missing.push_back(name + " (" + entry.path().string() + ")");
+      }
+    }
+  EXPECT_GE(found.size(), 10u) << "the scan found too few variables: the pattern no longer matches the code";
+  std::string report;
+  for (const std::string& m : missing) report += m + "\n";
+  EXPECT_TRUE(missing.empty()) << "variables read but not in docs/TUNING.md:\n" << report;
+}
