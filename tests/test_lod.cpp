@@ -254,6 +254,27 @@ TEST(LodStream, UnderATinyCapEveryFrameStillRendersAndTheCapHolds) {
   }
 }
 
+// The renderer's working memory counts against the cap: the budget leaves room for it.
+TEST(LodStream, TheFramesWorkingMemoryIsInsideTheCap) {
+  LodStreamOptions options;
+  options.cut.max_error_px = 0.0f;
+  options.host_bytes = 4u << 20;
+  lod_frame_costs(BackendKind::cpu, 160, 90, 2, &options.host_frame, &options.device_frame);
+  EXPECT_GT(options.host_frame.fixed, 160u * 90 * 12 - 1);  // the float image at least
+  EXPECT_GT(options.host_frame.per_gaussian, 50u);
+  LodStreamer streamer(read_lod_set(demo_set()), options);
+  const std::uint64_t scene_bytes = 4 * (14 + 9);  // the demo scene is SH degree 1
+  const Camera camera = test::load_demo_cameras()[5].resized(160, 90);
+  streamer.update(camera);
+  streamer.wait_until_idle();
+  const std::shared_ptr<const Scene> scene = streamer.update(camera);
+  const LodStreamStats s = streamer.stats();
+  EXPECT_EQ(s.budget, (options.host_bytes / 2 - options.host_frame.fixed) / (2 * scene_bytes + options.host_frame.per_gaussian));
+  EXPECT_GT(scene->size(), 0u);
+  EXPECT_LE(s.host_high_water, options.host_bytes);
+  EXPECT_GE(s.host_bytes, options.host_frame.fixed + scene->size() * (scene_bytes + options.host_frame.per_gaussian));
+}
+
 TEST(LodStream, ACorruptChunkIsOneLineAndTheRestKeepsRendering) {
   const std::string dir = fresh_folder("corrupt");
   fs::copy(demo_set(), dir, fs::copy_options::recursive);

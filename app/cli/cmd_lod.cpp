@@ -132,6 +132,9 @@ void run_fly(const FlyArgs& args) {
     reference_renderer = create_backend(args.backend);
     reference_renderer->set_scene(full);
   }
+  const bool cpu = renderer->name().rfind("cpu", 0) == 0;
+  lod_frame_costs(cpu ? BackendKind::cpu : BackendKind::cuda, size.width, size.height,
+                  static_cast<int>(std::thread::hardware_concurrency()), &options.host_frame, &options.device_frame);
   LodStreamer streamer(std::move(set), options);
   const LodSet& lod = streamer.set();
   std::printf("set %s: %zu leaves, %d levels, level 0 %llu Gaussians; path of %zu frames at %dx%d through %zu cameras\n",

@@ -15,6 +15,8 @@ LodStreamOptions stream_options(const StreamSettings& s) {
   options.cut.max_error_px = s.max_error_px;
   options.host_bytes = s.host_bytes;
   options.device_bytes = s.device_bytes;
+  options.host_frame = s.host_frame;
+  options.device_frame = s.device_frame;
   return options;
 }
 

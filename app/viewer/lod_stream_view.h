@@ -16,6 +16,7 @@ struct StreamSettings {
   std::uint64_t budget = 0;   // Gaussians drawn at most, 0: the caps' only
   float max_error_px = 1.0f;  // refine while a leaf's error is larger
   std::uint64_t host_bytes = 0, device_bytes = 0;  // 0: no cap
+  LodFrameCost host_frame, device_frame;           // what the renderer needs beside the scene
 };
 
 class LodStreamView {

@@ -1,9 +1,11 @@
 // Opening scenes in the viewer: the first one (generated, named or the demo file, tiled), one
 // the user opens (beside the frame loop, or at once in scripted runs), another LOD level, and
 // installing a loaded scene into the frame path and the navigation.
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <thread>
 
 #include "count_text.h"
 #include "flashgs/demo_scene.h"
@@ -13,6 +15,7 @@
 #include "memory_budget.h"
 #include "scene_state.h"
 #include "viewer_app_gl.h"
+#include "window_gl.h"
 
 namespace flashgs::viewer {
 
@@ -77,6 +80,11 @@ void ViewerApp::start_stream() {
   settings.max_error_px = m_args.stream_max_error_px;
   settings.host_bytes = m_args.host_memory_mb << 20;
   settings.device_bytes = m_path_is_cpu ? 0 : m_args.gpu_memory_mb << 20;
+  int width = 0, height = 0;  // the frames' cost beside the scene, at the window's size
+  m_window->framebuffer_size(&width, &height);
+  lod_frame_costs(m_path_is_cpu ? BackendKind::cpu : BackendKind::cuda, std::max(width, 1), std::max(height, 1),
+                  m_args.cpu_threads > 0 ? m_args.cpu_threads : static_cast<int>(std::thread::hardware_concurrency()),
+                  &settings.host_frame, &settings.device_frame);
   m_settings.stream_max_error_px = settings.max_error_px;
   m_settings.stream_budget_millions = static_cast<float>(static_cast<double>(settings.budget) / 1e6);
   try {

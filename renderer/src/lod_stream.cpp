@@ -21,9 +21,9 @@ struct LodStreamer::Chunk {
 
 namespace {
 
-// GPU memory of a drawn scene per byte of its Gaussians: the scene itself, the per-Gaussian
-// records of the preprocess and the sort's keys (about; the CUDA renderer sizes them to the scene).
-constexpr std::uint64_t kDeviceBytesPerSceneByte = 3;
+// Gaussian-tile pairs per drawn Gaussian that the frame costs are sized for (flash on the real
+// scenes: 1.5-6 at 1080p).
+constexpr std::uint64_t kPairsPerGaussian = 4;
 // Frames of the camera's last step to look ahead when prefetching.
 constexpr float kPrefetchFrames = 8.0f;
 
@@ -32,6 +32,15 @@ std::uint64_t bytes_per_gaussian(int sh_degree) {
 }
 
 }  // namespace
+
+void lod_frame_costs(BackendKind backend, int width, int height, int cpu_threads, LodFrameCost* host,
+                     LodFrameCost* device) {
+  constexpr std::size_t kMillion = 1000000;
+  const FrameMemory none = estimate_frame_memory(backend, 0, width, height, 0, cpu_threads);
+  const FrameMemory many = estimate_frame_memory(backend, kMillion, width, height, kPairsPerGaussian * kMillion, cpu_threads);
+  if (host) *host = LodFrameCost{none.host, (many.host - none.host) / kMillion};
+  if (device) *device = LodFrameCost{none.device, (many.device - none.device) / kMillion};
+}
 
 LodStreamer::LodStreamer(LodSet set, LodStreamOptions options) : m_set(std::move(set)), m_options(options) {
   const int files = static_cast<int>(m_set.files.size());
@@ -64,14 +73,25 @@ LodStreamer::LodStreamer(LodSet set, LodStreamOptions options) : m_set(std::move
     }
   }
   if (m_bytes_per_gaussian == 0) throw Error(m_set.meta_path + ": none of the set's chunk files can be read");
-  // Two drawn scenes (the one drawn and the next) take at most half of the host cap; the
-  // chunks the rest.
+  // Two drawn scenes (the one drawn and the next) and the frame's working memory take at most
+  // half of the host cap; the chunks the rest. On the GPU, the drawn scene and the frame.
   m_budget = options.cut.budget ? options.cut.budget : std::numeric_limits<std::uint64_t>::max();
-  if (options.host_bytes) m_budget = std::min(m_budget, options.host_bytes / 4 / m_bytes_per_gaussian);
-  if (options.device_bytes)
-    m_budget = std::min(m_budget, options.device_bytes / (kDeviceBytesPerSceneByte * m_bytes_per_gaussian));
-  m_chunk_cap = options.host_bytes ? options.host_bytes - std::min(options.host_bytes, 2 * m_budget * m_bytes_per_gaussian)
-                                   : std::numeric_limits<std::uint64_t>::max();
+  const std::uint64_t drawn_per_gaussian = 2 * m_bytes_per_gaussian + options.host_frame.per_gaussian;
+  if (options.host_bytes) {
+    const std::uint64_t half = options.host_bytes / 2;
+    m_budget = std::min(m_budget, half > options.host_frame.fixed ? (half - options.host_frame.fixed) / drawn_per_gaussian : 0);
+  }
+  if (options.device_bytes) {
+    const std::uint64_t cap = options.device_bytes;
+    m_budget = std::min(m_budget, cap > options.device_frame.fixed
+                                      ? (cap - options.device_frame.fixed) / (m_bytes_per_gaussian + options.device_frame.per_gaussian)
+                                      : 0);
+  }
+  m_chunk_cap = std::numeric_limits<std::uint64_t>::max();
+  if (options.host_bytes) {
+    const std::uint64_t drawn = m_budget * drawn_per_gaussian + options.host_frame.fixed;
+    m_chunk_cap = options.host_bytes - std::min(options.host_bytes, drawn);
+  }
   for (int t = 0; t < std::max(1, options.threads); ++t) m_threads.emplace_back([this] { load_loop(); });
 }
 
@@ -280,7 +300,8 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
     m_scene = std::move(scene);
     m_drawn = std::move(drawn);
     std::lock_guard<std::mutex> lock(m_mutex);
-    m_drawn_bytes = m_scene->size() * m_bytes_per_gaussian;
+    // The scene drawn now and the frame that renders it.
+    m_drawn_bytes = m_scene->size() * (m_bytes_per_gaussian + m_options.host_frame.per_gaussian) + m_options.host_frame.fixed;
   }
   stats.drawn_gaussians = m_scene->size();
   m_stats = stats;

@@ -12,16 +12,31 @@
 #include <vector>
 
 #include "flashgs/camera.h"
+#include "flashgs/frame_memory.h"
 #include "flashgs/lod_cut.h"
 #include "flashgs/lod_set.h"
 #include "flashgs/scene.h"
 
 namespace flashgs {
 
+// What the renderer needs beside the drawn scene to render it: fixed bytes (the image, the
+// tiles) and bytes per drawn Gaussian (its records and pairs).
+struct LodFrameCost {
+  std::uint64_t fixed = 0, per_gaussian = 0;
+};
+// The host and GPU costs of a width x height frame on `backend` (estimate_frame_memory, with
+// four pairs per Gaussian).
+void lod_frame_costs(BackendKind backend, int width, int height, int cpu_threads, LodFrameCost* host,
+                     LodFrameCost* device);
+
 struct LodStreamOptions {
   LodCutOptions cut;
-  std::uint64_t host_bytes = 0;    // memory for chunks and the drawn scene; 0 = no cap
-  std::uint64_t device_bytes = 0;  // GPU memory for the drawn scene; 0 = no cap (CPU backend)
+  // The caps: everything the stream and the renderer hold (chunks, loads in flight, the drawn
+  // scene and the next, the frame's working memory); 0 = no cap. device_bytes: the drawn scene
+  // uploaded and the frame's GPU memory (CUDA backend).
+  std::uint64_t host_bytes = 0;
+  std::uint64_t device_bytes = 0;
+  LodFrameCost host_frame, device_frame;
   int threads = 2;                 // chunk loaders
   bool prefetch = true;            // also load what the view will need if the camera keeps moving
 };
@@ -34,7 +49,7 @@ struct LodStreamStats {
   int leaves_coarser = 0;  // drawn coarser than the cut wants: their chunk is on its way
   int leaves_missing = 0;  // in the cut but with no level in memory yet
   int files_resident = 0, files_queued = 0, files_failed = 0;
-  std::uint64_t host_bytes = 0, host_high_water = 0;  // chunks, loads in flight and drawn scenes
+  std::uint64_t host_bytes = 0, host_high_water = 0;  // chunks, loads in flight, drawn scenes, the frame
   std::uint64_t bytes_read = 0;                        // chunk file bytes read so far
   float worst_error_px = 0;                            // of the cut wanted
 };
