@@ -131,30 +131,25 @@ void replot(const ReportArgs& args) {
 }
 
 // The report into the checked output folder.
-void measure(const ReportArgs& args) {
-  for (const char* name : kReportFiles) check_output_file("--output-dir", args.output_dir + "/" + name);
-  const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
-  const std::string scene_path = args.scene.resolved_scene();
-  auto scene = load_scene_verbose(scene_path, args.scene.lod);
-  const std::string cameras_path = args.scene.resolved_cameras();
-  const std::vector<Camera> all_cameras = load_cameras(cameras_path);
+// --camera-list (or 0, 2, ..., 34 as far as the file has them), cut to --max-cameras.
+std::vector<int> report_camera_ids(const ReportArgs& args, std::size_t camera_count, const std::string& cameras_path) {
   const bool listed = args.camera_list_option->count() > 0;
   std::vector<int> kept = listed ? parse_index_list("--camera-list", args.camera_list_text) : std::vector<int>{};
   if (!listed) {
     // The default list (the views of ANCHORS.md), as far as the file has them.
-    for (int i = 0; i <= 34 && i < static_cast<int>(all_cameras.size()); i += 2) kept.push_back(i);
+    for (int i = 0; i <= 34 && i < static_cast<int>(camera_count); i += 2) kept.push_back(i);
     if (kept.empty()) throw Error(cameras_path + ": holds no camera");
   }
-  check_camera_indices("--camera-list", kept, all_cameras.size(), cameras_path);
+  check_camera_indices("--camera-list", kept, camera_count, cameras_path);
   if (args.max_cameras > 0 && static_cast<int>(kept.size()) > args.max_cameras) kept.resize(args.max_cameras);
+  return kept;
+}
 
-  SweepFrames frames;
-  for (int i : kept) {
-    Camera c = all_cameras[i];
-    if (!args.resolution.empty()) c = c.resized(size.width, size.height);
-    frames.cameras.push_back(c);
-  }
-  std::vector<std::pair<std::string, std::unique_ptr<Renderer>>> backends;
+using NamedBackends = std::vector<std::pair<std::string, std::unique_ptr<Renderer>>>;
+
+// The backends --backend asks for (all: every one present, a missing one noted).
+NamedBackends report_backends(const ReportArgs& args) {
+  NamedBackends backends;
   for (const char* name : {"cpu", "cuda"}) {
     if (args.backend != "all" && args.backend != name) continue;
     try {
@@ -164,38 +159,37 @@ void measure(const ReportArgs& args) {
       std::fprintf(stderr, "note: backend %s not measured: %s\n", name, e.what());
     }
   }
-  for (auto& [name, renderer] : backends)
-    check_frame_fits(*renderer, frames.cameras.front(), scene->size(),
-                     args.resolution.empty() ? "the cameras' size" : "--resolution");
+  return backends;
+}
+
+// fp64 reference windows: the centre and two off-centre squares of side `side`. The reference
+// costs pixels x Gaussians, so it is evaluated on these windows of the first few cameras only.
+// Returns the seconds it took.
+double add_reference(const Scene& scene, const SplatKernel& kernel, int side, std::size_t ref_cameras, SweepFrames& frames) {
   const int width = frames.cameras[0].width, height = frames.cameras[0].height;
-  // fp64 reference windows: the centre and two off-centre squares. The reference costs
-  // pixels x Gaussians, so it is evaluated on these windows of the first few cameras only.
-  const int s = std::min({args.ref_window, width, height});
   auto window_at = [&](double fx, double fy) {
     PixelWindow w;
-    w.width = w.height = s;
-    w.x0 = std::clamp(static_cast<int>(fx * width) - s / 2, 0, width - s);
-    w.y0 = std::clamp(static_cast<int>(fy * height) - s / 2, 0, height - s);
+    w.width = w.height = side;
+    w.x0 = std::clamp(static_cast<int>(fx * width) - side / 2, 0, width - side);
+    w.y0 = std::clamp(static_cast<int>(fy * height) - side / 2, 0, height - side);
     return w;
   };
   frames.windows = {window_at(0.5, 0.5), window_at(0.35, 0.6), window_at(0.65, 0.4)};
-  const std::size_t ref_cameras = std::min<std::size_t>(std::max(0, args.ref_cameras), frames.cameras.size());
   const auto ref_start = std::chrono::steady_clock::now();
-  const SplatKernel kernel = args.kernel.resolve(*scene);
   RenderOptions ref_options;
   ref_options.kernel = kernel;
   for (std::size_t c = 0; c < ref_cameras; ++c) {
     std::vector<Image> per_window;
-    for (const PixelWindow& w : frames.windows)
-      per_window.push_back(render_reference(*scene, frames.cameras[c], ref_options, w));
+    for (const PixelWindow& w : frames.windows) per_window.push_back(render_reference(scene, frames.cameras[c], ref_options, w));
     frames.reference.push_back(std::move(per_window));
   }
-  const double ref_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - ref_start).count();
-  std::fprintf(stderr, "fp64 reference: %zu cameras x %zu windows of %dx%d in %.1f s\n", ref_cameras,
-               frames.windows.size(), s, s, ref_seconds);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - ref_start).count();
+}
 
+// Every configuration of the sweep on every backend, each on a fresh renderer.
+std::vector<SweepResult> sweep(NamedBackends& backends, const std::shared_ptr<const Scene>& scene, const SplatKernel& kernel,
+                               SweepFrames& frames, int repeat, std::vector<std::string>& backend_names) {
   std::vector<SweepResult> results;
-  std::vector<std::string> backend_names;
   for (auto& [name, renderer] : backends) {
     renderer->set_scene(scene);
     backend_names.push_back(name + ": " + renderer->name());
@@ -207,7 +201,7 @@ void measure(const ReportArgs& args) {
       // that rendered the baseline first would be the baseline's for every configuration.
       std::unique_ptr<Renderer> fresh = create_backend(name);
       fresh->set_scene(scene);
-      SweepResult r = measure_config(*fresh, name, config, frames, args.repeat);
+      SweepResult r = measure_config(*fresh, name, config, frames, repeat);
       std::fprintf(stderr, "%-5s %-22s median %9.3f ms  p95 %9.3f ms  kv %11.0f  vs baseline %6s dB  vs fp64 %6s dB (%.0f s)\n",
                    name.c_str(), config.name.c_str(), r.median_ms, r.p95_ms, r.kv_pairs,
                    psnr_text(r.vs_baseline.psnr_db).c_str(), psnr_text(r.vs_reference.psnr_db).c_str(),
@@ -215,58 +209,74 @@ void measure(const ReportArgs& args) {
       results.push_back(std::move(r));
     }
   }
+  return results;
+}
 
-  const std::string stem = args.output_dir + "/report";
-  // CSV: one row per (backend, configuration).
-  {
-    std::ostringstream csv;
-    // One column per switch (its label token): 1 where it is in effect.
-    csv << "backend,config,group,algorithm,";
-    for (const RenderSwitch& s : kRenderSwitches) csv << s.label << ',';
-    csv << "tau,fp16_sh,fp16_shape,fp16_blend,median_ms,p95_ms,frames,kv_pairs,peak_memory_mb,psnr_vs_baseline_db,"
-           "max_abs_vs_baseline,frac_over_1_255_vs_baseline,psnr_vs_fp64_db,max_abs_vs_fp64,frac_over_1_255_vs_fp64,"
-           "non_finite,pareto\n";
-    for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
-      std::vector<SweepResult> subset;
-      for (const SweepResult& r : results)
-        if (r.backend == bname) subset.push_back(r);
-      const std::vector<std::size_t> front = pareto_front(subset);
-      for (std::size_t i = 0; i < subset.size(); ++i) {
-        const SweepResult& r = subset[i];
-        const RenderOptions& o = r.config.options;
-        csv << r.backend << ',' << r.config.name << ',' << r.config.group << ',' << algorithm_name(o.algorithm) << ',';
-        for (const RenderSwitch& s : kRenderSwitches) csv << (!o.is_baseline() && o.*(s.member)) << ',';
-        csv << fmt("%.6g", o.tau) << ',' << o.fp16_sh << ',' << o.fp16_shape << ',' << o.fp16_blend << ','
-            << fmt("%.4f", r.median_ms) << ',' << fmt("%.4f", r.p95_ms) << ',' << r.frame_ms.size() << ','
-            << fmt("%.0f", r.kv_pairs) << ','
-            << (r.peak_memory_mb >= 0 ? fmt("%.1f", r.peak_memory_mb) : "") << ','
-            << psnr_csv(r.vs_baseline.psnr_db) << ',' << fmt("%.3e", r.vs_baseline.max_abs) << ','
-            << fmt("%.3e", r.vs_baseline.fraction_over) << ',' << psnr_csv(r.vs_reference.psnr_db) << ','
-            << fmt("%.3e", r.vs_reference.max_abs) << ',' << fmt("%.3e", r.vs_reference.fraction_over) << ','
-            << (r.vs_baseline.non_finite + r.vs_reference.non_finite) << ','
-            << (std::find(front.begin(), front.end(), i) != front.end()) << '\n';
-      }
+std::vector<SweepResult> results_of(const std::vector<SweepResult>& results, const std::string& backend) {
+  std::vector<SweepResult> subset;
+  for (const SweepResult& r : results)
+    if (r.backend == backend) subset.push_back(r);
+  return subset;
+}
+
+// report.csv: one row per (backend, configuration), one column per switch.
+void write_csv(const std::vector<SweepResult>& results, const std::string& path) {
+  std::ostringstream csv;
+  // One column per switch (its label token): 1 where it is in effect.
+  csv << "backend,config,group,algorithm,";
+  for (const RenderSwitch& s : kRenderSwitches) csv << s.label << ',';
+  csv << "tau,fp16_sh,fp16_shape,fp16_blend,median_ms,p95_ms,frames,kv_pairs,peak_memory_mb,psnr_vs_baseline_db,"
+         "max_abs_vs_baseline,frac_over_1_255_vs_baseline,psnr_vs_fp64_db,max_abs_vs_fp64,frac_over_1_255_vs_fp64,"
+         "non_finite,pareto\n";
+  for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
+    const std::vector<SweepResult> subset = results_of(results, bname);
+    const std::vector<std::size_t> front = pareto_front(subset);
+    for (std::size_t i = 0; i < subset.size(); ++i) {
+      const SweepResult& r = subset[i];
+      const RenderOptions& o = r.config.options;
+      csv << r.backend << ',' << r.config.name << ',' << r.config.group << ',' << algorithm_name(o.algorithm) << ',';
+      for (const RenderSwitch& s : kRenderSwitches) csv << (!o.is_baseline() && o.*(s.member)) << ',';
+      csv << fmt("%.6g", o.tau) << ',' << o.fp16_sh << ',' << o.fp16_shape << ',' << o.fp16_blend << ','
+          << fmt("%.4f", r.median_ms) << ',' << fmt("%.4f", r.p95_ms) << ',' << r.frame_ms.size() << ','
+          << fmt("%.0f", r.kv_pairs) << ',' << (r.peak_memory_mb >= 0 ? fmt("%.1f", r.peak_memory_mb) : "") << ','
+          << psnr_csv(r.vs_baseline.psnr_db) << ',' << fmt("%.3e", r.vs_baseline.max_abs) << ','
+          << fmt("%.3e", r.vs_baseline.fraction_over) << ',' << psnr_csv(r.vs_reference.psnr_db) << ','
+          << fmt("%.3e", r.vs_reference.max_abs) << ',' << fmt("%.3e", r.vs_reference.fraction_over) << ','
+          << (r.vs_baseline.non_finite + r.vs_reference.non_finite) << ','
+          << (std::find(front.begin(), front.end(), i) != front.end()) << '\n';
     }
-    write_file_atomically(stem + ".csv", csv.str());
   }
-  // Markdown and one plot per backend.
+  write_file_atomically(path, csv.str());
+}
+
+// What report.md says about the run above its table.
+struct ReportContext {
+  std::string scene_path, title, camera_text;
+  const Scene* scene = nullptr;
+  SplatKernel kernel;
+  int width = 0, height = 0, window_side = 0;
+  std::size_t windows = 0, ref_cameras = 0;
+  double ref_seconds = 0;
+  std::vector<std::string> backend_names;
+};
+
+// report.md and one plot per backend, report_<backend>.svg.
+void write_markdown_and_plots(const ReportArgs& args, const ReportContext& c, const std::vector<SweepResult>& results,
+                              const std::string& stem) {
   std::ostringstream md;
-  const std::string title = args.title.empty() ? std::filesystem::path(scene_path).parent_path().filename().string()
-                                               : args.title;
-  std::string camera_text;
-  for (int i : kept) camera_text += (camera_text.empty() ? "" : ", ") + std::to_string(i);
-  md << "# flashgs report: " << title << "\n\n";
-  md << "- scene: `" << scene_path << "`, " << scene->size() << " Gaussians, SH degree " << scene->sh_degree
-     << ", drawn with the " << kernel.description() << " kernel ("
-     << (args.kernel.chosen() ? std::string("--kernel") : kernel_summary(scene->trained_kernel)) << ")\n";
-  md << "- cameras " << camera_text << " at " << width << "x" << height << "; per camera one warm-up frame, then "
+  md << "# flashgs report: " << c.title << "\n\n";
+  md << "- scene: `" << c.scene_path << "`, " << c.scene->size() << " Gaussians, SH degree " << c.scene->sh_degree
+     << ", drawn with the " << c.kernel.description() << " kernel ("
+     << (args.kernel.chosen() ? std::string("--kernel") : kernel_summary(c.scene->trained_kernel)) << ")\n";
+  md << "- cameras " << c.camera_text << " at " << c.width << "x" << c.height << "; per camera one warm-up frame, then "
      << args.repeat << " timed frames; time is the backend's FrameStats total (CPU: wall time of the stages)\n";
   md << "- host: " << cpu_model() << ", " << std::thread::hardware_concurrency() << " hardware threads\n";
-  for (const std::string& b : backend_names) md << "- backend " << b << "\n";
+  for (const std::string& b : c.backend_names) md << "- backend " << b << "\n";
   md << "- error vs baseline: whole frames against the same backend's baseline render; error vs fp64: the fp64 "
         "brute-force reference (cost pixels x Gaussians) on "
-     << frames.windows.size() << " windows of " << s << "x" << s << " px (centre, (0.35, 0.6), (0.65, 0.4) of the "
-     << "frame) of the first " << ref_cameras << " camera(s), " << fmt("%.0f", ref_seconds) << " s\n";
+     << c.windows << " windows of " << c.window_side << "x" << c.window_side
+     << " px (centre, (0.35, 0.6), (0.65, 0.4) of the "
+     << "frame) of the first " << c.ref_cameras << " camera(s), " << fmt("%.0f", c.ref_seconds) << " s\n";
   md << "- peak MB: the backend's working memory above the scene (high-water mark of a backend created for that "
         "configuration); \"-\": not reported (CPU)\n";
   md << "- PSNR with peak 1.0 on float images; \"> 1/255\": fraction of pixels with a channel off by more than 1/255; "
@@ -276,9 +286,7 @@ void measure(const ReportArgs& args) {
   md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<std::string> plots;
   for (const std::string& bname : {std::string("cpu"), std::string("cuda")}) {
-    std::vector<SweepResult> subset;
-    for (const SweepResult& r : results)
-      if (r.backend == bname) subset.push_back(r);
+    const std::vector<SweepResult> subset = results_of(results, bname);
     if (subset.empty()) continue;
     const std::vector<std::size_t> front = pareto_front(subset);
     for (std::size_t i = 0; i < subset.size(); ++i) {
@@ -292,13 +300,13 @@ void measure(const ReportArgs& args) {
          << (std::find(front.begin(), front.end(), i) != front.end() ? "yes" : "") << " |\n";
     }
     std::string device;
-    for (const auto& b : backend_names)
+    for (const auto& b : c.backend_names)
       if (b.rfind(bname + ":", 0) == 0) device = b.substr(bname.size() + 2);
-    const std::string subtitle = std::to_string(scene->size()) + " Gaussians, " + std::to_string(width) + "x" +
-                                 std::to_string(height) + ", cameras " + camera_text + ", " + device +
+    const std::string subtitle = std::to_string(c.scene->size()) + " Gaussians, " + std::to_string(c.width) + "x" +
+                                 std::to_string(c.height) + ", cameras " + c.camera_text + ", " + device +
                                  (bname == "cpu" ? " on " + cpu_model() : "");
     const std::string svg_path = stem + "_" + bname + ".svg";
-    write_file_atomically(svg_path, plot_svg(subset, "Error vs run time: " + title + " (" + bname + ")", subtitle));
+    write_file_atomically(svg_path, plot_svg(subset, "Error vs run time: " + c.title + " (" + bname + ")", subtitle));
     plots.push_back("report_" + bname + ".svg");
     std::printf("wrote %s\n", svg_path.c_str());
   }
@@ -306,6 +314,45 @@ void measure(const ReportArgs& args) {
   for (const std::string& p : plots) md << " [" << p << "](" << p << ")";
   md << "\n";
   write_file_atomically(stem + ".md", md.str());
+}
+
+void measure(const ReportArgs& args) {
+  for (const char* name : kReportFiles) check_output_file("--output-dir", args.output_dir + "/" + name);
+  const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
+  ReportContext context;
+  context.scene_path = args.scene.resolved_scene();
+  auto scene = load_scene_verbose(context.scene_path, args.scene.lod);
+  context.scene = scene.get();
+  const std::string cameras_path = args.scene.resolved_cameras();
+  const std::vector<Camera> all_cameras = load_cameras(cameras_path);
+  const std::vector<int> kept = report_camera_ids(args, all_cameras.size(), cameras_path);
+  SweepFrames frames;
+  for (int i : kept) {
+    Camera c = all_cameras[i];
+    if (!args.resolution.empty()) c = c.resized(size.width, size.height);
+    frames.cameras.push_back(c);
+  }
+  NamedBackends backends = report_backends(args);
+  for (auto& [name, renderer] : backends)
+    check_frame_fits(*renderer, frames.cameras.front(), scene->size(),
+                     args.resolution.empty() ? "the cameras' size" : "--resolution");
+  context.width = frames.cameras[0].width;
+  context.height = frames.cameras[0].height;
+  context.window_side = std::min({args.ref_window, context.width, context.height});
+  context.ref_cameras = std::min<std::size_t>(std::max(0, args.ref_cameras), frames.cameras.size());
+  context.kernel = args.kernel.resolve(*scene);
+  context.ref_seconds = add_reference(*scene, context.kernel, context.window_side, context.ref_cameras, frames);
+  context.windows = frames.windows.size();
+  std::fprintf(stderr, "fp64 reference: %zu cameras x %zu windows of %dx%d in %.1f s\n", context.ref_cameras,
+               context.windows, context.window_side, context.window_side, context.ref_seconds);
+
+  const std::vector<SweepResult> results = sweep(backends, scene, context.kernel, frames, args.repeat, context.backend_names);
+  const std::string stem = args.output_dir + "/report";
+  write_csv(results, stem + ".csv");
+  context.title = args.title.empty() ? std::filesystem::path(context.scene_path).parent_path().filename().string()
+                                     : args.title;
+  for (int i : kept) context.camera_text += (context.camera_text.empty() ? "" : ", ") + std::to_string(i);
+  write_markdown_and_plots(args, context, results, stem);
   std::printf("wrote %s.csv and %s.md\n", stem.c_str(), stem.c_str());
 }
 
