@@ -189,8 +189,8 @@ void run_fly(const FlyArgs& args) {
               "not yet in memory %d\n",
               percentile(drawn_d, 0.5), percentile(drawn_d, 1.0), s.budget ? std::to_string(s.budget).c_str() : "none", swaps,
               missing_frames);
-  std::printf("host memory: high-water %.1f MB of a %s cap; chunk bytes read %.1f MB (%.1f MB/s); files resident %d, failed %d\n",
-              static_cast<double>(s.host_high_water) / 1e6,
+  std::printf("host memory: high-water %.1f MiB of a %s cap; chunk bytes read %.1f MB (%.1f MB/s); files resident %d, failed %d\n",
+              static_cast<double>(s.host_high_water) / (1 << 20),
               args.host_mb ? (std::to_string(args.host_mb) + " MiB").c_str() : "no",
               static_cast<double>(s.bytes_read) / 1e6, static_cast<double>(s.bytes_read) / 1e6 / seconds, s.files_resident,
               s.files_failed);
