@@ -64,7 +64,10 @@ PyScene scene_from_arrays(py::handle means_in, py::handle quats_in, py::handle s
     const double norm = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
     if (!(norm > 0) || !std::isfinite(norm))
       throw Error("quats: row " + std::to_string(i) + " has no direction (a zero quaternion)");
-    for (int k = 0; k < 4; ++k) q[k] = static_cast<float>(q[k] / norm);
+    // One of unit length to float rounding stays as it is, so that a scene's own arrays come back
+    // bit for bit (normalising again would move some components by an ulp).
+    if (std::abs(norm - 1.0) > 1e-6)
+      for (int k = 0; k < 4; ++k) q[k] = static_cast<float>(q[k] / norm);
   }
 
   // gsplat's (N, K, 3) coefficients split into the DC term and the rest, [k][channel] per Gaussian.
