@@ -28,8 +28,12 @@ py::array_t<float> copy_cuda_array(const py::dict& interface, const std::string&
   const std::string type = py::str(interface["typestr"]);
   std::vector<py::ssize_t> shape;
   for (py::handle extent : py::tuple(interface["shape"])) shape.push_back(extent.cast<py::ssize_t>());
-  const bool contiguous = !interface.contains("strides") || interface["strides"].is_none() ||
-                          py::tuple(interface["strides"]).cast<std::vector<py::ssize_t>>() == byte_strides(shape);
+  bool contiguous = true;  // strides None (or left out) mean C order
+  if (interface.contains("strides") && !interface["strides"].is_none()) {
+    std::vector<py::ssize_t> strides;
+    for (py::handle stride : py::tuple(interface["strides"])) strides.push_back(stride.cast<py::ssize_t>());
+    contiguous = strides == byte_strides(shape);
+  }
   if (type != "<f4" || !contiguous)
     throw Error(name + ": a CUDA array must be contiguous float32 (it is " + type +
                 (contiguous ? "" : ", strided") + "; use tensor.float().contiguous())");

@@ -138,3 +138,24 @@ def test_type_stubs_name_every_option():
     stub = (pathlib.Path(flashgs.__file__).parent / "__init__.pyi").read_text()
     for name in flashgs.RenderOptions.names():
         assert f"    {name}: " in stub, f"__init__.pyi lacks RenderOptions.{name}"
+
+
+class FakeCudaArray:
+    """An object that says it lives on a CUDA device at an address no device has."""
+
+    def __init__(self, shape, typestr="<f4", strides=None):
+        self.__cuda_array_interface__ = {"shape": shape, "typestr": typestr, "data": (0x10, False),
+                                         "strides": strides, "version": 3}
+
+
+def test_cuda_arrays_are_read_through_their_interface():
+    good = dict(means=np.zeros((2, 3)), quats=np.tile([1.0, 0, 0, 0], (2, 1)), scales=np.full((2, 3), 0.1),
+                opacities=np.full(2, 0.5), sh=np.zeros((2, 1, 3)))
+    with pytest.raises(flashgs.Error, match=r"means: a CUDA array must be contiguous float32 \(it is <f8;"):
+        flashgs.Scene.from_arrays(**{**good, "means": FakeCudaArray((2, 3), "<f8")})
+    with pytest.raises(flashgs.Error, match=r"means: .*strided"):
+        flashgs.Scene.from_arrays(**{**good, "means": FakeCudaArray((2, 3), strides=(24, 4))})
+    # A well-formed one reaches the copy, which fails without a device (or without CUDA in the build).
+    expected = "means: cannot copy the CUDA array" if flashgs.has_cuda else "means: a CUDA array, but this build"
+    with pytest.raises(flashgs.Error, match=expected):
+        flashgs.Scene.from_arrays(**{**good, "means": FakeCudaArray((2, 3), strides=(12, 4))})
