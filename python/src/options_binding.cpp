@@ -2,7 +2,6 @@
 // table as an attribute of its label, the kernel ("auto" = the scene's), tau, background, SH cap
 // and the fp16 options, each checked as the CLI checks its flag.
 #include <cmath>
-#include <iterator>
 #include <string>
 
 #include <pybind11/stl.h>
