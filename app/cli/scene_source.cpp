@@ -1,7 +1,6 @@
 // Scene, camera, option and backend selection shared by the CLI subcommands.
 #include "scene_source.h"
 
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 
@@ -37,35 +36,6 @@ SceneLocation SceneArgs::locate() const {
     location.cameras = cameras_path;
   }
   return location;
-}
-
-namespace {
-
-Scene load_sog_lod_level(const std::string& path, int lod, LoadReport* report) {
-  const SogLodSet set = describe_sog_lod(path);
-  const AvailableMemory memory = available_host_memory();
-  const int level = lod >= 0 ? lod : choose_sog_lod_level(set, memory.bytes);
-  if (level >= static_cast<int>(set.levels.size()))
-    throw Error("--lod " + std::to_string(lod) + ": " + path + " has levels 0.." + std::to_string(set.levels.size() - 1));
-  const SogLodLevel& chosen = set.levels[static_cast<std::size_t>(level)];
-  std::fprintf(stderr, "%s: LOD level %d of 0..%zu, %zu Gaussians (%s)\n", path.c_str(), level, set.levels.size() - 1,
-               chosen.gaussians,
-               lod >= 0 ? "--lod"
-                        : ("the finest needing at most half of the " + format_bytes(memory.bytes) + " available").c_str());
-  const auto began = std::chrono::steady_clock::now();
-  Scene scene = read_sog_lod(path, level, report);
-  report->decode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-  report->format = std::string(format_name(SceneFormat::sog)) + ", LOD level " + std::to_string(level);
-  report->quantisation = format_quantisation(SceneFormat::sog);
-  return scene;
-}
-
-}  // namespace
-
-Scene load_scene_at_level(const std::string& path, int lod, LoadReport* report) {
-  const bool lod_set = is_sog_lod_set(path);
-  if (lod >= 0 && !lod_set) throw Error("--lod: " + path + " is not a SOG LOD set (lod-meta.json)");
-  return lod_set ? load_sog_lod_level(path, lod, report) : load_scene_file(path, report);
 }
 
 std::string describe_lod_levels(const std::string& path) {

@@ -12,6 +12,7 @@
 #include "flashgs/options.h"
 #include "flashgs/scene.h"
 #include "kernel_option.h"
+#include "scene_level.h"
 #include "switch_flags.h"
 
 namespace flashgs::cli {
@@ -32,9 +33,6 @@ struct SceneArgs {
   CLI::Option* m_cameras_option = nullptr;
 };
 
-// Reads the scene file into `report`'s scene: a SOG LOD set at level `lod` (-1: the finest
-// that fits in memory; the choice is printed to stderr); `lod` >= 0 for any other scene is an error.
-Scene load_scene_at_level(const std::string& path, int lod, LoadReport* report);
 // Loads the scene, printing what the loader dropped to stderr.
 std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod = -1);
 // A SOG LOD set's levels, one line each (Gaussians, SH degree, memory), for `flashgs info`;

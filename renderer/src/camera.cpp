@@ -1,7 +1,11 @@
-// Camera construction from a pose, and resizing with the field of view kept.
+// Camera construction from a pose, resizing with the field of view kept, and the rotation check.
 #include "flashgs/camera.h"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "flashgs/error.h"
 
 namespace flashgs {
 
@@ -36,6 +40,23 @@ Camera Camera::resized(int new_width, int new_height) const {
 
 float Camera::horizontal_fov_degrees() const {
   return static_cast<float>(2.0 * std::atan(0.5 * width / fx) * 180.0 / M_PI);
+}
+
+void check_rotation(const double rows[9], const std::string& where) {
+  // R^T R must be the identity and det R = +1 (a proper rotation).
+  double worst = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      double dot = 0;
+      for (int k = 0; k < 3; ++k) dot += rows[k * 3 + a] * rows[k * 3 + b];
+      worst = std::max(worst, std::abs(dot - (a == b ? 1.0 : 0.0)));
+    }
+  const double det = rows[0] * (rows[4] * rows[8] - rows[5] * rows[7]) -
+                     rows[1] * (rows[3] * rows[8] - rows[5] * rows[6]) +
+                     rows[2] * (rows[3] * rows[7] - rows[4] * rows[6]);
+  if (!(worst <= 1e-3) || det < 0)
+    throw Error(where + ": rotation is not orthonormal (|R^T R - I| = " + std::to_string(worst) +
+                ", det = " + std::to_string(det) + ")");
 }
 
 }  // namespace flashgs

@@ -98,20 +98,7 @@ std::vector<Camera> parse_cameras(const std::string& json_text, const std::strin
         if (!std::isfinite(rows[r * 3 + c])) throw Error(where + ": rotation has a non-finite entry");
       }
     }
-    // R^T R must be the identity and det R = +1 (a proper rotation).
-    double worst = 0;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        double dot = 0;
-        for (int k = 0; k < 3; ++k) dot += rows[k * 3 + a] * rows[k * 3 + b];
-        worst = std::max(worst, std::abs(dot - (a == b ? 1.0 : 0.0)));
-      }
-    const double det = rows[0] * (rows[4] * rows[8] - rows[5] * rows[7]) -
-                       rows[1] * (rows[3] * rows[8] - rows[5] * rows[6]) +
-                       rows[2] * (rows[3] * rows[7] - rows[4] * rows[6]);
-    if (worst > 1e-3 || det < 0)
-      throw Error(where + ": rotation is not orthonormal (|R^T R - I| = " + std::to_string(worst) +
-                  ", det = " + std::to_string(det) + ")");
+    check_rotation(rows, where);
     float r[9], c[3];
     for (int k = 0; k < 9; ++k) r[k] = static_cast<float>(rows[k]);
     for (int k = 0; k < 3; ++k) c[k] = static_cast<float>(position[k]);

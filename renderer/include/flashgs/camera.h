@@ -25,4 +25,8 @@ struct Camera {
   float horizontal_fov_degrees() const;
 };
 
+// Throws flashgs::Error starting with `where` unless the row-major 3x3 `rows` is a proper
+// rotation (R^T R = I within 1e-3, det R = +1).
+void check_rotation(const double rows[9], const std::string& where);
+
 }  // namespace flashgs

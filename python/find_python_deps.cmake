@@ -1,0 +1,25 @@
+# Decides whether the Python module is built: FLASHGS_PYTHON on, Python's development headers
+# and pybind11 found, and no sanitizer (an instrumented module cannot load into a plain Python).
+# FLASHGS_PYTHON_MODULE_ABSENT says why not, for the tests that then skip.
+set(FLASHGS_PYTHON_MODULE OFF)
+set(FLASHGS_PYTHON_MODULE_ABSENT "FLASHGS_PYTHON is OFF")
+if(FLASHGS_PYTHON AND (FLASHGS_SANITIZE OR FLASHGS_SANITIZE_THREAD))
+  set(FLASHGS_PYTHON_MODULE_ABSENT "off in sanitizer builds")
+elseif(FLASHGS_PYTHON)
+  find_package(Python 3.8 COMPONENTS Interpreter Development.Module QUIET)
+  if(Python_FOUND)
+    set(PYBIND11_FINDPYTHON ON)  # pybind11 uses the Python found above
+    find_package(pybind11 2.6 CONFIG QUIET)
+  endif()
+  if(Python_FOUND AND pybind11_FOUND)
+    set(FLASHGS_PYTHON_MODULE ON)
+    message(STATUS "Python module: ${Python_EXECUTABLE} (${Python_VERSION}), pybind11 ${pybind11_VERSION}")
+  elseif(NOT Python_FOUND)
+    set(FLASHGS_PYTHON_MODULE_ABSENT "Python's development headers not found (Debian: python3-dev)")
+  else()
+    set(FLASHGS_PYTHON_MODULE_ABSENT "pybind11 not found (Debian: python3-pybind11)")
+  endif()
+endif()
+if(NOT FLASHGS_PYTHON_MODULE)
+  message(STATUS "Python module: ${FLASHGS_PYTHON_MODULE_ABSENT}")
+endif()
