@@ -464,8 +464,8 @@ TEST(CliConvert, BadOutputsAreRefusedBeforeReading) {
   const std::string ply = dir + "/point_cloud.ply";
   const auto size = fs::file_size(ply);
   expect_one_line_error(run_cli("convert " + ply + " " + dir + "/out.obj"),
-                        "OUT " + dir + "/out.obj: unknown scene format (the extension picks it: .ply (INRIA PLY) or "
-                        ".splat)", "unknown extension");
+                        "OUT " + dir + "/out.obj: unknown scene format (the name picks it: .ply (INRIA PLY), "
+                        ".compressed.ply, .splat, .spz, .sog", "unknown extension");
   EXPECT_FALSE(fs::exists(dir + "/out.obj"));
   expect_one_line_error(run_cli("convert " + ply + " " + ply), "is the input file itself", "same path");
   expect_one_line_error(run_cli("convert " + ply + " " + dir + "/../convert_bad/point_cloud.ply --force"),

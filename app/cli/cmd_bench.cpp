@@ -135,7 +135,7 @@ void run(const BenchArgs& args) {
   std::vector<Resolution> resolutions;
   for (const std::string& text : args.resolutions) resolutions.push_back(parse_resolution(text));
   const std::string scene_path = args.scene.resolved_scene();
-  std::shared_ptr<const Scene> scene = load_scene_verbose(scene_path, args.scene.lod);
+  std::shared_ptr<const Scene> scene = load_scene_verbose(scene_path, args.scene.lod, args.scene.read_options());
   if (args.copies > 1) {
     const std::uint64_t wanted = static_cast<std::uint64_t>(scene->byte_size()) * args.copies;
     const AvailableMemory available = available_host_memory();

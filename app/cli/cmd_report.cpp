@@ -135,7 +135,7 @@ void measure(const ReportArgs& args) {
   for (const char* name : kReportFiles) check_output_file("--output-dir", args.output_dir + "/" + name);
   const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
   const std::string scene_path = args.scene.resolved_scene();
-  auto scene = load_scene_verbose(scene_path, args.scene.lod);
+  auto scene = load_scene_verbose(scene_path, args.scene.lod, args.scene.read_options());
   const std::string cameras_path = args.scene.resolved_cameras();
   const std::vector<Camera> all_cameras = load_cameras(cameras_path);
   const bool listed = args.camera_list_option->count() > 0;
