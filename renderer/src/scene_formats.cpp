@@ -74,6 +74,8 @@ bool is_ply(const FileStart& f) { return starts_as_ply(f); }
 
 // .splat has no magic number: the extension decides, and its parser checks the size.
 bool is_splat(const FileStart& f) { return ends_with(f.name, ".splat"); }
+// .ksplat has a version in its first bytes but no magic number: the extension decides.
+bool is_ksplat(const FileStart& f) { return ends_with(f.name, ".ksplat"); }
 
 Scene parse_inria_ply(const char* data, std::size_t size, const std::string& name, LoadReport& report,
                       LoadProgress* progress, const SceneReadOptions&) {
@@ -107,7 +109,7 @@ Scene parse_sog_bundle(const char* data, std::size_t size, const std::string& na
                        LoadProgress* progress, const SceneReadOptions&) {
   const ZipReader zip(data, size, name);
   if (!zip.contains("meta.json"))
-    throw Error(name + ": a zip archive without meta.json: not a SOG bundle (expected a PLY, .splat, .spz or SOG)");
+    throw Error(name + ": a zip archive without meta.json: not a SOG bundle (expected a PLY, .splat, .ksplat, .spz or SOG)");
   const std::vector<char> meta = zip.read("meta.json", kMaxSogJsonBytes);
   const SogFileSource files = [&zip](const std::string& file) { return zip.read(file, kMaxSogTextureBytes); };
   return parse_sog(std::string(meta.begin(), meta.end()), files, name, &report, progress);
@@ -126,6 +128,7 @@ const FormatReader kReaders[] = {
     {SceneFormat::sog, is_sog, nullptr, read_sog_file},
     {SceneFormat::sog_bundle, is_zip, parse_sog_bundle},
     {SceneFormat::splat, is_splat, without_options<parse_splat>},
+    {SceneFormat::ksplat, is_ksplat, without_options<parse_ksplat>},
 };
 
 double seconds_since(std::chrono::steady_clock::time_point began) {
@@ -142,7 +145,7 @@ std::string describe_start(const FileStart& f) {
 const FormatReader& recognise(const FileStart& start) {
   for (const FormatReader& reader : kReaders)
     if (reader.recognises(start)) return reader;
-  throw Error(start.name + ": not a scene file: " + describe_start(start) + "; expected a PLY, .splat, .spz or SOG");
+  throw Error(start.name + ": not a scene file: " + describe_start(start) + "; expected a PLY, .splat, .ksplat, .spz or SOG");
 }
 
 void note_format(LoadReport& report, SceneFormat format) {

@@ -123,9 +123,7 @@ Packed read_zstd_streams(const unsigned char* data, std::size_t size, Header& he
                          LoadProgress* progress) {
   if (size < kV4HeaderBytes) fail(name, "the SPZ version 4 header is cut short (" + std::to_string(size) + " bytes)");
   header = parse_header(data, name);
-  if (header.version != 4)
-    fail(name, "an uncompressed SPZ header of version " + std::to_string(header.version) +
-                   " (versions 1-3 are a gzip stream)");
+  if (header.version != 4) fail(name, "an SPZ header of version " + std::to_string(header.version) + " here");
   const Layout layout(header);
   const int streams = data[15];
   const std::uint32_t toc_offset = read_u32(data + 16);
@@ -159,6 +157,29 @@ Packed read_zstd_streams(const unsigned char* data, std::size_t size, Header& he
   if (offset != size)
     fail(name, "the streams end at byte " + std::to_string(offset) + " but the file has " + std::to_string(size) +
                    " bytes: a wrong table of contents, or junk after it");
+  return packed;
+}
+
+// Versions 1-3 stored without gzip (some writers leave the stream uncompressed): the 16-byte
+// header, then each attribute in turn, exactly as inside the gzip stream.
+Packed read_raw_streams(const unsigned char* data, std::size_t size, Header& header, const std::string& name) {
+  if (size < kGzipHeaderBytes) fail(name, "the SPZ header is cut short (" + std::to_string(size) + " bytes)");
+  header = parse_header(data, name);
+  const Layout layout(header);
+  const std::uint64_t expected = std::uint64_t{header.count} * layout.total();
+  const std::uint64_t available = size - kGzipHeaderBytes;
+  if (expected > available || (expected < available && !(header.flags & kFlagHasExtensions)))
+    fail(name, "the header declares " + std::to_string(header.count) + " Gaussians (" + std::to_string(expected) +
+                   " bytes) but the uncompressed file holds " + std::to_string(available) + " bytes after it: " +
+                   (expected > available ? "truncated file or wrong count" : "extra data or wrong count"));
+  check_memory(header, layout, name);
+  Packed packed;
+  const std::size_t sizes[6] = {layout.position, layout.alpha, layout.color, layout.scale, layout.rotation, layout.sh};
+  const unsigned char* at = data + kGzipHeaderBytes;
+  for (int a = 0; a < 6; ++a) {
+    packed.attribute[a].assign(at, at + header.count * sizes[a]);
+    at += header.count * sizes[a];
+  }
   return packed;
 }
 
@@ -285,6 +306,8 @@ Scene parse_spz(const char* data, std::size_t size, const std::string& name, Loa
   Packed packed;
   if (size >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b)
     packed = read_gzip_streams(bytes, size, header, name, progress);
+  else if (size >= 8 && read_u32(bytes) == kSpzMagic && read_u32(bytes + 4) != 4)
+    packed = read_raw_streams(bytes, size, header, name);
   else if (size >= 4 && read_u32(bytes) == kSpzMagic)
     packed = read_zstd_streams(bytes, size, header, name, progress);
   else
