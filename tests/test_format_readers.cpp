@@ -14,6 +14,7 @@
 #include <zlib.h>
 
 #include "compressed_builders.h"
+#include "format_builders.h"
 #include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
 #include "flashgs/model_constants.h"
@@ -53,14 +54,7 @@ std::string error_of(Load&& load) {
 TEST(SogVersion1, DecodesItsRangesLikeTheLinearCodebooksOfVersion2) {
   std::mt19937 rng(11);
   const test::SogChunk v2 = test::random_sog_chunk(300, 2, rng);
-  test::SogChunk v1 = v2;
-  nlohmann::json& meta = v1.meta;
-  meta.erase("version");
-  meta.erase("count");
-  meta["means"]["shape"] = {300, 3};
-  meta["scales"] = {{"mins", {-8, -8, -8}}, {"maxs", {-1, -1, -1}}, {"files", {"scales.webp"}}};
-  meta["sh0"] = {{"mins", {-2, -2, -2, -5}}, {"maxs", {3, 3, 3, 5}}, {"files", {"sh0.webp"}}};
-  meta["shN"] = {{"mins", -1}, {"maxs", 1}, {"files", {"shN_centroids.webp", "shN_labels.webp"}}};
+  const test::SogChunk v1 = test::sog_version_1(v2);
   const Scene a = v2.parse(), b = v1.parse();
   ASSERT_EQ(b.size(), a.size());
   ASSERT_EQ(b.sh_degree, 2) << "the band count comes from the palette's width";
@@ -159,95 +153,11 @@ TEST(SpzUncompressed, ReadsTheGzipStreamsContentStoredBare) {
 
 // ---- .ksplat ----
 
-void put16(std::string& s, std::uint16_t v) { s.append(reinterpret_cast<const char*>(&v), 2); }
-void put32(std::string& s, std::uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
-void putf(std::string& s, float v) { s.append(reinterpret_cast<const char*>(&v), 4); }
-// The nearest half of a normal value.
-std::uint16_t half_of(float v) {
-  if (v == 0) return 0;
-  const std::uint16_t sign = v < 0 ? 0x8000 : 0;
-  int exponent;
-  const float fraction = std::frexp(std::abs(v), &exponent);  // in [0.5, 1)
-  int mantissa = static_cast<int>(std::lround((fraction * 2 - 1) * 1024));
-  if (mantissa == 1024) mantissa = 0, ++exponent;  // rounded up to the next power of two
-  return static_cast<std::uint16_t>(sign | (exponent - 1 + 15) << 10 | mantissa);
-}
-
-struct KsplatGaussian {
-  float position[3], scale[3], rotation[4];
-  std::uint8_t rgba[4];
-  std::vector<float> sh;  // file order: band by band, channel-major in each band
-};
-
-// One section of `gs` with buckets of 4 (full ones, then partial ones of the remainder in
-// twos), SH degree `degree`, compression `mode`; SH range [-2, 2] for mode 2.
-std::string ksplat_file(const std::vector<KsplatGaussian>& gs, int mode, int degree) {
-  const std::uint32_t capacity = 4, n = static_cast<std::uint32_t>(gs.size());
-  const std::uint32_t full = n / capacity, rest = n % capacity;
-  std::vector<std::uint32_t> partial;
-  for (std::uint32_t left = rest; left > 0; left -= std::min(left, 2u)) partial.push_back(std::min(left, 2u));
-  const std::uint32_t buckets = full + static_cast<std::uint32_t>(partial.size());
-  const float block = 2.0f;
-  const std::uint32_t q = 32767;
-  std::string f(4096, '\0');
-  f[0] = 0;
-  f[1] = 1;
-  const std::uint32_t sections = 1;
-  std::memcpy(&f[4], &sections, 4);
-  std::memcpy(&f[16], &n, 4);
-  const std::uint16_t m = static_cast<std::uint16_t>(mode);
-  std::memcpy(&f[20], &m, 2);
-  const float lo = -2, hi = 2;
-  std::memcpy(&f[36], &lo, 4);
-  std::memcpy(&f[40], &hi, 4);
-  std::string section(1024, '\0');
-  const std::uint32_t header[] = {n, n, capacity, buckets};
-  std::memcpy(&section[0], header, sizeof header);
-  std::memcpy(&section[16], &block, 4);
-  const std::uint16_t bucket_bytes = 12;
-  std::memcpy(&section[20], &bucket_bytes, 2);
-  std::memcpy(&section[32], &full, 4);
-  const std::uint32_t partial_count = static_cast<std::uint32_t>(partial.size());
-  std::memcpy(&section[36], &partial_count, 4);
-  const std::uint16_t d = static_cast<std::uint16_t>(degree);
-  std::memcpy(&section[40], &d, 2);
-  f += section;
-  for (std::uint32_t p : partial) put32(f, p);
-  // Bucket b's centre: (b, -b, 0.5 b).
-  for (std::uint32_t b = 0; b < buckets; ++b) {
-    putf(f, float(b));
-    putf(f, -float(b));
-    putf(f, 0.5f * b);
-  }
-  for (std::uint32_t i = 0; i < n; ++i) {
-    const KsplatGaussian& g = gs[i];
-    const std::uint32_t bucket = i < full * capacity ? i / capacity : full + (i - full * capacity) / 2;
-    const float centre[3] = {float(bucket), -float(bucket), 0.5f * bucket};
-    auto value = [&](float v) { mode == 0 ? putf(f, v) : put16(f, half_of(v)); };
-    for (int k = 0; k < 3; ++k) {
-      if (mode == 0)
-        putf(f, g.position[k]);
-      else
-        put16(f, static_cast<std::uint16_t>(std::lround((g.position[k] - centre[k]) / (block / 2 / q) + q)));
-    }
-    for (float s : g.scale) value(s);
-    for (float r : g.rotation) value(r);
-    f.append(reinterpret_cast<const char*>(g.rgba), 4);
-    for (float v : g.sh) {
-      if (mode == 2)
-        f.push_back(static_cast<char>(std::lround((v - lo) / (hi - lo) * 255)));
-      else
-        value(v);
-    }
-  }
-  return f;
-}
-
 TEST(Ksplat, DecodesEveryCompressionModeAndBucketLayout) {
   for (int mode : {0, 1, 2}) {
-    std::vector<KsplatGaussian> gs;
+    std::vector<test::KsplatGaussian> gs;
     for (int i = 0; i < 11; ++i) {  // two full buckets of 4, partial buckets of 2 and 1
-      KsplatGaussian g{};
+      test::KsplatGaussian g{};
       const std::uint32_t bucket = i < 8 ? i / 4 : 2 + (i - 8) / 2;
       for (int k = 0; k < 3; ++k) g.position[k] = (k == 0 ? bucket : k == 1 ? -float(bucket) : 0.5f * bucket) + 0.25f * (k + 1) * (i % 3 - 1);
       for (int k = 0; k < 3; ++k) g.scale[k] = 0.125f * (k + 1 + i % 2);
@@ -262,7 +172,7 @@ TEST(Ksplat, DecodesEveryCompressionModeAndBucketLayout) {
       gs.push_back(g);
     }
     const std::string path = scratch("mode" + std::to_string(mode) + ".ksplat");
-    write_bytes(path, ksplat_file(gs, mode, 2));
+    write_bytes(path, test::ksplat_file(gs, mode, 2));
     LoadReport report;
     const Scene scene = load_scene_file(path, &report);
     EXPECT_EQ(report.format, format_name(SceneFormat::ksplat));
@@ -289,12 +199,12 @@ TEST(Ksplat, DecodesEveryCompressionModeAndBucketLayout) {
 }
 
 TEST(Ksplat, BadFilesGetOneLine) {
-  std::vector<KsplatGaussian> gs(5);
+  std::vector<test::KsplatGaussian> gs(5);
   for (auto& g : gs) {
     g.rotation[0] = 1;
     g.scale[0] = g.scale[1] = g.scale[2] = 0.5f;
   }
-  const std::string good = ksplat_file(gs, 1, 0);
+  const std::string good = test::ksplat_file(gs, 1, 0);
   const std::string path = scratch("bad.ksplat");
   auto message_for = [&](const std::string& bytes) {
     write_bytes(path, bytes);
