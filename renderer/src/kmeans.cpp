@@ -15,7 +15,11 @@ std::vector<float> kmeans_1d(std::vector<float> values, std::size_t entries, int
   std::vector<double> prefix(n + 1, 0.0);
   for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + values[i];
   std::vector<double> centres;
-  for (std::size_t e = 0; e < entries; ++e) centres.push_back(values[std::min(n - 1, (2 * e + 1) * n / (2 * entries))]);
+  // The quantiles, and the two extremes: a few outliers (a saturated colour, a huge Gaussian)
+  // keep entries of their own instead of taking the nearest of the bulk's.
+  centres.push_back(values.front());
+  for (std::size_t e = 0; e + 2 < entries; ++e) centres.push_back(values[std::min(n - 1, (2 * e + 1) * n / (2 * (entries - 2)))]);
+  centres.push_back(values.back());
   for (int pass = 0; pass < iterations; ++pass) {
     centres.erase(std::unique(centres.begin(), centres.end()), centres.end());
     std::vector<double> next;
