@@ -225,4 +225,54 @@ inline SogChunk random_sog_chunk(std::size_t count, int bands, std::mt19937& rng
   return chunk;
 }
 
+// The same chunk as SOG version 1 (no "version"): the count in means.shape and ranges equal to
+// the builder's linear codebooks, so it decodes alike but for the opacity (a logit range).
+inline SogChunk sog_version_1(SogChunk chunk) {
+  nlohmann::json& meta = chunk.meta;
+  meta["means"]["shape"] = {meta["count"], 3};
+  meta.erase("version");
+  meta.erase("count");
+  meta["scales"] = {{"mins", {-8, -8, -8}}, {"maxs", {-1, -1, -1}}, {"files", {"scales.webp"}}};
+  meta["sh0"] = {{"mins", {-2, -2, -2, -5}}, {"maxs", {3, 3, 3, 5}}, {"files", {"sh0.webp"}}};
+  if (meta.contains("shN"))
+    meta["shN"] = {{"mins", -1}, {"maxs", 1}, {"files", {"shN_centroids.webp", "shN_labels.webp"}}};
+  return chunk;
+}
+
+// A zip archive of the chunk (meta.json, then its textures), stored, as a .sog bundle is.
+inline std::string sog_bundle(const SogChunk& chunk) {
+  std::vector<std::pair<std::string, std::string>> entries = {{"meta.json", chunk.meta.dump()}};
+  for (const auto& [name, bytes] : chunk.files) entries.push_back({name, std::string(bytes.begin(), bytes.end())});
+  std::string out, directory;
+  auto u16 = [](std::string& s, std::uint16_t v) { s.append(reinterpret_cast<const char*>(&v), 2); };
+  for (const auto& [name, bytes] : entries) {
+    const std::uint32_t crc = static_cast<std::uint32_t>(
+        crc32(0, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
+    const std::uint32_t offset = static_cast<std::uint32_t>(out.size()), size = static_cast<std::uint32_t>(bytes.size());
+    auto common = [&](std::string& s) {
+      u16(s, 20), u16(s, 0), u16(s, 0), u16(s, 0), u16(s, 0x21);
+      put_u32(s, crc), put_u32(s, size), put_u32(s, size);
+      u16(s, static_cast<std::uint16_t>(name.size())), u16(s, 0);
+    };
+    put_u32(out, 0x04034b50);
+    common(out);
+    out += name + bytes;
+    put_u32(directory, 0x02014b50);
+    u16(directory, 20);
+    common(directory);
+    u16(directory, 0), u16(directory, 0), u16(directory, 0);
+    put_u32(directory, 0), put_u32(directory, offset);
+    directory += name;
+  }
+  const std::uint32_t directory_offset = static_cast<std::uint32_t>(out.size());
+  out += directory;
+  put_u32(out, 0x06054b50);
+  u16(out, 0), u16(out, 0), u16(out, static_cast<std::uint16_t>(entries.size())),
+      u16(out, static_cast<std::uint16_t>(entries.size()));
+  put_u32(out, static_cast<std::uint32_t>(directory.size()));
+  put_u32(out, directory_offset);
+  u16(out, 0);
+  return out;
+}
+
 }  // namespace flashgs::test

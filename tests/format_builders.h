@@ -1,6 +1,8 @@
-// Builds small PlayCanvas compressed PLY and .splat files in memory for the format tests.
+// Builds small PlayCanvas compressed PLY, .splat and .ksplat files in memory for the format tests.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -60,6 +62,92 @@ inline std::string splat_record(const float position[3], const float scale[3], c
   append_bytes(out, rgba, 4);
   append_bytes(out, quat, 4);
   return out;
+}
+
+// ---- .ksplat ----
+
+inline void put16(std::string& s, std::uint16_t v) { append_bytes(s, &v, 2); }
+inline void put32(std::string& s, std::uint32_t v) { append_bytes(s, &v, 4); }
+inline void putf(std::string& s, float v) { append_bytes(s, &v, 4); }
+// The nearest half of a normal value.
+inline std::uint16_t half_of(float v) {
+  if (v == 0) return 0;
+  const std::uint16_t sign = v < 0 ? 0x8000 : 0;
+  int exponent;
+  const float fraction = std::frexp(std::abs(v), &exponent);  // in [0.5, 1)
+  int mantissa = static_cast<int>(std::lround((fraction * 2 - 1) * 1024));
+  if (mantissa == 1024) mantissa = 0, ++exponent;  // rounded up to the next power of two
+  return static_cast<std::uint16_t>(sign | (exponent - 1 + 15) << 10 | mantissa);
+}
+
+struct KsplatGaussian {
+  float position[3], scale[3], rotation[4];
+  std::uint8_t rgba[4];
+  std::vector<float> sh;  // file order: band by band, channel-major in each band
+};
+
+// One section of `gs` with buckets of 4 (full ones, then partial ones of the remainder in
+// twos), SH degree `degree`, compression `mode`; SH range [-2, 2] for mode 2.
+inline std::string ksplat_file(const std::vector<KsplatGaussian>& gs, int mode, int degree) {
+  const std::uint32_t capacity = 4, n = static_cast<std::uint32_t>(gs.size());
+  const std::uint32_t full = n / capacity, rest = n % capacity;
+  std::vector<std::uint32_t> partial;
+  for (std::uint32_t left = rest; left > 0; left -= std::min(left, 2u)) partial.push_back(std::min(left, 2u));
+  const std::uint32_t buckets = full + static_cast<std::uint32_t>(partial.size());
+  const float block = 2.0f;
+  const std::uint32_t q = 32767;
+  std::string f(4096, '\0');
+  f[0] = 0;
+  f[1] = 1;
+  const std::uint32_t sections = 1;
+  std::memcpy(&f[4], &sections, 4);
+  std::memcpy(&f[16], &n, 4);
+  const std::uint16_t m = static_cast<std::uint16_t>(mode);
+  std::memcpy(&f[20], &m, 2);
+  const float lo = -2, hi = 2;
+  std::memcpy(&f[36], &lo, 4);
+  std::memcpy(&f[40], &hi, 4);
+  std::string section(1024, '\0');
+  const std::uint32_t header[] = {n, n, capacity, buckets};
+  std::memcpy(&section[0], header, sizeof header);
+  std::memcpy(&section[16], &block, 4);
+  const std::uint16_t bucket_bytes = 12;
+  std::memcpy(&section[20], &bucket_bytes, 2);
+  std::memcpy(&section[32], &full, 4);
+  const std::uint32_t partial_count = static_cast<std::uint32_t>(partial.size());
+  std::memcpy(&section[36], &partial_count, 4);
+  const std::uint16_t d = static_cast<std::uint16_t>(degree);
+  std::memcpy(&section[40], &d, 2);
+  f += section;
+  for (std::uint32_t p : partial) put32(f, p);
+  // Bucket b's centre: (b, -b, 0.5 b).
+  for (std::uint32_t b = 0; b < buckets; ++b) {
+    putf(f, float(b));
+    putf(f, -float(b));
+    putf(f, 0.5f * b);
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const KsplatGaussian& g = gs[i];
+    const std::uint32_t bucket = i < full * capacity ? i / capacity : full + (i - full * capacity) / 2;
+    const float centre[3] = {float(bucket), -float(bucket), 0.5f * bucket};
+    auto value = [&](float v) { mode == 0 ? putf(f, v) : put16(f, half_of(v)); };
+    for (int k = 0; k < 3; ++k) {
+      if (mode == 0)
+        putf(f, g.position[k]);
+      else
+        put16(f, static_cast<std::uint16_t>(std::lround((g.position[k] - centre[k]) / (block / 2 / q) + q)));
+    }
+    for (float s : g.scale) value(s);
+    for (float r : g.rotation) value(r);
+    f.append(reinterpret_cast<const char*>(g.rgba), 4);
+    for (float v : g.sh) {
+      if (mode == 2)
+        f.push_back(static_cast<char>(std::lround((v - lo) / (hi - lo) * 255)));
+      else
+        value(v);
+    }
+  }
+  return f;
 }
 
 }  // namespace flashgs::test

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -458,14 +459,44 @@ TEST(CliConvert, ConvertsBetweenTheFormats) {
     EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
 }
 
+// The name picks the writer (x.compressed.ply is no plain PLY), and the loss is printed.
+TEST(CliConvert, TheNamePicksTheFormatAndTheLossIsPrinted) {
+  const std::string dir = scratch_dir("convert_formats");
+  ASSERT_EQ(run_cli("generate demo --count 600 -o " + dir).exit_code, 0);
+  const std::string ply = dir + "/point_cloud.ply";
+  const CliResult compressed = run_cli("convert " + ply + " " + dir + "/x.compressed.ply");
+  ASSERT_EQ(compressed.exit_code, 0) << compressed.output;
+  EXPECT_NE(compressed.output.find("wrote " + dir + "/x.compressed.ply (PlayCanvas compressed PLY)"), std::string::npos)
+      << compressed.output;
+  std::size_t written = 0, read_back = 1;
+  const std::size_t loss_at = compressed.output.find("loss: ");
+  ASSERT_NE(loss_at, std::string::npos) << compressed.output;
+  ASSERT_EQ(std::sscanf(compressed.output.c_str() + loss_at, "loss: %zu Gaussians written, %zu read back", &written,
+                        &read_back), 2) << compressed.output;
+  EXPECT_EQ(read_back, written);
+  EXPECT_GT(written, 500u);
+  EXPECT_NE(compressed.output.find("loss:   position"), std::string::npos) << compressed.output;
+  EXPECT_NE(compressed.output.find(" dB against the input's"), std::string::npos) << compressed.output;
+  const CliResult info = run_cli("info " + dir + "/x.compressed.ply");
+  EXPECT_NE(info.output.find("format:          PlayCanvas compressed PLY\n"), std::string::npos) << info.output;
+
+  const CliResult reduced = run_cli("convert " + ply + " " + dir + "/x.spz --sh-degree 0 --spz-version 4 --no-loss");
+  ASSERT_EQ(reduced.exit_code, 0) << reduced.output;
+  EXPECT_EQ(reduced.output.find("loss:"), std::string::npos) << reduced.output;
+  EXPECT_NE(run_cli("info " + dir + "/x.spz").output.find("sh degree:       0"), std::string::npos);
+  expect_one_line_error(run_cli("convert " + ply + " " + dir + "/y.spz --spz-axes opengl"), "--spz-axes", "bad axes");
+  expect_one_line_error(run_cli("convert " + ply + " " + dir + "/y.spz --spz-version 2"), "--spz-version", "bad version");
+  EXPECT_FALSE(fs::exists(dir + "/y.spz"));
+}
+
 TEST(CliConvert, BadOutputsAreRefusedBeforeReading) {
   const std::string dir = scratch_dir("convert_bad");
   ASSERT_EQ(run_cli("generate demo --count 300 -o " + dir).exit_code, 0);
   const std::string ply = dir + "/point_cloud.ply";
   const auto size = fs::file_size(ply);
   expect_one_line_error(run_cli("convert " + ply + " " + dir + "/out.obj"),
-                        "OUT " + dir + "/out.obj: unknown scene format (the extension picks it: .ply (INRIA PLY) or "
-                        ".splat)", "unknown extension");
+                        "OUT " + dir + "/out.obj: unknown scene format (the name picks it: .ply (INRIA PLY), "
+                        ".compressed.ply, .splat, .spz, .sog", "unknown extension");
   EXPECT_FALSE(fs::exists(dir + "/out.obj"));
   expect_one_line_error(run_cli("convert " + ply + " " + ply), "is the input file itself", "same path");
   expect_one_line_error(run_cli("convert " + ply + " " + dir + "/../convert_bad/point_cloud.ply --force"),

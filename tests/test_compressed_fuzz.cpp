@@ -9,6 +9,7 @@
 #include "compressed_builders.h"
 #include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
+#include "flashgs/scene_formats.h"
 
 namespace flashgs {
 namespace {
@@ -62,6 +63,8 @@ TEST(SpzFuzz, MutatedFilesLoadOrFailCleanly) {
     std::string file;
     if (version == 4) {
       file = mutate(test::spz_v4_file(content), rng, 32 + 6 * 16);
+    } else if (rng() % 3 == 0) {  // stored without gzip
+      file = mutate(test::spz_payload(content), rng, 16);
     } else if (rng() % 2) {  // a valid gzip stream around a mutated payload: the header and counts lie
       file = test::gzip(mutate(test::spz_payload(content), rng, 16));
     } else {  // the compressed bytes themselves
@@ -80,6 +83,7 @@ TEST(SogFuzz, MutatedChunksLoadOrFailCleanly) {
   int loaded = 0, rejected = 0;
   std::vector<test::SogChunk> seeds;
   for (int bands = 0; bands <= 3; ++bands) seeds.push_back(test::random_sog_chunk(20 + 7 * bands, bands, rng));
+  for (int bands = 0; bands <= 3; bands += 3) seeds.push_back(test::sog_version_1(test::random_sog_chunk(30, bands, rng)));
   for (int round = 0; round < 1000; ++round) {
     test::SogChunk chunk = seeds[rng() % seeds.size()];
     std::string meta = chunk.meta.dump();
@@ -102,6 +106,22 @@ TEST(SogFuzz, MutatedChunksLoadOrFailCleanly) {
     expect_clean([&] { return parse_sog(meta, chunk.source(), "fuzz/meta.json"); }, loaded, rejected);
   }
   std::printf("SOG fuzz: %d loaded, %d refused\n", loaded, rejected);
+  EXPECT_GT(loaded, 0);
+  EXPECT_GT(rejected, 0);
+}
+
+// The zipped bundle: mutated archives (headers, directory, entries) through the one entry point.
+TEST(SogFuzz, MutatedBundlesLoadOrFailCleanly) {
+  std::mt19937 rng(20241203);
+  std::vector<std::string> seeds;
+  for (int bands : {0, 2}) seeds.push_back(test::sog_bundle(test::random_sog_chunk(25, bands, rng)));
+  int loaded = 0, rejected = 0;
+  for (int round = 0; round < 1500; ++round) {
+    const std::string file = mutate(seeds[rng() % seeds.size()], rng, 64);
+    std::vector<char> copy(file.begin(), file.end());
+    expect_clean([&] { return parse_scene_bytes(copy.data(), copy.size(), "fuzz.sog"); }, loaded, rejected);
+  }
+  std::printf("SOG bundle fuzz: %d loaded, %d refused\n", loaded, rejected);
   EXPECT_GT(loaded, 0);
   EXPECT_GT(rejected, 0);
 }

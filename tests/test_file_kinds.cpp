@@ -262,7 +262,7 @@ TEST(FileKindsCli, TheSceneArgumentRefusesWhatIsNotAScene) {
       {odd.fifo, "is a FIFO (named pipe), not a regular file"},
       {odd.device, "is a device, not a regular file"},
       {odd.loop, "cannot open: a loop of symbolic links"},
-      {odd.empty, "not a scene file: it is empty; expected a PLY, .splat, .spz or SOG"}};
+      {odd.empty, "not a scene file: it is empty; expected a PLY, .splat, .ksplat, .spz or SOG"}};
   for (const char* command : {"info", "render"})
     for (const auto& [path, problem] : cases)
       expect_cli_error(std::string(command) + " " + quoted_arg(path), path.string() + ": " + problem);

@@ -77,12 +77,12 @@ TEST(SceneFormats, UnknownContentGetsOneLineNamingTheFile) {
   write_file(path, "GIF89a\x01\x02 and more");
   LoadProgress progress;
   EXPECT_EQ(error_of([&] { load_scene_file(path, nullptr, &progress); }),
-            path + ": not a scene file: it starts with \"GIF89a\\x01\\x02\"; expected a PLY, .splat, .spz or SOG");
+            path + ": not a scene file: it starts with \"GIF89a\\x01\\x02\"; expected a PLY, .splat, .ksplat, .spz or SOG");
   EXPECT_EQ(progress.bytes_total.load(), 0u) << "recognised from its first bytes, not read whole";
   const std::string empty = scratch_file("empty.bin");
   write_file(empty, "");
   EXPECT_EQ(error_of([&] { load_scene_file(empty); }),
-            empty + ": not a scene file: it is empty; expected a PLY, .splat, .spz or SOG");
+            empty + ": not a scene file: it is empty; expected a PLY, .splat, .ksplat, .spz or SOG");
 }
 
 TEST(SceneFormats, ContentDecidesOverTheExtension) {

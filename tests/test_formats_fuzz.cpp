@@ -1,4 +1,4 @@
-// Randomised mutation fuzzing of the compressed PLY and .splat readers and of the recogniser
+// Randomised mutation fuzzing of the compressed PLY, .splat and .ksplat readers and of the recogniser
 // that picks a reader (parse_scene_bytes), built with AddressSanitizer and UBSan: every
 // mutated file loads to finite values or fails with one line naming the file, never a crash,
 // an out-of-bounds read or an allocation larger than the file justifies.
@@ -36,7 +36,9 @@ Outcome try_parse(const std::string& bytes, const std::string& name) {
     return Outcome::loaded;
   } catch (const Error& e) {
     const std::string message = e.what();
-    EXPECT_EQ(message.rfind(name + ": ", 0), 0u) << "the message does not name the file: " << message;
+    // "<file>: ..." or, for a file inside an archive, "<file> -> <entry>: ...".
+    EXPECT_TRUE(message.rfind(name + ": ", 0) == 0 || message.rfind(name + " -> ", 0) == 0)
+        << "the message does not name the file: " << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << "a message of more than one line: " << message;
     return Outcome::rejected;
   }
@@ -113,16 +115,49 @@ TEST(FormatsFuzz, MutatedSplatFilesLoadOrFailCleanly) {
   EXPECT_GT(loaded, 1000);
 }
 
+TEST(FormatsFuzz, MutatedKsplatFilesLoadOrFailCleanly) {
+  std::mt19937 rng(55);
+  std::vector<std::string> seeds;
+  for (int mode = 0; mode <= 2; ++mode) {
+    std::vector<test::KsplatGaussian> gs(9);
+    for (std::size_t i = 0; i < gs.size(); ++i) {
+      gs[i].rotation[0] = 1;
+      for (int k = 0; k < 3; ++k) gs[i].scale[k] = 0.25f, gs[i].position[k] = 0.1f * float(i);
+      gs[i].rgba[3] = 200;
+      gs[i].sh.assign(static_cast<std::size_t>(mode == 2 ? 9 : 0), 0.5f);
+    }
+    seeds.push_back(test::ksplat_file(gs, mode, mode == 2 ? 1 : 0));
+  }
+  int loaded = 0, rejected = 0;
+  for (int i = 0; i < 20000; ++i) {
+    std::string s = seeds[i % seeds.size()];
+    for (int e = 1 + static_cast<int>(rng() % 4); e > 0 && !s.empty(); --e) {
+      // Half of the edits hit the main and section headers (the first 5120 bytes).
+      const std::size_t at = rng() % (rng() % 2 ? std::min<std::size_t>(s.size(), 4096 + 64) : s.size());
+      switch (rng() % 4) {
+        case 0: s.resize(at); break;
+        case 1: s[at] = static_cast<char>(rng()); break;
+        default: s[std::min(s.size() - 1, at < 4096 ? at % 48 : at)] = static_cast<char>(rng());  // the header's fields
+      }
+    }
+    (try_parse(s, "fuzz.ksplat") == Outcome::loaded ? loaded : rejected)++;
+  }
+  std::printf("fuzz: %d mutated .ksplat files loaded, %d rejected with an error\n", loaded, rejected);
+  EXPECT_GT(rejected, 1000);
+  EXPECT_GT(loaded, 1000);
+}
+
 TEST(FormatsFuzz, RandomBytesUnderAnyNameFailCleanly) {
   std::mt19937 rng(99);
-  const char* names[] = {"fuzz.ply", "fuzz.splat", "fuzz.spz", "fuzz.compressed.ply", "fuzz", "fuzz.SPLAT"};
+  const char* names[] = {"fuzz.ply", "fuzz.splat", "fuzz.spz", "fuzz.compressed.ply", "fuzz", "fuzz.SPLAT", "fuzz.ksplat",
+                         "fuzz.sog"};
   const char* prefixes[] = {"", "ply\n", "ply\r\n", "ply\nformat binary_little_endian 1.0\nelement chunk 1\n",
                             "\x1f\x8b\x08", "PK\x03\x04", "{\"version\":2"};
   int rejected = 0;
   for (int i = 0; i < 20000; ++i) {
     std::string s = prefixes[rng() % 7];
     for (std::size_t n = rng() % 200; n > 0; --n) s.push_back(static_cast<char>(rng() & 0xff));
-    rejected += try_parse(s, names[rng() % 6]) == Outcome::rejected;
+    rejected += try_parse(s, names[rng() % 8]) == Outcome::rejected;
   }
   EXPECT_GT(rejected, 10000);
 }

@@ -131,7 +131,7 @@ nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::js
 
 // The scene, tiled --tile times when asked (refused with the figures when the copies cannot fit).
 std::shared_ptr<const Scene> load_bench_scene(const BenchArgs& args, const std::string& scene_path) {
-  std::shared_ptr<const Scene> scene = load_scene_verbose(scene_path, args.scene.lod);
+  std::shared_ptr<const Scene> scene = load_scene_verbose(scene_path, args.scene.lod, args.scene.read_options());
   if (args.copies <= 1) return scene;
   const std::uint64_t wanted = static_cast<std::uint64_t>(scene->byte_size()) * args.copies;
   const AvailableMemory available = available_host_memory();

@@ -15,7 +15,7 @@ void register_info(CLI::App& app) {
   sub->callback([args] {
     const std::string path = args->resolved_scene();
     LoadReport report;
-    const Scene scene = load_scene_at_level(path, args->lod, &report);
+    const Scene scene = load_scene_at_level(path, args->lod, &report, args->read_options());
     std::printf("%s", summarize_scene(scene, &report).c_str());
     std::printf("%s", describe_lod_levels(path).c_str());
   });

@@ -23,7 +23,7 @@ struct RenderCommand {
   void run() const {
     check_output_image("--output", output);  // before the render, which may take long
     const std::string scene_path = scene.resolved_scene();
-    auto loaded = load_scene_verbose(scene_path, scene.lod);
+    auto loaded = load_scene_verbose(scene_path, scene.lod, scene.read_options());
     const Camera cam = camera.select(scene.resolved_cameras());
     auto renderer = create_backend(render.backend);
     check_frame_fits(*renderer, cam, loaded->size(),

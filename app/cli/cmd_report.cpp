@@ -321,7 +321,7 @@ void measure(const ReportArgs& args) {
   const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
   ReportContext context;
   context.scene_path = args.scene.resolved_scene();
-  auto scene = load_scene_verbose(context.scene_path, args.scene.lod);
+  auto scene = load_scene_verbose(context.scene_path, args.scene.lod, args.scene.read_options());
   context.scene = scene.get();
   const std::string cameras_path = args.scene.resolved_cameras();
   const std::vector<Camera> all_cameras = load_cameras(cameras_path);

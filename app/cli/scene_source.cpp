@@ -22,6 +22,13 @@ void SceneArgs::add_to(CLI::App* command) {
   m_cameras_option = command->add_option("--cameras", cameras_path, "cameras.json (default: the scene's own)");
   command->add_option("--lod", lod, kLodOptionHelp)->check(whole_number())
       ->check(CLI::NonNegativeNumber);
+  command->add_option("--spz-axes", spz_axes, kSpzAxesHelp)->check(CLI::IsMember({"niantic", "none"}));
+}
+
+SceneReadOptions SceneArgs::read_options() const {
+  SceneReadOptions options;
+  parse_spz_axes(spz_axes, options.spz_axes);  // the option's check admits only valid values
+  return options;
 }
 
 SceneLocation SceneArgs::locate() const {
@@ -55,9 +62,9 @@ std::string describe_lod_levels(const std::string& path) {
   return text;
 }
 
-std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod) {
+std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod, const SceneReadOptions& options) {
   LoadReport report;
-  auto scene = std::make_shared<Scene>(load_scene_at_level(path, lod, &report));
+  auto scene = std::make_shared<Scene>(load_scene_at_level(path, lod, &report, options));
   if (report.dropped_non_finite)
     std::fprintf(stderr, "%s: dropped %zu Gaussians with NaN/Inf attributes (or exp(scale) overflow)\n",
                  path.c_str(), report.dropped_non_finite);

@@ -11,6 +11,7 @@
 #include "flashgs/io.h"
 #include "flashgs/options.h"
 #include "flashgs/scene.h"
+#include "flashgs/scene_formats.h"
 #include "kernel_option.h"
 #include "scene_level.h"
 #include "switch_flags.h"
@@ -21,7 +22,10 @@ struct SceneArgs {
   std::string scene_path;    // a PLY or a scene folder; not given: the demo scene
   std::string cameras_path;  // not given: the scene's own cameras.json
   int lod = -1;              // level of a SOG LOD set; -1: the finest that fits in memory
+  std::string spz_axes = "niantic";
   void add_to(CLI::App* command);
+  // What the scene files are read with (--spz-axes).
+  SceneReadOptions read_options() const;
   // The PLY and cameras.json to use (see locate_scene); throws flashgs::Error for a path given
   // empty, or one that names no usable scene.
   SceneLocation locate() const;
@@ -34,7 +38,12 @@ struct SceneArgs {
 };
 
 // Loads the scene, printing what the loader dropped to stderr.
-std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod = -1);
+std::shared_ptr<const Scene> load_scene_verbose(const std::string& path, int lod = -1,
+                                               const SceneReadOptions& options = {});
+// The --spz-axes option's help, shared by every command that reads scenes.
+inline constexpr const char kSpzAxesHelp[] =
+    "axes of SPZ files: niantic (right-up-back, as Niantic's spz library writes) or none (PLY's axes unchanged, "
+    "as some converters wrote)";
 // A SOG LOD set's levels, one line each (Gaussians, SH degree, memory), for `flashgs info`;
 // empty for any other scene.
 std::string describe_lod_levels(const std::string& path);

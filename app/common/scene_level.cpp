@@ -34,10 +34,10 @@ Scene load_sog_lod_level(const std::string& path, int lod, LoadReport* report) {
 
 }  // namespace
 
-Scene load_scene_at_level(const std::string& path, int lod, LoadReport* report) {
+Scene load_scene_at_level(const std::string& path, int lod, LoadReport* report, const SceneReadOptions& options) {
   const bool lod_set = is_sog_lod_set(path);
   if (lod >= 0 && !lod_set) throw Error("--lod: " + path + " is not a SOG LOD set (lod-meta.json)");
-  return lod_set ? load_sog_lod_level(path, lod, report) : load_scene_file(path, report);
+  return lod_set ? load_sog_lod_level(path, lod, report) : load_scene_file(path, report, nullptr, options);
 }
 
 }  // namespace flashgs

@@ -52,5 +52,7 @@ Scene parse_compressed_ply(const char* data, std::size_t size, const std::string
                            LoadProgress* progress);
 Scene parse_splat(const char* data, std::size_t size, const std::string& name, LoadReport& report,
                   LoadProgress* progress);
+Scene parse_ksplat(const char* data, std::size_t size, const std::string& name, LoadReport& report,
+                   LoadProgress* progress);
 
 }  // namespace flashgs

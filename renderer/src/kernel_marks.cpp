@@ -68,6 +68,19 @@ TrainedKernel kernel_from_spz_flags(std::uint8_t flags) {
   return {SplatKernel::antialiased(), "SPZ header flag antialiased"};
 }
 
+std::uint8_t spz_flags_for(const TrainedKernel& kernel) {
+  return kernel.kernel.compensates_opacity() ? kSpzFlagAntialiased : 0;
+}
+
+bool kernel_fits_a_flag(const TrainedKernel& kernel) {
+  return !kernel.kernel.compensates_opacity() || kernel.kernel.epsilon == kGsplatAntialiasEpsilon;
+}
+
+std::string sog_model_for(const TrainedKernel& kernel) {
+  if (kernel.kernel.compensates_opacity()) return "antialiased";
+  return kernel.marked() ? "classic" : "";
+}
+
 bool kernel_from_sog_model(const std::string& model, TrainedKernel& out) {
   if (model == "antialiased" || model == "mip") {
     out = {SplatKernel::antialiased(), "SOG meta.json \"model\": \"" + printable_file_text(model) + "\""};

@@ -21,8 +21,16 @@ std::vector<std::string> ply_comments_for(const TrainedKernel& kernel);
 TrainedKernel mip_splatting_kernel();
 // The "antialiased" bit (0x1) of an SPZ header's flags byte (Niantic's spz library).
 TrainedKernel kernel_from_spz_flags(std::uint8_t flags);
+// The flags byte that carries `kernel` into an SPZ header (the bit says anti-aliased, not its
+// epsilon: the spz library's kernel is gsplat's 0.3).
+std::uint8_t spz_flags_for(const TrainedKernel& kernel);
 // SOG meta.json's optional "model" entry ("antialiased" or "mip"; "default" or "classic").
 // Returns false for a value it does not know (the caller names the file).
 bool kernel_from_sog_model(const std::string& model, TrainedKernel& out);
+// The "model" entry that carries `kernel` into a SOG meta.json ("antialiased" or "classic";
+// empty for an unmarked classic scene).
+std::string sog_model_for(const TrainedKernel& kernel);
+// Whether a format that stores only "anti-aliased or not" keeps `kernel` whole.
+bool kernel_fits_a_flag(const TrainedKernel& kernel);
 
 }  // namespace flashgs

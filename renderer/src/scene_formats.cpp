@@ -15,7 +15,9 @@
 #include "flashgs/file_access.h"
 #include "flashgs/io.h"
 #include "format_readers.h"
+#include "format_writers.h"
 #include "sog_meta.h"
+#include "zip_archive.h"
 
 namespace flashgs {
 namespace {
@@ -28,7 +30,8 @@ struct FileStart {
 };
 
 using Recogniser = bool (*)(const FileStart&);
-using Parser = Scene (*)(const char*, std::size_t, const std::string&, LoadReport&, LoadProgress*);
+using Parser = Scene (*)(const char*, std::size_t, const std::string&, LoadReport&, LoadProgress*,
+                         const SceneReadOptions&);
 using PathReader = Scene (*)(const std::string&, LoadReport&, LoadProgress*);
 
 // A format parses the file's bytes, or (when its file names others beside it, as SOG's
@@ -71,23 +74,45 @@ bool is_ply(const FileStart& f) { return starts_as_ply(f); }
 
 // .splat has no magic number: the extension decides, and its parser checks the size.
 bool is_splat(const FileStart& f) { return ends_with(f.name, ".splat"); }
+// .ksplat has a version in its first bytes but no magic number: the extension decides.
+bool is_ksplat(const FileStart& f) { return ends_with(f.name, ".ksplat"); }
 
 Scene parse_inria_ply(const char* data, std::size_t size, const std::string& name, LoadReport& report,
-                      LoadProgress* progress) {
+                      LoadProgress* progress, const SceneReadOptions&) {
   return parse_ply(data, size, name, &report, progress);
 }
 
 bool is_spz(const FileStart& f) { return looks_like_spz(f.bytes.data(), f.bytes.size()); }
 
 Scene parse_spz_file(const char* data, std::size_t size, const std::string& name, LoadReport& report,
-                     LoadProgress* progress) {
-  return parse_spz(data, size, name, &report, progress);
+                     LoadProgress* progress, const SceneReadOptions& options) {
+  return parse_spz(data, size, name, &report, progress, options.spz_axes);
+}
+
+// A parser that has no choice to take from the options.
+template <Scene (*parse)(const char*, std::size_t, const std::string&, LoadReport&, LoadProgress*)>
+Scene without_options(const char* data, std::size_t size, const std::string& name, LoadReport& report,
+                      LoadProgress* progress, const SceneReadOptions&) {
+  return parse(data, size, name, report, progress);
 }
 
 // A SOG meta.json (one chunk) or lod-meta.json (a LOD set), by their keys.
 bool is_sog(const FileStart& f) {
   const std::string text(f.bytes);
   return looks_like_sog_meta(text) || looks_like_sog_lod_meta(text);
+}
+
+// A SOG bundle: a zip archive (SuperSplat's .sog export) holding meta.json and its textures.
+bool is_zip(const FileStart& f) { return looks_like_zip(f.bytes.data(), f.bytes.size()); }
+
+Scene parse_sog_bundle(const char* data, std::size_t size, const std::string& name, LoadReport& report,
+                       LoadProgress* progress, const SceneReadOptions&) {
+  const ZipReader zip(data, size, name);
+  if (!zip.contains("meta.json"))
+    throw Error(name + ": a zip archive without meta.json: not a SOG bundle (expected a PLY, .splat, .ksplat, .spz or SOG)");
+  const std::vector<char> meta = zip.read("meta.json", kMaxSogJsonBytes);
+  const SogFileSource files = [&zip](const std::string& file) { return zip.read(file, kMaxSogTextureBytes); };
+  return parse_sog(std::string(meta.begin(), meta.end()), files, name, &report, progress);
 }
 
 Scene read_sog_file(const std::string& path, LoadReport& report, LoadProgress* progress) {
@@ -97,11 +122,13 @@ Scene read_sog_file(const std::string& path, LoadReport& report, LoadProgress* p
 
 // In order: formats with a magic number or header first, extension-only formats last.
 const FormatReader kReaders[] = {
-    {SceneFormat::compressed_ply, is_compressed_ply, parse_compressed_ply},
+    {SceneFormat::compressed_ply, is_compressed_ply, without_options<parse_compressed_ply>},
     {SceneFormat::inria_ply, is_ply, parse_inria_ply},
     {SceneFormat::spz, is_spz, parse_spz_file},
     {SceneFormat::sog, is_sog, nullptr, read_sog_file},
-    {SceneFormat::splat, is_splat, parse_splat},
+    {SceneFormat::sog_bundle, is_zip, parse_sog_bundle},
+    {SceneFormat::splat, is_splat, without_options<parse_splat>},
+    {SceneFormat::ksplat, is_ksplat, without_options<parse_ksplat>},
 };
 
 double seconds_since(std::chrono::steady_clock::time_point began) {
@@ -118,7 +145,7 @@ std::string describe_start(const FileStart& f) {
 const FormatReader& recognise(const FileStart& start) {
   for (const FormatReader& reader : kReaders)
     if (reader.recognises(start)) return reader;
-  throw Error(start.name + ": not a scene file: " + describe_start(start) + "; expected a PLY, .splat, .spz or SOG");
+  throw Error(start.name + ": not a scene file: " + describe_start(start) + "; expected a PLY, .splat, .ksplat, .spz or SOG");
 }
 
 void note_format(LoadReport& report, SceneFormat format) {
@@ -135,6 +162,8 @@ const char* format_name(SceneFormat format) {
     case SceneFormat::splat: return ".splat (antimatter15)";
     case SceneFormat::spz: return "SPZ (Niantic)";
     case SceneFormat::sog: return "SOG (PlayCanvas)";
+    case SceneFormat::sog_bundle: return "SOG (PlayCanvas), zipped";
+    case SceneFormat::ksplat: return ".ksplat (GaussianSplats3D)";
   }
   return "unknown";
 }
@@ -148,13 +177,17 @@ const char* format_quantisation(SceneFormat format) {
     case SceneFormat::splat:
       return "float positions and scales, 8-bit colour, opacity and rotation components; no SH bands";
     case SceneFormat::spz: return "fixed-point positions, 8-bit scales, rotations, colours, opacity and SH";
-    case SceneFormat::sog: return "16-bit positions, 8-bit quaternions, codebook scales, colours and SH in WebP textures";
+    case SceneFormat::sog:
+    case SceneFormat::sog_bundle:
+      return "16-bit positions, 8-bit quaternions, codebook scales, colours and SH in WebP textures";
+    case SceneFormat::ksplat:
+      return "per section: float, half or 8-bit positions, scales, rotations, colours and SH";
   }
   return "";
 }
 
 Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& name, LoadReport* report,
-                        LoadProgress* progress) {
+                        LoadProgress* progress, const SceneReadOptions& options) {
   LoadReport local_report;
   if (!report) report = &local_report;
   // A JSON object may hold its keys past kStartBytes; its bytes are already in memory.
@@ -164,13 +197,14 @@ Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& n
   if (!reader.parse)
     throw Error(name + ": " + format_name(reader.format) + " reads the files beside this one: open it by its path");
   const auto began = std::chrono::steady_clock::now();
-  Scene scene = reader.parse(data, size, name, *report, progress);
+  Scene scene = reader.parse(data, size, name, *report, progress, options);
   report->decode_seconds = seconds_since(began);
   note_format(*report, reader.format);
   return scene;
 }
 
-Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress* progress) {
+Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress* progress,
+                      const SceneReadOptions& options) {
   LoadReport local_report;
   if (!report) report = &local_report;
   // Recognised from its start first: a file of no known format is not read whole.
@@ -185,17 +219,49 @@ Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress*
   }
   const std::vector<char> bytes = read_regular_file(path, std::numeric_limits<std::size_t>::max(), progress);
   const double read_seconds = seconds_since(began);
-  Scene scene = parse_scene_bytes(bytes.data(), bytes.size(), path, report, progress);
+  Scene scene = parse_scene_bytes(bytes.data(), bytes.size(), path, report, progress, options);
   report->read_seconds = read_seconds;
   return scene;
 }
 
-SceneWriter scene_writer_for(const std::string& path) {
-  if (ends_with(path, ".ply")) return save_ply;
-  if (ends_with(path, ".splat")) return save_splat;
+bool parse_spz_axes(const std::string& text, SpzAxes& out) {
+  if (text == "niantic") out = SpzAxes::niantic;
+  else if (text == "none") out = SpzAxes::none;
+  else return false;
+  return true;
+}
+
+namespace {
+
+void write_inria_ply(const Scene& scene, const std::string& path, const SceneWriteOptions&) { save_ply(scene, path); }
+void write_splat(const Scene& scene, const std::string& path, const SceneWriteOptions&) { save_splat(scene, path); }
+
+// Longer name endings first: ".compressed.ply" before ".ply".
+const WritableFormat kWriters[] = {
+    {SceneFormat::compressed_ply, ".compressed.ply", save_compressed_ply, 3, true},
+    {SceneFormat::inria_ply, ".ply", write_inria_ply, 3, true},
+    {SceneFormat::splat, ".splat", write_splat, 0, false},
+    {SceneFormat::spz, ".spz", save_spz, 3, true},
+    {SceneFormat::sog_bundle, ".sog", save_sog_bundle, 3, true},
+    {SceneFormat::sog, "meta.json", save_sog_folder, 3, true},
+};
+
+}  // namespace
+
+const WritableFormat* writable_format_for(const std::string& path) {
+  for (const WritableFormat& format : kWriters)
+    if (ends_with(path, format.name_ending)) return &format;
   return nullptr;
 }
 
-const char* writable_scene_extensions() { return ".ply (INRIA PLY) or .splat"; }
+const char* writable_scene_extensions() {
+  return ".ply (INRIA PLY), .compressed.ply, .splat, .spz, .sog (zipped SOG) or meta.json (SOG, textures beside it)";
+}
+
+void save_scene_file(const Scene& scene, const std::string& path, const SceneWriteOptions& options) {
+  const WritableFormat* format = writable_format_for(path);
+  if (!format) throw Error(path + ": unknown scene format (the name picks it: " + writable_scene_extensions() + ")");
+  format->write(scene, path, options);
+}
 
 }  // namespace flashgs

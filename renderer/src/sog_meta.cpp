@@ -81,6 +81,82 @@ constexpr const char* kJsonSpace = " \t\r\n";
 
 }  // namespace
 
+namespace {
+
+// `count` numbers of meta.json's `key`.
+std::vector<double> numbers(const json& object, const char* key, std::size_t count, const std::string& where,
+                            const std::string& name) {
+  const json& list = field(object, key, where + ".", name);
+  if (!list.is_array() || list.size() != count)
+    fail(name, "meta.json's " + where + "." + key + " must be an array of " + std::to_string(count) + " numbers");
+  std::vector<double> values;
+  for (std::size_t i = 0; i < count; ++i)
+    values.push_back(finite_number(list[i], where + "." + key + "[" + std::to_string(i) + "]", name));
+  return values;
+}
+
+// Version 1's byte b stands for lo + (hi - lo) b / 255.
+std::vector<float> lerp_table(double lo, double hi) {
+  std::vector<float> table;
+  for (std::size_t b = 0; b < kCodebookSize; ++b) table.push_back(static_cast<float>(lo + (hi - lo) * double(b) / 255.0));
+  return table;
+}
+
+// What both versions share: the positions' range and files, the rotations, the kernel mark.
+void parse_common(const json& root, SogMeta& meta, const std::string& name) {
+  const json& means = field(root, "means", "", name);
+  const std::vector<double> mins = numbers(means, "mins", 3, "means", name), maxs = numbers(means, "maxs", 3, "means", name);
+  for (int k = 0; k < 3; ++k) {
+    meta.means_min[k] = mins[k];
+    meta.means_max[k] = maxs[k];
+  }
+  const auto means_files = files(means, "means", 2, name);
+  meta.means_files = {means_files[0], means_files[1]};
+  meta.quats_file = files(field(root, "quats", "", name), "quats", 1, name)[0];
+  if (root.contains("model") && !root.at("model").is_null()) {
+    const json& model = root.at("model");
+    if (!model.is_string() || !kernel_from_sog_model(model.get<std::string>(), meta.kernel))
+      fail(name, "meta.json's model " + printable_file_text(model.dump()) +
+                     " is not one this renderer draws (antialiased, mip, default or classic)");
+  }
+}
+
+// Version 1 (meta.json without "version"): the count in means.shape, per-channel ranges for
+// scales (log) and sh0 (f_dc, then the opacity's logit), one range for the SH palette, whose
+// band count the centroids texture's width gives.
+SogMeta parse_version_1(const json& root, const std::string& name) {
+  SogMeta meta;
+  meta.version = 1;
+  const json& shape = field(field(root, "means", "", name), "shape", "means.", name);
+  if (!shape.is_array() || shape.size() != 2)
+    fail(name, "meta.json (SOG version 1: no \"version\") has no means.shape [count, 3]");
+  meta.count = whole_number(shape[0], 1, kMaxSogCount, "means.shape[0]", name);
+  parse_common(root, meta, name);
+  const json& scales = field(root, "scales", "", name);
+  const std::vector<double> s_lo = numbers(scales, "mins", 3, "scales", name), s_hi = numbers(scales, "maxs", 3, "scales", name);
+  meta.scales_file = files(scales, "scales", 1, name)[0];
+  const json& sh0 = field(root, "sh0", "", name);
+  const std::vector<double> c_lo = numbers(sh0, "mins", 4, "sh0", name), c_hi = numbers(sh0, "maxs", 4, "sh0", name);
+  meta.sh0_file = files(sh0, "sh0", 1, name)[0];
+  for (int k = 0; k < 3; ++k) {
+    meta.scales_tables[k] = lerp_table(s_lo[k], s_hi[k]);
+    meta.sh0_tables[k] = lerp_table(c_lo[k], c_hi[k]);
+  }
+  for (float logit : lerp_table(c_lo[3], c_hi[3]))
+    meta.opacity_table.push_back(static_cast<float>(1.0 / (1.0 + std::exp(-double(logit)))));
+  if (root.contains("shN") && !root.at("shN").is_null()) {
+    const json& sh = root.at("shN");
+    meta.sh_codebook = lerp_table(finite_number(field(sh, "mins", "shN.", name), "shN.mins", name),
+                                  finite_number(field(sh, "maxs", "shN.", name), "shN.maxs", name));
+    const auto sh_files = files(sh, "shN", 2, name);
+    meta.sh_files = {sh_files[0], sh_files[1]};
+    meta.sh_bands_from_texture = true;
+  }
+  return meta;
+}
+
+}  // namespace
+
 SogMeta parse_sog_meta(const std::string& json_text, const std::string& name) {
   json root;
   try {
@@ -89,38 +165,21 @@ SogMeta parse_sog_meta(const std::string& json_text, const std::string& name) {
     fail(name, std::string("meta.json is not valid JSON (") + printable_file_text(e.what()) + ")");
   }
   if (!root.is_object()) fail(name, "meta.json is not a JSON object");
-  const json& version = field(root, "version", "", name);
+  if (!root.contains("version")) return parse_version_1(root, name);
+  const json& version = root.at("version");
   if (!version.is_number_integer() || version.get<long long>() != 2)
-    fail(name, "SOG version " + printable_file_text(version.dump()) + " is not supported (version 2 is)");
+    fail(name, "SOG version " + printable_file_text(version.dump()) + " is not supported (versions 1 and 2 are)");
   SogMeta meta;
   meta.count = whole_number(field(root, "count", "", name), 1, kMaxSogCount, "count", name);
-
-  const json& means = field(root, "means", "", name);
-  const json& mins = field(means, "mins", "means.", name);
-  const json& maxs = field(means, "maxs", "means.", name);
-  if (!mins.is_array() || mins.size() != 3 || !maxs.is_array() || maxs.size() != 3)
-    fail(name, "meta.json's means.mins and means.maxs must be arrays of 3 numbers");
-  for (int k = 0; k < 3; ++k) {
-    meta.means_min[k] = finite_number(mins[k], "means.mins[" + std::to_string(k) + "]", name);
-    meta.means_max[k] = finite_number(maxs[k], "means.maxs[" + std::to_string(k) + "]", name);
-  }
-  const auto means_files = files(means, "means", 2, name);
-  meta.means_files = {means_files[0], means_files[1]};
-
+  parse_common(root, meta, name);
   const json& scales = field(root, "scales", "", name);
-  meta.scales_codebook = codebook(scales, "scales", name);
+  const std::vector<float> scales_codebook = codebook(scales, "scales", name);
   meta.scales_file = files(scales, "scales", 1, name)[0];
-  meta.quats_file = files(field(root, "quats", "", name), "quats", 1, name)[0];
   const json& sh0 = field(root, "sh0", "", name);
-  meta.sh0_codebook = codebook(sh0, "sh0", name);
+  const std::vector<float> sh0_codebook = codebook(sh0, "sh0", name);
   meta.sh0_file = files(sh0, "sh0", 1, name)[0];
-
-  if (root.contains("model") && !root.at("model").is_null()) {
-    const json& model = root.at("model");
-    if (!model.is_string() || !kernel_from_sog_model(model.get<std::string>(), meta.kernel))
-      fail(name, "meta.json's model " + printable_file_text(model.dump()) +
-                     " is not one this renderer draws (antialiased, mip, default or classic)");
-  }
+  meta.scales_tables = {scales_codebook, scales_codebook, scales_codebook};
+  meta.sh0_tables = {sh0_codebook, sh0_codebook, sh0_codebook};
   if (root.contains("shN") && !root.at("shN").is_null()) {
     const json& sh = root.at("shN");
     meta.sh_bands = static_cast<int>(whole_number(field(sh, "bands", "shN.", name), 1, 3, "shN.bands", name));
@@ -135,7 +194,8 @@ SogMeta parse_sog_meta(const std::string& json_text, const std::string& name) {
 std::vector<std::string> sog_meta_files(const SogMeta& meta) {
   std::vector<std::string> names = {meta.means_files[0], meta.means_files[1], meta.scales_file, meta.quats_file,
                                     meta.sh0_file};
-  if (meta.sh_bands > 0) names.insert(names.end(), meta.sh_files.begin(), meta.sh_files.end());
+  if (meta.sh_bands > 0 || meta.sh_bands_from_texture)
+    names.insert(names.end(), meta.sh_files.begin(), meta.sh_files.end());
   return names;
 }
 

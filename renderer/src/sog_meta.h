@@ -29,19 +29,25 @@ constexpr std::size_t kMaxSogTextureBytes = std::size_t{1} << 30;
 constexpr std::size_t kMaxSogCount = std::size_t{1} << 28;
 
 struct SogMeta {
+  int version = 2;  // 1: no "version" key, per-channel ranges instead of codebooks
   std::size_t count = 0;
   std::array<double, 3> means_min{}, means_max{};
   std::array<std::string, 2> means_files;  // lower bytes, upper bytes
   std::string scales_file, quats_file, sh0_file;
-  std::vector<float> scales_codebook, sh0_codebook;  // 256 entries each
-  int sh_bands = 0;  // 0 when there is no shN
+  // What each byte of a texture decodes to, per channel (256 entries each): version 2's
+  // codebook for all three, version 1's range lerped per channel. The log-scale, f_dc, and
+  // (version 1 only; empty for version 2, whose byte is the opacity / 255) the opacity.
+  std::array<std::vector<float>, 3> scales_tables, sh0_tables;
+  std::vector<float> opacity_table;
+  int sh_bands = 0;  // 0 when there is no shN; version 1: known only from the centroids' width
+  bool sh_bands_from_texture = false;
   std::size_t sh_palette_size = 0;
   std::vector<float> sh_codebook;
   std::array<std::string, 2> sh_files;  // centroids, labels
   TrainedKernel kernel;  // from the optional "model" entry
 };
 
-// Throws flashgs::Error "<name>: ..." for invalid JSON, another version, a missing or
+// Version 1 (no "version" key) or 2. Throws flashgs::Error "<name>: ..." for invalid JSON, another version, a missing or
 // mistyped field, a count out of range, a codebook that is not 256 finite floats, or a texture
 // name that is not a plain file name.
 SogMeta parse_sog_meta(const std::string& json_text, const std::string& name);

@@ -1,4 +1,4 @@
-// Reads one SOG v2 chunk (PlayCanvas): meta.json names lossless WebP textures whose pixel i
+// Reads one SOG chunk (PlayCanvas, version 1 or 2): meta.json names lossless WebP textures whose pixel i
 // holds Gaussian i's quantised attributes; each texture's size is checked against meta.json
 // before it is decoded.
 #include <algorithm>
@@ -112,6 +112,19 @@ Texture load_texture(const SogFileSource& files, const std::string& file_name, c
   return texture;
 }
 
+// SOG version 1 names no band count: the centroids texture is 64 entries of 3, 8 or 15
+// pixels wide, and 64 entries per row give the palette's size.
+void find_sh_bands(SogMeta& meta, const SogFileSource& files, const std::string& name) {
+  const std::string file = name + " -> " + meta.sh_files[0];
+  const TextureSize size = webp_size(files(meta.sh_files[0]), file);
+  for (int bands = 1; bands <= 3; ++bands)
+    if (size.width == kCentroidsPerRow * (sh_coefficient_count(bands) - 1)) meta.sh_bands = bands;
+  if (meta.sh_bands == 0)
+    fail(file, "the SH palette is " + std::to_string(size.width) +
+                   " pixels wide; SOG version 1 palettes are 192, 512 or 960 (SH degree 1, 2 or 3)");
+  meta.sh_palette_size = std::size_t(kCentroidsPerRow) * std::size_t(std::max(0, size.height));
+}
+
 // Symmetric log transform undone: sign(n) (e^|n| - 1).
 double unlog(double n) { return n < 0 ? -(std::exp(-n) - 1.0) : std::exp(n) - 1.0; }
 
@@ -123,10 +136,10 @@ Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const 
   if (!report) report = &local_report;
   *report = LoadReport{};
   report->path = name;
-  const SogMeta meta = parse_sog_meta(meta_json, name);
+  SogMeta meta = parse_sog_meta(meta_json, name);
+  if (meta.sh_bands_from_texture) find_sh_bands(meta, files, name);
   const std::size_t n = meta.count;
   report->vertices_in_file = n;
-  report->sh_degree_in_file = meta.sh_bands;
   // The scene and the decoded textures, refused before any is allocated when they cannot fit
   // (a tiny lossless WebP may claim 16384 x 16384 pixels).
   const std::uint64_t need = n * (sizeof(float) * (14 + 3 * std::uint64_t(sh_coefficient_count(meta.sh_bands) - 1)) +
@@ -136,6 +149,7 @@ Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const 
     fail(name, "meta.json declares " + std::to_string(n) + " Gaussians, " + format_bytes(need) +
                    " to decode, but only " + format_bytes(available.bytes) + " of memory is available");
 
+  report->sh_degree_in_file = meta.sh_bands;
   const Texture means_l = load_texture(files, meta.means_files[0], name, n, nullptr, progress);
   const Texture means_u = load_texture(files, meta.means_files[1], name, n, nullptr, progress);
   const Texture scales = load_texture(files, meta.scales_file, name, n, nullptr, progress);
@@ -189,8 +203,8 @@ Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const 
     const std::uint8_t* c0 = sh0.pixel(i);
     float scale[3], dc[3];
     for (int k = 0; k < 3; ++k) {
-      scale[k] = static_cast<float>(std::exp(double(meta.scales_codebook[s[k]])));
-      dc[k] = meta.sh0_codebook[c0[k]];
+      scale[k] = static_cast<float>(std::exp(double(meta.scales_tables[k][s[k]])));
+      dc[k] = meta.sh0_tables[k][c0[k]];
     }
     if (meta.sh_bands > 0) {
       const std::uint8_t* l = labels.pixel(i);
@@ -214,7 +228,7 @@ Scene parse_sog(const std::string& meta_json, const SogFileSource& files, const 
     scene.positions.insert(scene.positions.end(), position, position + 3);
     scene.scales.insert(scene.scales.end(), scale, scale + 3);
     for (int k = 0; k < 4; ++k) scene.rotations.push_back(static_cast<float>(rotation[k] / norm));
-    scene.opacities.push_back(static_cast<float>(c0[3] / 255.0));
+    scene.opacities.push_back(meta.opacity_table.empty() ? static_cast<float>(c0[3] / 255.0) : meta.opacity_table[c0[3]]);
     scene.sh_dc.insert(scene.sh_dc.end(), dc, dc + 3);
     scene.sh_rest.insert(scene.sh_rest.end(), sh_rest.begin(), sh_rest.end());
   }

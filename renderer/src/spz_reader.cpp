@@ -14,6 +14,7 @@
 #include "flashgs/file_access.h"
 #include "flashgs/frame_memory.h"
 #include "kernel_marks.h"
+#include "spz_axes.h"
 
 namespace flashgs {
 namespace {
@@ -27,13 +28,6 @@ constexpr std::uint8_t kFlagHasExtensions = 0x2;
 constexpr double kColorScale = 0.15;
 // Deflate expands at most about 1032:1; a count needing more than that is a lie.
 constexpr std::uint64_t kMaxDeflateRatio = 1032;
-// SPZ stores right-up-back axes (OpenGL), 3DGS PLY right-down-forward: y and z change sign.
-// That is a 180-degree turn about x, so the quaternion's y and z change sign too, and each SH
-// coefficient by the parity of its basis function in y and z (bands 1-3, m = -l..l).
-constexpr float kAxisFlip[3] = {1, -1, -1};
-constexpr float kShFlip[15] = {-1, -1, 1,                 // y, z, x
-                               -1, 1, 1, -1, 1,           // xy, yz, 3z2-1, xz, x2-y2
-                               -1, 1, -1, -1, 1, -1, 1};  // y(3x2-y2), xyz, y(5z2-1), z(5z2-3), x(5z2-1), z(x2-y2), x(x2-3y2)
 // Progress is published and cancellation checked every this many Gaussians.
 constexpr std::size_t kProgressStep = 1 << 16;
 
@@ -129,9 +123,7 @@ Packed read_zstd_streams(const unsigned char* data, std::size_t size, Header& he
                          LoadProgress* progress) {
   if (size < kV4HeaderBytes) fail(name, "the SPZ version 4 header is cut short (" + std::to_string(size) + " bytes)");
   header = parse_header(data, name);
-  if (header.version != 4)
-    fail(name, "an uncompressed SPZ header of version " + std::to_string(header.version) +
-                   " (versions 1-3 are a gzip stream)");
+  if (header.version != 4) fail(name, "an SPZ header of version " + std::to_string(header.version) + " here");
   const Layout layout(header);
   const int streams = data[15];
   const std::uint32_t toc_offset = read_u32(data + 16);
@@ -168,6 +160,29 @@ Packed read_zstd_streams(const unsigned char* data, std::size_t size, Header& he
   return packed;
 }
 
+// Versions 1-3 stored without gzip (some writers leave the stream uncompressed): the 16-byte
+// header, then each attribute in turn, exactly as inside the gzip stream.
+Packed read_raw_streams(const unsigned char* data, std::size_t size, Header& header, const std::string& name) {
+  if (size < kGzipHeaderBytes) fail(name, "the SPZ header is cut short (" + std::to_string(size) + " bytes)");
+  header = parse_header(data, name);
+  const Layout layout(header);
+  const std::uint64_t expected = std::uint64_t{header.count} * layout.total();
+  const std::uint64_t available = size - kGzipHeaderBytes;
+  if (expected > available || (expected < available && !(header.flags & kFlagHasExtensions)))
+    fail(name, "the header declares " + std::to_string(header.count) + " Gaussians (" + std::to_string(expected) +
+                   " bytes) but the uncompressed file holds " + std::to_string(available) + " bytes after it: " +
+                   (expected > available ? "truncated file or wrong count" : "extra data or wrong count"));
+  check_memory(header, layout, name);
+  Packed packed;
+  const std::size_t sizes[6] = {layout.position, layout.alpha, layout.color, layout.scale, layout.rotation, layout.sh};
+  const unsigned char* at = data + kGzipHeaderBytes;
+  for (int a = 0; a < 6; ++a) {
+    packed.attribute[a].assign(at, at + header.count * sizes[a]);
+    at += header.count * sizes[a];
+  }
+  return packed;
+}
+
 float half_to_float(std::uint16_t h) {
   const int exponent = (h >> 10) & 0x1f, mantissa = h & 0x3ff;
   const double sign = (h & 0x8000) ? -1.0 : 1.0;
@@ -195,7 +210,7 @@ void unpack_smallest_three(const std::uint8_t* r, double q[4]) {
 // Turns the attribute bytes into the scene's activated floats in PLY axes (quaternions are
 // stored x y z w).
 Scene unpack(const Packed& packed, const Header& header, const std::string& name, LoadReport* report,
-             LoadProgress* progress) {
+             LoadProgress* progress, SpzAxes axes) {
   const std::size_t n = header.count;
   const int degree = std::min(header.sh_degree, 3);
   const int file_dim = sh_rest_dim(header.sh_degree), kept_dim = sh_rest_dim(degree);
@@ -244,17 +259,17 @@ Scene unpack(const Packed& packed, const Header& header, const std::string& name
       q[3] = std::sqrt(std::max(0.0, 1.0 - sum));
     }
     const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    for (int k = 0; k < 3; ++k) scene.positions.push_back(kAxisFlip[k] * p[k]);
+    for (int k = 0; k < 3; ++k) scene.positions.push_back(spz_axis_sign(axes, k) * p[k]);
     for (int k = 0; k < 3; ++k) scene.scales.push_back(static_cast<float>(std::exp(scale[i * 3 + k] / 16.0 - 10.0)));
     scene.rotations.push_back(static_cast<float>(q[3] / norm));
-    for (int k = 0; k < 3; ++k) scene.rotations.push_back(kAxisFlip[k] * static_cast<float>(q[k] / norm));
+    for (int k = 0; k < 3; ++k) scene.rotations.push_back(spz_axis_sign(axes, k) * static_cast<float>(q[k] / norm));
     scene.opacities.push_back(static_cast<float>(alpha[i] / 255.0));
     for (int k = 0; k < 3; ++k)
       scene.sh_dc.push_back(static_cast<float>((color[i * 3 + k] / 255.0 - 0.5) / kColorScale));
     // [coefficient][channel] in the file as in the scene; degree 4's band is left out.
     const std::uint8_t* coefficients = sh.empty() ? nullptr : &sh[i * file_dim * 3];
     for (int c = 0; c < kept_dim * 3; ++c)
-      scene.sh_rest.push_back(kShFlip[c / 3] * static_cast<float>((coefficients[c] - 128.0) / 128.0));
+      scene.sh_rest.push_back(spz_sh_sign(axes, c / 3) * static_cast<float>((coefficients[c] - 128.0) / 128.0));
   }
   if (progress) progress->gaussians_done.store(n, std::memory_order_relaxed);
   if (scene.size() == 0) fail(name, "all " + std::to_string(n) + " Gaussians have non-finite positions");
@@ -276,7 +291,7 @@ bool looks_like_spz(const char* data, std::size_t size) {
 }
 
 Scene parse_spz(const char* data, std::size_t size, const std::string& name, LoadReport* report,
-                LoadProgress* progress) {
+                LoadProgress* progress, SpzAxes axes) {
   LoadReport local_report;
   if (!report) report = &local_report;
   *report = LoadReport{};
@@ -291,18 +306,20 @@ Scene parse_spz(const char* data, std::size_t size, const std::string& name, Loa
   Packed packed;
   if (size >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b)
     packed = read_gzip_streams(bytes, size, header, name, progress);
+  else if (size >= 8 && read_u32(bytes) == kSpzMagic && read_u32(bytes + 4) != 4)
+    packed = read_raw_streams(bytes, size, header, name);
   else if (size >= 4 && read_u32(bytes) == kSpzMagic)
     packed = read_zstd_streams(bytes, size, header, name, progress);
   else
     fail(name, "not an SPZ file (neither a gzip stream nor the \"NGSP\" magic)");
   report->vertices_in_file = header.count;
   report->sh_degree_in_file = header.sh_degree;
-  return unpack(packed, header, name, report, progress);
+  return unpack(packed, header, name, report, progress, axes);
 }
 
-Scene read_spz(const std::string& path, LoadReport* report, LoadProgress* progress) {
+Scene read_spz(const std::string& path, LoadReport* report, LoadProgress* progress, SpzAxes axes) {
   const std::vector<char> bytes = read_regular_file(path);
-  return parse_spz(bytes.data(), bytes.size(), path, report, progress);
+  return parse_spz(bytes.data(), bytes.size(), path, report, progress, axes);
 }
 
 }  // namespace flashgs

@@ -11,6 +11,7 @@
 
 #include "flashgs/load_progress.h"
 #include "flashgs/scene.h"
+#include "flashgs/scene_formats.h"
 
 namespace flashgs {
 
@@ -22,10 +23,12 @@ bool looks_like_spz(const char* data, std::size_t size);
 // Reads an SPZ file (versions 1-4: gzip, or zstd streams with a table of contents). Every
 // count is checked against what the file can hold before memory is taken. Throws
 // flashgs::Error naming the file and the problem, flashgs::LoadCancelled on request.
-Scene read_spz(const std::string& path, LoadReport* report = nullptr, LoadProgress* progress = nullptr);
+// `axes`: whether the file is in Niantic's axes (turned to PLY's) or already in PLY's.
+Scene read_spz(const std::string& path, LoadReport* report = nullptr, LoadProgress* progress = nullptr,
+               SpzAxes axes = SpzAxes::niantic);
 // Same, from bytes in memory (`name` is used in messages). The fuzz test drives this.
 Scene parse_spz(const char* data, std::size_t size, const std::string& name, LoadReport* report = nullptr,
-                LoadProgress* progress = nullptr);
+                LoadProgress* progress = nullptr, SpzAxes axes = SpzAxes::niantic);
 
 // ---- SOG v2 (one chunk: meta.json and its WebP textures) ----
 
