@@ -16,6 +16,7 @@
 #include "camera_controller.h"
 #include "camera_path.h"
 #include "compare_mode.h"
+#include "path_editor.h"
 #include "file_dialog.h"
 #include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
@@ -673,10 +674,15 @@ TEST(ViewerHeatmap, TheLockKeepsTheMaximumAcrossConfigurations) {
   fv::HeatScale scale;
   EXPECT_EQ(scale.update(1771, false), 1771u);
   EXPECT_EQ(scale.update(900, false), 900u);
-  EXPECT_EQ(scale.update(1771, true), 1771u);  // locking takes this frame's maximum...
-  EXPECT_EQ(scale.update(600, true), 1771u);   // ...and keeps it
-  EXPECT_EQ(scale.update(2500, true), 1771u);
+  // Ticked while 900 is shown, the next frame (another configuration's) at 1771: the lock
+  // keeps the maximum the user saw.
+  EXPECT_EQ(scale.update(1771, true), 900u);
+  EXPECT_EQ(scale.update(600, true), 900u);
+  EXPECT_EQ(scale.update(2500, true), 900u);
   EXPECT_EQ(scale.update(600, false), 600u);   // unlocked: follows the frame again
+  fv::HeatScale locked_from_start;             // locked before any frame: the first one's
+  EXPECT_EQ(locked_from_start.update(1234, true), 1234u);
+  EXPECT_EQ(locked_from_start.update(99, true), 1234u);
 }
 
 TEST(ViewerHeatmap, TheRampIsViridisLikeAndMonotoneInLightness) {
@@ -749,6 +755,24 @@ TEST(ViewerCompare, AnyTwoConfigurationsAndTheSameOneTwiceIsRefused) {
   EXPECT_EQ(fv::same_configuration_problem(base, o), "");
 }
 
+// The panel lists configurations by name, not by label() token, and only those the backend
+// draws differently from flash: a GPU-only switch turned off renders flash on the CPU.
+TEST(ViewerCompare, ChoicesAreNamedForPeopleAndGpuOnlyOnesAreNotOfferedOnTheCpu) {
+  const int no_tight = fv::compare_choice_from_name("flash-no_tight_bbox");
+  const int no_warp = fv::compare_choice_from_name("flash-no_warp_emit");
+  ASSERT_GT(no_warp, 2);
+  EXPECT_EQ(fv::compare_choice_title(no_tight), "flash without Tight box");
+  EXPECT_EQ(fv::compare_choice_title(fv::kCompareBaseline), "baseline");
+  EXPECT_TRUE(fv::compare_choice_offered(no_tight, flashgs::Backend::cpu));
+  EXPECT_FALSE(fv::compare_choice_offered(no_warp, flashgs::Backend::cpu));
+  EXPECT_TRUE(fv::compare_choice_offered(no_warp, flashgs::Backend::cuda));
+  const flashgs::RenderOptions current;
+  const std::string problem = fv::compare_sides_problem(fv::kCompareBaseline, no_warp, current, flashgs::Backend::cpu);
+  EXPECT_NE(problem.find("flash without Warp emit renders as flash here (the CPU backend has no warps)"),
+            std::string::npos) << problem;
+  EXPECT_EQ(fv::compare_sides_problem(fv::kCompareBaseline, no_warp, current, flashgs::Backend::cuda), "");
+}
+
 TEST(ViewerScreenshots, NamesAreTimestampedAndNeverReused) {
   const std::string dir = scratch_dir("viewer_shots");
   const std::time_t t = 1764612345;
@@ -809,9 +833,13 @@ TEST(ViewerGuides, FrustumsProjectWhereTheCamerasAreAndAClickPicksOne) {
   // The first segment of camera k starts at its centre: clicking there picks k.
   for (int k : {0, 3, 5}) {
     const fv::ScreenSegment& s = segments[std::size_t(k) * 10];
-    EXPECT_EQ(fv::pick_camera(cameras, view, s.x0 + 2.0f, s.y0 - 2.0f, 14.0f), k);
+    EXPECT_EQ(fv::pick_camera(cameras, view, s.x0 + 2.0f, s.y0 - 2.0f, 14.0f, 0.1f), k);
   }
-  EXPECT_EQ(fv::pick_camera(cameras, view, -500.0f, -500.0f, 14.0f), -1);
+  EXPECT_EQ(fv::pick_camera(cameras, view, -500.0f, -500.0f, 14.0f, 0.1f), -1);
+  // Inside a frustum's body, far from its centre and its edges, picks it too.
+  const fv::ScreenSegment* f = &segments[3 * 10];
+  const float cx = 0.25f * (f[0].x1 + f[2].x1 + f[4].x1 + f[6].x1), cy = 0.25f * (f[0].y1 + f[2].y1 + f[4].y1 + f[6].y1);
+  EXPECT_EQ(fv::pick_camera(cameras, view, cx, cy, 1.0f, 0.1f), 3);
   // Segments crossing behind the view are cut at the near plane, never mirrored.
   const fv::WorldSegment through{view_point(view, 0, 0, 1), view_point(view, 0, 0, -1), {1, 1, 1, 1}};
   const auto cut = fv::project_segments({through}, view, 0.01f);
@@ -824,6 +852,67 @@ TEST(ViewerGuides, FrustumsProjectWhereTheCamerasAreAndAClickPicksOne) {
       EXPECT_NEAR(g.a.y, 0.0f, 1e-5f) << "grid lines lie in the ground plane";
     }
   }
+}
+
+// After N or a snap in a window of another shape than the camera's images (16:10 vs 16:9),
+// the view is on the camera's pose and FOV: the panel says so (it said "free view").
+TEST(ViewerGuides, TheViewPanelNamesTheCameraWhoseShapeDiffersFromTheWindow) {
+  const auto cameras = orbit(4);
+  fv::CameraController c;
+  EXPECT_EQ(c.view_description(-1, 1280, 800, 60.0f), "free view");
+  c.snap_to(cameras[2]);
+  const float fov = cameras[2].horizontal_fov_degrees();
+  EXPECT_EQ(c.view_description(2, 1280, 720, fov), "on camera 2 (exact)");
+  EXPECT_EQ(c.view_description(2, 1280, 800, fov), "on camera 2: its pose and FOV; window 1.60:1, its images 1.78:1");
+  fv::NavigationInput forward;
+  forward.forward = true;
+  fv::ViewerSettings s;
+  c.update(forward, 0.5f, s);
+  EXPECT_EQ(c.view_description(2, 1280, 800, fov), "free view (last camera 2)");
+}
+
+// Keys from the view: added 2 s apart, replaced, retimed (kept in order, the selection
+// following), deleted; saved and loaded back; the preview plays from the first key to the last.
+TEST(ViewerKeyframes, KeysAreAddedReplacedRetimedDeletedAndSaved) {
+  const auto cameras = orbit(4);
+  fv::PathEditor e;
+  e.add(cameras[0]);
+  e.add(cameras[1]);
+  e.add(cameras[2]);
+  ASSERT_EQ(e.path().keys.size(), 3u);
+  EXPECT_EQ(e.selected(), 2);
+  EXPECT_DOUBLE_EQ(e.path().keys[2].time_s, 4.0);
+  EXPECT_FLOAT_EQ(e.path().keys[1].position[0], cameras[1].position[0]);
+  e.select(1);
+  e.replace_selected(cameras[3]);
+  EXPECT_FLOAT_EQ(e.path().keys[1].position[0], cameras[3].position[0]);
+  EXPECT_DOUBLE_EQ(e.path().keys[1].time_s, 2.0) << "a replaced key keeps its time";
+  e.set_time(1, 5.0);  // after key 2 now
+  EXPECT_EQ(e.selected(), 2);
+  EXPECT_FLOAT_EQ(e.path().keys[2].position[0], cameras[3].position[0]);
+  EXPECT_DOUBLE_EQ(e.path().duration_s(), 5.0);
+  e.set_duration(10.0);
+  EXPECT_DOUBLE_EQ(e.path().keys[1].time_s, 8.0);
+  e.delete_selected();
+  ASSERT_EQ(e.path().keys.size(), 2u);
+  EXPECT_EQ(e.selected(), 1);
+  const std::string dir = scratch_dir("keyframes");
+  EXPECT_EQ(e.save(dir + "/p.json"), "");
+  fv::PathEditor f;
+  EXPECT_EQ(f.load(dir + "/p.json"), "");
+  ASSERT_EQ(f.path().keys.size(), 2u);
+  EXPECT_DOUBLE_EQ(f.path().keys[1].time_s, 8.0);
+  EXPECT_NE(f.load(dir + "/absent.json").find("camera path not loaded: " + dir + "/absent.json"), std::string::npos);
+  EXPECT_EQ(f.path().keys.size(), 2u) << "a failed load keeps the path";
+  EXPECT_NE(fv::PathEditor().save(dir + "/empty.json").find("no keyframes"), std::string::npos);
+  // The preview: from key 0 to the last, then it stops on the last key.
+  f.start_preview();
+  ASSERT_TRUE(f.previewing());
+  flashgs::Camera c = f.preview_step(0.0, 160, 90);
+  EXPECT_NEAR(c.position[0], cameras[0].position[0], 1e-5f);
+  for (int i = 0; i < 100 && f.previewing(); ++i) c = f.preview_step(0.1, 160, 90);
+  EXPECT_FALSE(f.previewing());
+  EXPECT_NEAR(c.position[0], cameras[2].position[0], 1e-5f);
 }
 
 TEST(ViewerFiles, TheDesktopDialogsAnswerIsTheChosenPath) {

@@ -34,8 +34,10 @@ std::vector<WorldSegment> camera_frustums(const std::vector<Camera>& cameras, fl
 std::vector<ScreenSegment> project_segments(const std::vector<WorldSegment>& segments, const Camera& view,
                                             float near_depth);
 
-// The camera whose centre projects within `radius` pixels of (x, y) in `view`'s image
-// (the nearest such, in front of the view), or -1.
-int pick_camera(const std::vector<Camera>& cameras, const Camera& view, float x, float y, float radius);
+// The camera whose frustum, as camera_frustums draws it at `depth`, is under (x, y) in
+// `view`'s image: inside its projected body or within `radius` pixels of an edge or its
+// centre. The nearest to the click wins; among bodies the click is inside, the one nearest the
+// viewer. -1 when none is.
+int pick_camera(const std::vector<Camera>& cameras, const Camera& view, float x, float y, float radius, float depth);
 
 }  // namespace flashgs::viewer

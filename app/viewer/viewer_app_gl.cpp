@@ -66,6 +66,12 @@ ViewerApp::ViewerApp(ViewerArgs args)
       m_compare_task([] { glfwPostEmptyEvent(); }),  // a finished comparison wakes the loop
       m_export_job([] { glfwPostEmptyEvent(); }) {   // as does each exported frame
   m_scripted = m_args.scripted();
+  // The keyframed path's file: the one named, loaded when it exists (else saved there later).
+  m_key_fields.file = m_args.camera_path.empty() ? "camera_path.json" : m_args.camera_path;
+  m_key_fields.folder = "path_frames";
+  if (!m_args.camera_path.empty() && std::filesystem::exists(m_args.camera_path) && !load_keys(m_args.camera_path) &&
+      m_scripted)
+    m_exit_code = 2;
   // Interactive runs start from the saved settings, the command line over them; scripted
   // runs from the defaults and the command line only (repeatable, and they save nothing).
   m_persist = !m_scripted && !config_dir().empty();
@@ -244,8 +250,15 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
 
   // ImGui runs with the panels hidden too (legend, help): its windows still take the input.
   const bool mouse_free = !(m_ui && m_ui->wants_mouse());
-  const bool keys_free = !(m_ui && m_ui->wants_keyboard());
+  // After Enter in the path field the typing goes on there (the field takes the focus back a
+  // frame or two later): until a click, letters are text, not shortcuts.
+  if (m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT) || m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT))
+    m_typing_in_path = false;
+  const bool keys_free = !(m_ui && m_ui->wants_keyboard()) && !m_typing_in_path;
   const std::vector<KeyPress> presses = m_window->take_key_presses();
+  // Esc leaves the field (ImGui ends its edit): the next keys are shortcuts again.
+  if (std::any_of(presses.begin(), presses.end(), [](const KeyPress& p) { return p.key == GLFW_KEY_ESCAPE; }))
+    m_typing_in_path = false;
   int mods = 0;
   auto pressed = [&](int key) {  // a press event since the last frame; `mods` its modifiers
     for (const KeyPress& p : presses)
@@ -257,7 +270,9 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   };
   if (keys_free) {
     nav.forward = m_window->key_down(GLFW_KEY_W);
-    nav.back = m_window->key_down(GLFW_KEY_S);
+    // Ctrl+S saves the camera path: it does not also move the view back.
+    nav.back = m_window->key_down(GLFW_KEY_S) && !m_window->key_down(GLFW_KEY_LEFT_CONTROL) &&
+               !m_window->key_down(GLFW_KEY_RIGHT_CONTROL);
     nav.left = m_window->key_down(GLFW_KEY_A);
     nav.right = m_window->key_down(GLFW_KEY_D);
     nav.down = m_window->key_down(GLFW_KEY_Q);
@@ -279,6 +294,8 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   }
   if (pressed(GLFW_KEY_F)) actions.frame_scene = true;
   if (pressed(GLFW_KEY_G)) m_settings.show_grid = !m_settings.show_grid;
+  if (pressed(GLFW_KEY_I)) actions.add_key = true;
+  if (pressed(GLFW_KEY_S) && (mods & GLFW_MOD_CONTROL)) actions.save_keys = true;
   // Any other key or a click takes back a first Esc (see handle_escape).
   if (std::any_of(presses.begin(), presses.end(), [](const KeyPress& p) { return p.key != GLFW_KEY_ESCAPE; }) ||
       m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT) || m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT))
@@ -336,6 +353,7 @@ void ViewerApp::apply_actions(const UiActions& a) {
     m_loader.abandon();
   }
   if (!a.open_path.empty()) request_open(a.open_path);
+  if (a.path_entered) m_typing_in_path = true;
   if (a.lod_level >= 0) request_lod_level(a.lod_level);
   if (a.snap_camera >= 0) snap_to_camera(a.snap_camera);
   if (a.next_camera) snap_to_camera(m_camera_index + 1);
@@ -364,6 +382,7 @@ void ViewerApp::apply_actions(const UiActions& a) {
   if (a.open_dialog) open_file_dialog();
   if (!a.export_folder.empty()) start_path_export(a.export_folder, m_args.export_frames);
   if (a.cancel_export) stop_path_export("cancelled", "");
+  apply_key_actions(a);
   if (a.screenshot) {
     // The picture of the view at full resolution: a scripted run has it now; an interactive
     // one may still be rendering it (or showing a reduced frame) and saves it once it is shown.
@@ -388,7 +407,7 @@ void ViewerApp::start_comparison() {
   job.camera = m_last_camera;
   job.left = compare_choice_options(m_settings.compare_left, m_settings.options);
   job.right = compare_choice_options(m_settings.compare_right, m_settings.options);
-  job.warm_up = !m_path_is_cpu;
+  job.rounds = m_args.compare_rounds;
   m_compare = {};  // the last comparison's images are of another view: the frame shows meanwhile
   m_compare_camera = m_last_camera;
   m_compare_options = m_last_options;
@@ -431,11 +450,13 @@ void ViewerApp::finish_comparison(bool at_once) {
   m_compare = std::move(done.result);
   m_difference_factor = done.difference_factor;
   std::fprintf(stderr,
-               "flashgs-viewer: compare %s vs %s at %dx%d: PSNR %.2f dB, max abs %.6f, %.3f ms vs %.3f ms, "
-               "speed-up %.2fx, pair reduction %.1f%%, difference image x%.0f\n",
+               "flashgs-viewer: compare %s vs %s at %dx%d: PSNR %.2f dB, max abs %.6f, median %.3f ms (%.3f-%.3f) "
+               "vs %.3f ms (%.3f-%.3f), %s, pair reduction %.1f%%, difference image x%.0f\n",
                m_compare.right_label.c_str(), m_compare.left_label.c_str(), m_compare.width, m_compare.height,
-               m_compare.difference.psnr_db, m_compare.difference.max_abs, m_compare.right_ms, m_compare.left_ms,
-               m_compare.speed_up(), 100.0 * m_compare.pair_reduction(), m_difference_factor);
+               m_compare.difference.psnr_db, m_compare.difference.max_abs, m_compare.right_ms.median,
+               m_compare.right_ms.min, m_compare.right_ms.max, m_compare.left_ms.median, m_compare.left_ms.min,
+               m_compare.left_ms.max, speed_up_text(m_compare).c_str(), 100.0 * m_compare.pair_reduction(),
+               m_difference_factor);
   // The view or configuration asked for while it ran is not the one compared.
   if (m_have_request && (!same_camera(m_requested.camera, m_compare_camera) || !(m_requested.options == m_compare_options))) {
     m_compare.stale = true;
@@ -467,13 +488,14 @@ int ViewerApp::frustum_under_click(bool left_down, double x, double y) {
   m_window->window_size(&width, &height);
   if (width <= 0 || height <= 0) return -1;
   const float sx = float(m_last_camera.width) / float(width), sy = float(m_last_camera.height) / float(height);
-  const int index = pick_camera(m_scene.cameras, m_last_camera, float(x) * sx, float(y) * sy, 14.0f * sx);
+  const int index = pick_camera(m_scene.cameras, m_last_camera, float(x) * sx, float(y) * sy, 8.0f * sx,
+                                frustum_depth());
   if (index >= 0) std::fprintf(stderr, "flashgs-viewer: clicked the frustum of camera %d\n", index);
   return index;
 }
 
 void ViewerApp::draw_guides(int fb_w, int fb_h) {
-  if (!(m_settings.show_grid || m_settings.show_frustums) || !m_have_frame) return;
+  if (!(m_settings.show_grid || m_settings.show_frustums || !m_keys.path().keys.empty()) || !m_have_frame) return;
   if (!m_lines) {
     m_lines = std::make_unique<LineOverlay>();
     m_lines->init();
@@ -481,10 +503,11 @@ void ViewerApp::draw_guides(int fb_w, int fb_h) {
   std::vector<WorldSegment> world;
   if (m_settings.show_grid) world = grid_and_axes(m_scene.centre, m_scene.extent, m_controller.world_up());
   if (m_settings.show_frustums) {
-    const std::vector<WorldSegment> f = camera_frustums(m_scene.cameras, 0.08f * m_scene.extent,
+    const std::vector<WorldSegment> f = camera_frustums(m_scene.cameras, frustum_depth(),
                                                         m_controller.on_scene_camera() ? m_camera_index : -1);
     world.insert(world.end(), f.begin(), f.end());
   }
+  key_guides(world);
   m_lines->draw(project_segments(world, m_last_camera, 1e-3f * m_scene.extent), m_last_camera.width,
                 m_last_camera.height, fb_w, fb_h);
 }
@@ -819,7 +842,8 @@ void ViewerApp::finish_script() {
                   m_compare.left_label.c_str(), m_compare.difference.psnr_db, m_compare.difference.max_abs);
   }
   if (!m_args.export_path.empty()) {
-    start_path_export(m_args.export_path, m_args.export_frames);
+    if (m_keys.path().keys.size() >= 2) start_key_render(m_args.export_path);
+    else start_path_export(m_args.export_path, m_args.export_frames);
     while (m_export.active() || m_encoding_video) export_step();
   }
   if (m_args.check_frame && m_have_frame) check_displayed_frame();
@@ -918,9 +942,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   }
   model.recent = &m_recent;
   model.current_camera = m_camera_index;
-  model.on_scene_camera = m_controller.on_scene_camera() && m_have_frame &&
-                          m_controller.exact_scene_camera(m_last_camera.width, m_last_camera.height,
-                                                          m_settings.fov_x_degrees);
+  model.view_description = m_controller.view_description(m_camera_index, m_last_camera.width, m_last_camera.height,
+                                                         m_settings.fov_x_degrees);
   model.playing = m_playing;
   model.render_width = m_presenter->width();
   model.render_height = m_presenter->height();
@@ -929,6 +952,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.rendering = background_busy();
   if (comparing()) model.comparing = m_comparing;
   model.compare_elapsed_s = m_compare_task.elapsed_seconds();
+  model.compare_renders_done = m_compare_task.renders_done();
+  model.compare_renders_total = m_compare_task.renders_total();
   model.stats = m_have_frame ? &m_stats : nullptr;
   model.history = &m_history;
   model.compare = &m_compare;
@@ -937,8 +962,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.compare_shown = comparison_shown();
   model.divider = m_divider.fraction();
   model.difference_factor = m_difference_factor;
-  model.compare_problem = same_configuration_problem(compare_choice_options(m_settings.compare_left, m_settings.options),
-                                                     compare_choice_options(m_settings.compare_right, m_settings.options));
+  model.compare_problem = compare_sides_problem(m_settings.compare_left, m_settings.compare_right, m_settings.options,
+                                                model.backend);
   model.export_done = m_export.done_frames();
   model.export_total = m_export.active() ? m_export.total_frames() : 0;
   model.dialog_tool = m_dialog.tool();
@@ -951,7 +976,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
   for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
   const ViewerSettings before = m_settings;
-  if (m_settings.show_ui) draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer);
+  if (m_settings.show_ui)
+    draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer, m_keys, m_key_fields);
   draw_overlays(model, m_settings);
   if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
   keep_settings_valid(m_settings, before);
@@ -967,6 +993,8 @@ bool ViewerApp::advance_camera(const NavigationInput& nav, float dt) {
   const bool steering = nav.forward || nav.back || nav.left || nav.right || nav.up || nav.down ||
                         nav.look_dx != 0.0f || nav.look_dy != 0.0f || nav.pan_dx != 0.0f || nav.pan_dy != 0.0f;
   if (m_playing && steering) m_playing = false;  // taking the controls stops the path
+  if (m_keys.previewing() && steering) m_keys.stop_preview();
+  if (preview_keys(dt)) return true;
   if (m_playing && m_camera_path && !m_camera_path->empty()) {
     m_path_t = m_camera_path->advance(m_path_t, dt, m_settings.path_seconds_per_camera);
     m_controller.set_pose(m_camera_path->pose_at(m_path_t));
