@@ -357,6 +357,39 @@ TEST(Viewer, WindowResizeRecreatesTheFrame) {
   EXPECT_GE(d.psnr_db, 40.0);
 }
 
+// Made smaller, the window keeps its panels inside it: the statistics window, placed at the
+// right edge of a 1280-point window, comes back inside a 1024x600 one.
+TEST(Viewer, PanelsStayInsideTheWindowAfterAResize) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 1280x800 --frames 6 --log-input "
+                          "--keys \"WAIT:0.05,RESIZE:1024:600,WAIT:0.1\" --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const std::string name : {"Statistics corner", "panel corner"}) {
+    const std::string key = "widget \"" + name + "\" at ";
+    const auto at = r.output.rfind(key);
+    ASSERT_NE(at, std::string::npos) << name << "\n" << r.output;
+    int x = 0, y = 0;
+    ASSERT_EQ(std::sscanf(r.output.c_str() + at + key.size(), "%d,%d", &x, &y), 2) << r.output;
+    EXPECT_LE(x, 1024) << name;
+    EXPECT_LE(y, 600) << name;
+  }
+}
+
+// The first frame of a new scene is a coarse one, then the full frame follows (a large scene's
+// full frame takes seconds: the window showed "no frame yet" all that time).
+TEST(Viewer, TheFirstFrameOfASceneIsCoarseThenFull) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string steps = "wait_for \"first frame shown\" || status=10\n"
+                            "[ $status -eq 0 ] && { close_window || status=12; }\n";
+  const RunResult r = run_live_viewer(prefix, "coarse_first", "--backend cpu --size 1280x800 --log-input", steps, 11);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code << " (10 no full frame, 11 crash, 12 close)\n" << r.output;
+  const auto first = r.output.find("frame shown ");
+  ASSERT_NE(first, std::string::npos) << r.output;
+  const std::string line = r.output.substr(first, r.output.find('\n', first) - first);
+  EXPECT_NE(line.find("(reduced)"), std::string::npos) << line;
+  EXPECT_NE(r.output.find("(full)", first), std::string::npos) << r.output;
+}
+
 TEST(Viewer, FailedLoadKeepsTheCurrentScene) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir();
@@ -484,7 +517,7 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
-                            "[ $status -eq 0 ] && { click \"Compare this view (C)\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { click \"tab Compare\" && click \"Compare this view (C)\" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=12; }\n";
   // The default window height (800): at 720 the Compare button sits below the panels' fold.
   const RunResult r = run_live_viewer(prefix, "click", "--backend cpu --size 1280x800 --log-input", steps, 13);
@@ -719,9 +752,11 @@ TEST(Viewer, TypingOnAfterAFailedOpenStaysInThePathField) {
   // GLFW key code: B 66.
   const std::string steps =
       "wait_for \"UI ready\" || status=10\n"
-      "[ $status -eq 0 ] && { click \"path field\" && \"$input\" focus 1 1 && \"$input\" type nosuchscene && \"$input\" down Return && "
-      "\"$input\" up Return || status=11; }\n"
-      "[ $status -eq 0 ] && { wait_for \"nosuchscene\" || status=12; }\n"
+      // Each key held across two frames (GLFW key codes: letters their capitals' ASCII, Enter 257).
+      "[ $status -eq 0 ] && { click \"path field\" || status=11; }\n"
+      "for c in n o p e; do [ $status -eq 0 ] && { hold $c \" key$(printf '%d' \"'${c^^}\") \" || status=11; }; done\n"
+      "[ $status -eq 0 ] && { hold Return \" key257 \" || status=11; }\n"
+      "[ $status -eq 0 ] && { wait_for \"load failed, scene kept: nope\" || status=12; }\n"
       "[ $status -eq 0 ] && { hold b \" key66 \" || status=13; }\n"
       "[ $status -eq 0 ] && { close_window || status=15; }\n";
   const RunResult r = run_live_viewer(prefix, "typing_on", "--backend cpu --size 1280x800 --log-input", steps, 14, "", config);
@@ -1449,7 +1484,7 @@ TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
       "[ $status -eq 0 ] && { hold c \" key67 \" || status=11; }\n"
       "[ $status -eq 0 ] && { wait_for \"comparing flash vs baseline at 2048x1200 in the background\" || status=12; }\n"
       "[ $status -eq 0 ] && { hold c \" key67 \" && wait_for \"this request is ignored\" || status=13; }\n"
-      "[ $status -eq 0 ] && { click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=14; }\n"
+      "[ $status -eq 0 ] && { click \"tab Rendering\" && click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=14; }\n"
       "open_gate\n"
       "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=15; }\n"
       "[ $status -eq 0 ] && { close_window || status=17; }\n";
@@ -1528,10 +1563,10 @@ TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
   // 1024x1000: the export row is on screen below the open sections.
   const std::string steps =
       "wait_for \"UI ready\" || status=10\n"
-      "[ $status -eq 0 ] && { click \"export folder\" && \"$input\" type exportwhilelive || status=11; }\n"
+      "[ $status -eq 0 ] && { click \"tab Overlay & output\" && click \"export folder\" && \"$input\" type exportwhilelive || status=11; }\n"
       "close_gate\n"
       "[ $status -eq 0 ] && { click \"Export path\" && wait_for \"path export: 3 frames into\" || status=12; }\n"
-      "[ $status -eq 0 ] && { click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
+      "[ $status -eq 0 ] && { click \"tab Rendering\" && click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
       "open_gate\n"
       "[ $status -eq 0 ] && { wait_for \"path export: 3 frames in \" || status=14; }\n"
       "[ $status -eq 0 ] && { close_window || status=16; }\n";

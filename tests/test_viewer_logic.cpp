@@ -863,7 +863,8 @@ TEST(ViewerGuides, TheViewPanelNamesTheCameraWhoseShapeDiffersFromTheWindow) {
   c.snap_to(cameras[2]);
   const float fov = cameras[2].horizontal_fov_degrees();
   EXPECT_EQ(c.view_description(2, 1280, 720, fov), "on camera 2 (exact)");
-  EXPECT_EQ(c.view_description(2, 1280, 800, fov), "on camera 2: its pose and FOV; window 1.60:1, its images 1.78:1");
+  EXPECT_EQ(c.view_description(2, 1280, 800, fov), "on camera 2: pose, window 1.60:1 vs 1.78:1");
+  EXPECT_EQ(c.view_description(2, 0, 0, fov), "on camera 2");
   fv::NavigationInput forward;
   forward.forward = true;
   fv::ViewerSettings s;
@@ -913,6 +914,17 @@ TEST(ViewerKeyframes, KeysAreAddedReplacedRetimedDeletedAndSaved) {
   for (int i = 0; i < 100 && f.previewing(); ++i) c = f.preview_step(0.1, 160, 90);
   EXPECT_FALSE(f.previewing());
   EXPECT_NEAR(c.position[0], cameras[2].position[0], 1e-5f);
+}
+
+// The load's bar covers reading and decoding: all bytes read with a tenth of the Gaussians
+// decoded is not a full bar (it was: the bytes alone filled it).
+TEST(ViewerLoad, TheProgressBarCoversReadingAndDecoding) {
+  EXPECT_FLOAT_EQ(fv::load_fraction(574, 574, 35, 350), 0.55f);
+  EXPECT_FLOAT_EQ(fv::load_fraction(287, 574, 0, 350), 0.25f);
+  EXPECT_FLOAT_EQ(fv::load_fraction(574, 574, 350, 350), 1.0f);
+  EXPECT_FLOAT_EQ(fv::load_fraction(100, 400, 0, 0), 0.25f);  // a reader that reports bytes only
+  EXPECT_FLOAT_EQ(fv::load_fraction(0, 0, 30, 60), 0.5f);     // ...or Gaussians only
+  EXPECT_FLOAT_EQ(fv::load_fraction(0, 0, 0, 0), -1.0f);
 }
 
 TEST(ViewerFiles, TheDesktopDialogsAnswerIsTheChosenPath) {

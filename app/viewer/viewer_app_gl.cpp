@@ -550,14 +550,25 @@ void ViewerApp::ensure_texture(int width, int height) {
 void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
   m_render_call_ms = 0;
   if (!m_scene.scene) return;
+  // The coarse first frame of a scene is not replaced while it renders: the next request
+  // (the full frame) would cancel it, and the window would stay empty until that one ends.
+  if (m_coarse_in_flight && m_path->busy()) return;
+  m_coarse_in_flight = false;
   // A slow backend renders fewer pixels while the view moves (about kMovingFrameMs a frame),
   // and the full frame once it stops: the camera then differs, so it is asked for again.
   float scale = m_settings.render_scale;
   // A screenshot waits for a full frame: none is reduced (or stopped) until it is taken.
   const bool shot_pending = !m_pending_screenshot.empty();
-  const bool reduced = !m_scripted && m_settings.adaptive_resolution && moving && m_full_render_ms > kMovingFrameMs &&
-                       !shot_pending;
-  if (reduced) scale *= std::clamp(float(std::sqrt(kMovingFrameMs / m_full_render_ms)), kMinMovingScale, 1.0f);
+  // The first frame of a new scene is coarse too: its full frame's time is not known yet.
+  // (A fixed --render-size has no coarser size.)
+  const bool coarse_first = !m_scripted && m_settings.adaptive_resolution && m_coarse_next_frame && !shot_pending &&
+                            m_settings.forced_width == 0;
+  const bool reduced = coarse_first || (!m_scripted && m_settings.adaptive_resolution && moving &&
+                                        m_full_render_ms > kMovingFrameMs && !shot_pending);
+  if (coarse_first) scale *= kMinMovingScale;
+  else if (reduced) scale *= std::clamp(float(std::sqrt(kMovingFrameMs / m_full_render_ms)), kMinMovingScale, 1.0f);
+  m_coarse_in_flight = coarse_first;
+  m_coarse_next_frame = false;
   const int wanted_w = m_settings.forced_width > 0 ? m_settings.forced_width : std::max(1, int(std::lround(fb_w * scale)));
   const int wanted_h = m_settings.forced_height > 0 ? m_settings.forced_height : std::max(1, int(std::lround(fb_h * scale)));
   int rw = 0, rh = 0;

@@ -155,6 +155,8 @@ class ViewerApp {
   FrameRequest m_requested;
   bool m_have_request = false;
   bool m_requested_full = false;  // the last request was at the full render scale
+  bool m_coarse_next_frame = false;  // a scene was installed: its first frame is a coarse one...
+  bool m_coarse_in_flight = false;   // ...and it is being rendered
   Camera m_last_camera;
   RenderOptions m_last_options;
   bool m_have_frame = false;

@@ -9,6 +9,7 @@
 #include <imgui_stdlib.h>
 
 #include "count_text.h"
+#include "scene_loader.h"
 #include "heatmap_legend.h"
 #include "help_overlay_ui.h"
 #include "widget_places_ui.h"
@@ -22,12 +23,6 @@ float g_ui = 1.0f;
 float ui(float v) { return v * g_ui; }
 // The main panel's right edge this frame (the status line stays right of it).
 float g_panel_right = 0;
-
-// The sections below Scene and View start open only in a window tall enough to leave the
-// picture visible beside them (at 800x450 they start folded; ImGui keeps what the user chose).
-ImGuiTreeNodeFlags open_if_roomy() {
-  return ImGui::GetMainViewport()->WorkSize.y >= ui(600) ? ImGuiTreeNodeFlags_DefaultOpen : 0;
-}
 
 // Every slider clamps what is typed into it (Ctrl+click) to its range, not just what is dragged.
 constexpr ImGuiSliderFlags kClamp = ImGuiSliderFlags_AlwaysClamp;
@@ -54,6 +49,17 @@ bool greyed_checkbox(const char* label, bool* value, bool enabled) {
   if (!enabled) ImGui::PopStyleColor();
   ImGui::EndDisabled();
   return changed;
+}
+
+// Call after Begin: a window that a resize (or a drag) left partly outside the viewport comes
+// back inside it, as far as it fits. `name` logs its bottom-right corner (--log-input).
+void keep_inside_viewport(const char* name) {
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  const ImVec2 inside(std::clamp(pos.x, vp->WorkPos.x, std::max(vp->WorkPos.x, vp->WorkPos.x + vp->WorkSize.x - size.x)),
+                      std::clamp(pos.y, vp->WorkPos.y, std::max(vp->WorkPos.y, vp->WorkPos.y + vp->WorkSize.y - size.y)));
+  if (inside.x != pos.x || inside.y != pos.y) ImGui::SetWindowPos(inside);
+  note_drawn_place(name, inside.x + size.x, inside.y + size.y, inside.x + size.x, inside.y + size.y);
 }
 
 // A progress bar; with `fraction` < 0 (not known) a block sliding along it, so that the
@@ -93,11 +99,12 @@ void load_window(const UiModel& m, UiActions& a) {
                    ImGuiWindowFlags_NoFocusOnAppearing);  // its height fits (size 0 above): its text wraps
   colored_wrapped(ImVec4(0.5f, 0.8f, 1.0f, 1), "Loading " + m.loading);
   const LoadView& l = m.load;
-  float fraction = -1.0f;
-  if (l.bytes_total > 0 && l.bytes_done > 0) fraction = float(double(l.bytes_done) / double(l.bytes_total));
-  else if (l.gaussians_total > 0 && l.gaussians_done > 0) fraction = float(double(l.gaussians_done) / double(l.gaussians_total));
-  char elapsed[32];
-  std::snprintf(elapsed, sizeof elapsed, "%.1f s", l.elapsed_s);
+  const float fraction = load_fraction(l.bytes_done, l.bytes_total, l.gaussians_done, l.gaussians_total);
+  // Which step: the bytes read in full, the Gaussians still being decoded.
+  const bool decoding = l.bytes_total > 0 && l.bytes_done >= l.bytes_total && l.gaussians_total > 0 &&
+                        l.gaussians_done < l.gaussians_total;
+  char elapsed[64];
+  std::snprintf(elapsed, sizeof elapsed, "%s%.1f s", decoding ? "decoding, " : "", l.elapsed_s);
   progress_bar(fraction, elapsed, l.elapsed_s);
   std::string detail;
   if (l.bytes_total > 0)
@@ -196,7 +203,7 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
     colored_wrapped(ImVec4(0.9f, 0.8f, 0.4f, 1), m.scene_note);
   }
   ImGui::SetNextItemWidth(ui(-170));
-  const bool enter = ImGui::InputTextWithHint("##open", "scene file or folder (or drop one)", &path_buffer,
+  const bool enter = ImGui::InputTextWithHint("##open", "scene file or folder", &path_buffer,
                                               ImGuiInputTextFlags_EnterReturnsTrue);
   // Enter ends the edit, but the typing goes on in the box (a mistyped path is corrected
   // there): letters typed next must not reach the single-key shortcuts.
@@ -260,7 +267,7 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
     ImGui::SliderFloat("s per camera", &s.path_seconds_per_camera, kPathSecondsRange.min, kPathSecondsRange.max, "%.1f",
                        kClamp | ImGuiSliderFlags_Logarithmic);
     note_widget_place("s per camera");
-    ImGui::TextWrapped("%s", m.view_description.c_str());
+    ImGui::TextUnformatted(m.view_description.c_str());  // one line: the sliders below stay put
   } else if (!m.scene_path.empty()) {
     ImGui::TextDisabled("no cameras.json: free navigation");
   }
@@ -303,7 +310,6 @@ void switch_checkbox(const RenderSwitch& sw, RenderOptions& o, Backend backend) 
 }
 
 void render_panel(const UiModel& m, ViewerSettings& s) {
-  if (!ImGui::CollapsingHeader("Rendering", open_if_roomy())) return;
   RenderOptions& o = s.options;
   int algo = o.is_baseline() ? 0 : 1;
   ImGui::RadioButton("Baseline (3DGS)", &algo, 0);
@@ -367,7 +373,6 @@ std::string spread_cell(const Spread& s) {
 }
 
 void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
-  if (!ImGui::CollapsingHeader("Compare", open_if_roomy())) return;
   // The two sides: any two of the configurations compare_mode.h lists that the backend draws
   // differently (a switch it ignores renders flash itself).
   auto side = [&](const char* label, int* choice) {
@@ -451,7 +456,6 @@ void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
 // The keyframed camera path: keys from the view (I), their times, easing, preview, the file,
 // and the render of its frames (size, fps, duration, folder; progress and Cancel).
 void keyframe_panel(const UiModel& m, UiActions& a, PathEditor& keys, PathFields& f) {
-  if (!ImGui::CollapsingHeader("Camera path (keyframes)")) return;
   KeyframePath& p = keys.path();
   if (ImGui::Button("Add view (I)")) a.add_key = true;
   note_widget_place("Add view (I)");
@@ -534,7 +538,6 @@ void keyframe_panel(const UiModel& m, UiActions& a, PathEditor& keys, PathFields
 }
 
 void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& export_folder) {
-  if (!ImGui::CollapsingHeader("Overlay, screenshots, export", open_if_roomy())) return;
   ImGui::Checkbox("Tile heat map (H)", &s.heatmap);
   ImGui::SameLine();
   ImGui::Checkbox("log", &s.heatmap_log);
@@ -577,10 +580,13 @@ void stats_window(const UiModel& m) {
   // The title keeps the frame rate in view when the window is folded.
   char title[256];
   if (m.fps > 0) std::snprintf(title, sizeof title, "%.1f FPS | %s###Statistics", m.fps, m.frame_path.c_str());
-  else std::snprintf(title, sizeof title, "idle | %s###Statistics", m.frame_path.c_str());
+  else if (m.last_frame_ms > 0)  // still: the last frame's time (the title's width is fixed)
+    std::snprintf(title, sizeof title, "%.0f ms/frame | %s###Statistics", m.last_frame_ms, m.frame_path.c_str());
+  else std::snprintf(title, sizeof title, "no frame yet | %s###Statistics", m.frame_path.c_str());
   // A fixed width: the anchor above places its right edge from the first frame on.
   ImGui::SetNextWindowSizeConstraints(ImVec2(ui(330), 0), ImVec2(ui(330), vp->WorkSize.y));
   ImGui::Begin(title, nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  keep_inside_viewport("Statistics corner");
   colored_wrapped(ImVec4(0.5f, 0.9f, 0.6f, 1), m.frame_path);
   if (!m.frame_path_note.empty()) ImGui::TextWrapped("%s", m.frame_path_note.c_str());
   ImGui::Text("rendered: %.1f FPS   render %dx%d", m.fps, m.render_width, m.render_height);
@@ -673,6 +679,43 @@ void compare_labels(const UiModel& m, const ViewerSettings& s) {
   label(at + ui(12), c->right_label);
 }
 
+// A tab of the sections' bar; its place is logged as "tab NAME" (--log-input).
+bool section_tab(const char* name, bool select) {
+  const bool open = ImGui::BeginTabItem(name, nullptr, select ? ImGuiTabItemFlags_SetSelected : 0);
+  note_widget_place((std::string("tab ") + name).c_str());
+  return open;
+}
+
+// Below Scene and View, one section at a time: the panel stays short enough at 1280x800 that
+// every action is on screen without scrolling (stacked, the Compare results and the export
+// were below the fold).
+void section_tabs(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& export_folder, PathEditor& keys,
+                  PathFields& key_fields) {
+  // A comparison started with C (from any tab) brings its tab forward once.
+  static bool was_comparing = false;
+  const bool comparing = !m.comparing.empty();
+  const bool show_compare = comparing && !was_comparing;
+  was_comparing = comparing;
+  if (!ImGui::BeginTabBar("sections")) return;
+  if (section_tab("Rendering", false)) {
+    render_panel(m, s);
+    ImGui::EndTabItem();
+  }
+  if (section_tab("Compare", show_compare)) {
+    compare_panel(m, s, a);
+    ImGui::EndTabItem();
+  }
+  if (section_tab("Camera path", false)) {
+    keyframe_panel(m, a, keys, key_fields);
+    ImGui::EndTabItem();
+  }
+  if (section_tab("Overlay & output", false)) {
+    overlay_panel(m, s, a, export_folder);
+    ImGui::EndTabItem();
+  }
+  ImGui::EndTabBar();
+}
+
 }  // namespace
 
 void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer, std::string& export_folder,
@@ -692,15 +735,13 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   fitted_for = scene_key;
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("flashgs-viewer");
+  keep_inside_viewport("panel corner");
   panel_width = ImGui::GetWindowSize().x;
   const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
   ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels
   scene_panel(m, s, a, path_buffer);
   view_panel(m, s, a);
-  render_panel(m, s);
-  compare_panel(m, s, a);
-  keyframe_panel(m, a, keys, key_fields);
-  overlay_panel(m, s, a, export_folder);
+  section_tabs(m, s, a, export_folder, keys, key_fields);
   if (ImGui::Button("Keys and mouse (F1)")) s.show_help = !s.show_help;
   ImGui::SameLine();
   ImGui::TextDisabled("Tab hides the panels");
