@@ -16,7 +16,9 @@
 #include "camera_controller.h"
 #include "camera_path.h"
 #include "compare_mode.h"
+#include "folder_listing.h"
 #include "path_editor.h"
+#include "process_clock.h"
 #include "file_dialog.h"
 #include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
@@ -925,6 +927,52 @@ TEST(ViewerLoad, TheProgressBarCoversReadingAndDecoding) {
   EXPECT_FLOAT_EQ(fv::load_fraction(100, 400, 0, 0), 0.25f);  // a reader that reports bytes only
   EXPECT_FLOAT_EQ(fv::load_fraction(0, 0, 30, 60), 0.5f);     // ...or Gaussians only
   EXPECT_FLOAT_EQ(fv::load_fraction(0, 0, 0, 0), -1.0f);
+}
+
+// Start-up is measured from exec: this test process started before the test ran, and not an
+// hour ago (a wrong field of /proc/self/stat reads as years or as a negative age).
+TEST(ViewerStartup, TheProcessAgeCountsFromExec) {
+  const double age = fv::ms_since_process_start();
+  EXPECT_GE(age, 0.0);
+  EXPECT_LT(age, 3.6e6);
+}
+
+// The in-app browser lists every format the viewer reads (it listed *.ply only) and the
+// folders that are a scene, with a training output's iterations; other files are left out.
+TEST(ViewerFiles, TheBrowserListsEveryFormatAndSceneFoldersSorted) {
+  namespace fs = std::filesystem;
+  const std::string dir = scratch_dir("browser_listing");
+  std::ofstream(dir + "/b.ply") << std::string(300, 'x');
+  std::ofstream(dir + "/a.spz") << std::string(100, 'x');
+  std::ofstream(dir + "/c.SPLAT") << std::string(200, 'x');
+  std::ofstream(dir + "/notes.txt") << "x";
+  std::ofstream(dir + "/.hidden.ply") << "x";
+  fs::create_directories(dir + "/sog");
+  std::ofstream(dir + "/sog/meta.json") << "{}";
+  fs::create_directories(dir + "/plain");
+  for (const char* it : {"iteration_7000", "iteration_30000", "iteration_x"}) {
+    fs::create_directories(dir + "/train/point_cloud/" + it);
+    std::ofstream(dir + "/train/point_cloud/" + it + "/point_cloud.ply") << "x";
+  }
+  std::string error;
+  const auto by_name = fv::list_folder(dir, fv::FolderSort::name, &error);
+  EXPECT_EQ(error, "");
+  std::vector<std::string> names;
+  for (const auto& e : by_name) names.push_back(e.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"plain", "sog", "train", "a.spz", "b.ply", "c.SPLAT"}));
+  EXPECT_EQ(by_name[0].kind, fv::FolderEntry::Kind::folder);
+  EXPECT_EQ(by_name[1].kind, fv::FolderEntry::Kind::scene_folder);
+  ASSERT_EQ(by_name[2].iterations.size(), 2u);
+  EXPECT_EQ(by_name[2].iterations[0].first, 30000);
+  EXPECT_EQ(by_name[2].iterations[1].second, dir + "/train/point_cloud/iteration_7000/point_cloud.ply");
+  EXPECT_EQ(by_name[4].bytes, 300u);
+  const auto by_size = fv::list_folder(dir, fv::FolderSort::size, &error);
+  EXPECT_EQ(by_size[3].name, "b.ply");
+  EXPECT_EQ(by_size[5].name, "a.spz");
+  EXPECT_TRUE(fv::is_scene_file_name("lod-meta.json"));
+  EXPECT_FALSE(fv::is_scene_file_name("cameras.json"));
+  EXPECT_TRUE(fv::list_folder(dir + "/absent", fv::FolderSort::name, &error).empty());
+  EXPECT_NE(error.find(dir + "/absent: "), std::string::npos) << error;
 }
 
 TEST(ViewerFiles, TheDesktopDialogsAnswerIsTheChosenPath) {

@@ -25,6 +25,7 @@
 #include "scene_lines.h"
 #include "split_view_gl.h"
 #include "path_note.h"
+#include "process_clock.h"
 #include "render_gate.h"
 #include "settings_store.h"
 #include "viewer_panels_ui.h"
@@ -658,8 +659,8 @@ void ViewerApp::collect_frame() {
                  m_frame_is_full ? "full" : "reduced", frame.wall_ms);
   if (!m_logged_first_frame && m_frame_is_full) {
     m_logged_first_frame = true;
-    std::fprintf(stderr, "flashgs-viewer: first frame shown %.0f ms after start (%dx%d, %s)\n", ms_since_start(),
-                 width, height, m_scene.path.c_str());
+    std::fprintf(stderr, "flashgs-viewer: first frame shown %.0f ms after start (%.0f ms after the process started) "
+                 "(%dx%d, %s)\n", ms_since_start(), ms_since_process_start(), width, height, m_scene.path.c_str());
   }
 }
 
@@ -718,7 +719,8 @@ void ViewerApp::draw_and_present(int fb_w, int fb_h) {
   // a frame late: from the third frame with panels on after the first load ended (the scene's
   // lines in its panel), they are all on screen where they stay (tests click them from then on).
   if (m_settings.show_ui && !m_first_load_pending && ++m_ui_frames == 3)
-    std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start\n", ms_since_start());
+    std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start (%.0f ms after the process started)\n",
+                 ms_since_start(), ms_since_process_start());
 }
 
 void ViewerApp::log_popup_changes() {

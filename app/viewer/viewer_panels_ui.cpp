@@ -219,10 +219,6 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   if (ImGui::Button("Browse...")) a.open_dialog = true;
   ImGui::EndDisabled();
   if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("the desktop's file dialog (Ctrl+O)");
-  if (m.dialog_open) {
-    ImGui::SameLine();
-    ImGui::TextDisabled("waiting for %s", m.dialog_tool.empty() ? "the file browser" : m.dialog_tool.c_str());
-  }
   // The recent scenes behind an arrow on the same row: the panel's layout does not move.
   ImGui::SameLine();
   const bool any_recent = m.recent && !m.recent->empty();
@@ -237,6 +233,8 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   ImGui::EndDisabled();
   if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
     ImGui::SetTooltip(any_recent ? "recently opened scenes" : "no recent scenes yet");
+  // On a line of its own: beside the Browse button it was cut off at the panel's edge.
+  if (m.dialog_open) ImGui::TextDisabled("waiting for %s", m.dialog_tool.empty() ? "the file browser" : m.dialog_tool.c_str());
   if (!m.load_error.empty()) {
     colored_wrapped(ImVec4(1.0f, 0.45f, 0.4f, 1), m.load_error);
   }
