@@ -1029,6 +1029,22 @@ TEST(Viewer, ScreenshotsIncludeTheHeatMapWhenAsked) {
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(on.pixel(320, 231)[c], want[c], 3.0f / 255.0f) << c;
   }
+  // Its tick values and caption too (white text above and below the bar; the screenshot had
+  // the bar alone): the ramp and the picture hold no white there.
+  std::size_t white_below = 0, white_above = 0, white_plain = 0;
+  for (int x = 170; x < 472; ++x) {
+    for (int y = 239; y < 256; ++y) {
+      white_below += on.pixel(x, y)[0] > 0.9f && on.pixel(x, y)[1] > 0.9f && on.pixel(x, y)[2] > 0.9f;
+      white_plain += off.pixel(x, y)[0] > 0.9f && off.pixel(x, y)[1] > 0.9f && off.pixel(x, y)[2] > 0.9f;
+    }
+    for (int y = 208; y < 222; ++y)
+      white_above += on.pixel(x, y)[0] > 0.9f && on.pixel(x, y)[1] > 0.9f && on.pixel(x, y)[2] > 0.9f;
+  }
+  std::printf("legend text in the screenshot: %zu white pixels below the bar, %zu above (%zu without the overlay)\n",
+              white_below, white_above, white_plain);
+  EXPECT_GT(white_below, 20u) << "no tick values";
+  EXPECT_GT(white_above, 40u) << "no caption";
+  EXPECT_EQ(white_plain, 0u) << "white there without the overlay: the checks above prove nothing";
 }
 
 // The split view: left of the divider the baseline's render, right of it the current

@@ -100,6 +100,7 @@ ViewerApp::ViewerApp(ViewerArgs args)
   m_settings.show_help = m_args.help_window;
   m_settings.screenshot_overlay = m_args.screenshot_overlay;
   m_settings.show_grid = m_args.grid;
+  m_settings.show_centres = m_args.centres;
   m_settings.show_frustums = m_args.frustums;
   m_settings.up_axis = int(std::find(kUpAxisNames, kUpAxisNames + kUpAxisCount, m_args.up) - kUpAxisNames) % kUpAxisCount;
   m_settings.compare_view = m_args.compare_view == "numbers" ? CompareView::numbers
@@ -496,7 +497,9 @@ int ViewerApp::frustum_under_click(bool left_down, double x, double y) {
 }
 
 void ViewerApp::draw_guides(int fb_w, int fb_h) {
-  if (!(m_settings.show_grid || m_settings.show_frustums || !m_keys.path().keys.empty()) || !m_have_frame) return;
+  if (!(m_settings.show_grid || m_settings.show_frustums || m_settings.show_centres || !m_keys.path().keys.empty()) ||
+      !m_have_frame)
+    return;
   if (!m_lines) {
     m_lines = std::make_unique<LineOverlay>();
     m_lines->init();
@@ -509,8 +512,12 @@ void ViewerApp::draw_guides(int fb_w, int fb_h) {
     world.insert(world.end(), f.begin(), f.end());
   }
   key_guides(world);
-  m_lines->draw(project_segments(world, m_last_camera, 1e-3f * m_scene.extent), m_last_camera.width,
-                m_last_camera.height, fb_w, fb_h);
+  std::vector<ScreenSegment> screen = project_segments(world, m_last_camera, 1e-3f * m_scene.extent);
+  if (m_settings.show_centres && m_scene.scene) {
+    const std::vector<ScreenSegment> dots = centre_marks(*m_scene.scene, m_last_camera, kMaxCentreMarks);
+    screen.insert(screen.end(), dots.begin(), dots.end());
+  }
+  m_lines->draw(screen, m_last_camera.width, m_last_camera.height, fb_w, fb_h);
 }
 
 void ViewerApp::open_file_dialog() {
@@ -694,12 +701,13 @@ void ViewerApp::draw_and_present(int fb_w, int fb_h) {
   if (comparing)
     m_split->draw(fb_w, fb_h, m_divider.fraction(), std::max(2.0f, 2.0f * m_ui_scale * m_window->framebuffer_scale()),
                   m_settings.compare_view == CompareView::difference);
-  if (!m_pending_overlay_shot.empty()) {  // the image as shown, heat map included, panels not
+  m_ui->end_frame();
+  if (m_overlay_shot_frame) {  // the image as shown, heat map and legend included, panels not
     save_window_screenshot(m_pending_overlay_shot, fb_w, fb_h);
     m_status = "saved " + m_pending_overlay_shot + " (heat map included)";
     m_pending_overlay_shot.clear();
+    m_overlay_shot_frame = false;
   }
-  m_ui->end_frame();
   if (!m_pending_window_shot.empty()) {
     save_window_screenshot(m_pending_window_shot, fb_w, fb_h);
     m_pending_window_shot.clear();
@@ -989,10 +997,17 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
   for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
   const ViewerSettings before = m_settings;
-  if (m_settings.show_ui)
-    draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer, m_keys, m_key_fields);
-  draw_overlays(model, m_settings);
-  if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
+  // A screenshot with the overlay: this frame draws the legend's labels alone over the image
+  // (no panels, no help, no status line), and the picture is taken once it is drawn.
+  m_overlay_shot_frame = !m_pending_overlay_shot.empty();
+  if (m_overlay_shot_frame) {
+    draw_legend_labels(model, m_settings);
+  } else {
+    if (m_settings.show_ui)
+      draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer, m_keys, m_key_fields);
+    draw_overlays(model, m_settings);
+    if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
+  }
   keep_settings_valid(m_settings, before);
   if (const std::string chosen = m_dialog.take_choice(); !chosen.empty()) actions.open_path = chosen;
   if (!model.loading.empty() && !m_logged_load_progress) {

@@ -193,7 +193,8 @@ class ViewerApp {
   PathExport m_export;
   BackgroundJob m_export_job;   // the export frame (or ffmpeg) in flight
   bool m_encoding_video = false;  // the job is ffmpeg making path.mp4
-  std::string m_pending_overlay_shot;  // a screenshot of the image with the heat map, taken before the panels are drawn
+  std::string m_pending_overlay_shot;  // a screenshot of the image with the heat map and its legend...
+  bool m_overlay_shot_frame = false;   // ...taken in this frame, which draws no panels
   bool m_compare_pending = false;  // asked for before there was a full frame to compare
   std::string m_status;
   RenderOptions m_logged_options;

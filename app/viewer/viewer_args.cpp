@@ -77,6 +77,7 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   auto* orbit = app.add_flag("--orbit", a->orbit, "start in orbit mode (default: orbit for object-sized scenes, else fly)");
   app.add_flag("--fly", a->fly, "start in fly mode")->excludes(orbit);
   app.add_flag("--grid", a->grid, "start with the ground grid and axes shown (G)");
+  app.add_flag("--centres", a->centres, "start with the Gaussians' centres drawn as dots (a debug view)");
   app.add_flag("--frustums", a->frustums, "start with the training cameras drawn as frustums");
   app.add_flag("--help-window", a->help_window, "start with the shortcut table open (F1)");
   app.add_option("--compare-view", a->compare_view, "what a comparison shows: numbers, split or difference")

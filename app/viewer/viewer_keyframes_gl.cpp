@@ -24,8 +24,11 @@ void ViewerApp::show_key_view(int index) {
 }
 
 void ViewerApp::apply_key_actions(const UiActions& a) {
-  const auto count = [&] { return std::to_string(m_keys.path().keys.size()) + " keys, " +
-                                  std::to_string(m_keys.path().duration_s()).substr(0, 5) + " s"; };
+  const auto count = [&] {  // "3 keys, 4.0 s"
+    char text[64];
+    std::snprintf(text, sizeof text, "%zu keys, %.1f s", m_keys.path().keys.size(), m_keys.path().duration_s());
+    return std::string(text);
+  };
   if (a.add_key) {
     m_keys.add(view_for_key());
     set_notice("camera path: key " + std::to_string(m_keys.selected()) + " added from the view (" + count() + ")");

@@ -546,6 +546,10 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
   ImGui::SliderFloat("opacity", &s.heatmap_opacity, kHeatmapOpacityRange.min, kHeatmapOpacityRange.max, "%.2f", kClamp);
   ImGui::SameLine();
   ImGui::Checkbox("in screenshots", &s.screenshot_overlay);
+  ImGui::Checkbox("Gaussian centres", &s.show_centres);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("each Gaussian's centre as a dot in its base colour (at most %d; every k-th beyond)",
+                      int(kMaxCentreMarks));
   ImGui::SetNextItemWidth(ui(-90));
   ImGui::InputTextWithHint("##shotdir", "screenshot folder", &s.screenshot_folder);
   ImGui::SameLine();
@@ -689,11 +693,12 @@ bool section_tab(const char* name, bool select) {
 // were below the fold).
 void section_tabs(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& export_folder, PathEditor& keys,
                   PathFields& key_fields) {
-  // A comparison started with C (from any tab) brings its tab forward once.
-  static bool was_comparing = false;
-  const bool comparing = !m.comparing.empty();
-  const bool show_compare = comparing && !was_comparing;
+  // A comparison started with C (from any tab), or its result arriving, brings its tab forward once.
+  static bool was_comparing = false, had_result = false;
+  const bool comparing = !m.comparing.empty(), result = m.compare && (m.compare->valid || !m.compare->error.empty());
+  const bool show_compare = (comparing && !was_comparing) || (result && !had_result);
   was_comparing = comparing;
+  had_result = result;
   if (!ImGui::BeginTabBar("sections")) return;
   if (section_tab("Rendering", false)) {
     render_panel(m, s);
@@ -748,6 +753,11 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   stats_window(m);
   load_window(m, a);
   g_panel_right = panel_right;
+}
+
+void draw_legend_labels(const UiModel& m, const ViewerSettings& s) {
+  g_ui = m.ui_scale;
+  if (s.heatmap && !m.compare_shown) legend_labels(m, s);
 }
 
 void draw_overlays(const UiModel& m, ViewerSettings& s) {

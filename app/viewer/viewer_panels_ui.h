@@ -108,5 +108,7 @@ void draw_panels(const UiModel& model, ViewerSettings& settings, UiActions& acti
 // What stays on screen with the panels hidden too: the heat-map legend, the comparison's
 // labels, the help window and the hint that the panels are hidden.
 void draw_overlays(const UiModel& model, ViewerSettings& settings);
+// The heat-map legend's caption, tick marks and values alone (a screenshot with the overlay).
+void draw_legend_labels(const UiModel& model, const ViewerSettings& settings);
 
 }  // namespace flashgs::viewer
