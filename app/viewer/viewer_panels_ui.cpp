@@ -554,7 +554,6 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
   ImGui::InputTextWithHint("##shotdir", "screenshot folder", &s.screenshot_folder);
   ImGui::SameLine();
   if (ImGui::Button("Save (F12)")) a.screenshot = true;
-  if (!m.status.empty()) ImGui::TextWrapped("%s", m.status.c_str());
   if (m.export_total > 0) {
     ImGui::ProgressBar(float(m.export_done) / float(m.export_total), ImVec2(ui(-70), 0));
     ImGui::SameLine();
@@ -745,6 +744,11 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   scene_panel(m, s, a, path_buffer);
   view_panel(m, s, a);
   section_tabs(m, s, a, export_folder, keys, key_fields);
+  // The last notice (a screenshot saved, a key added, a refusal) under the tabs, whichever is open.
+  if (!m.status.empty()) {
+    ImGui::Separator();
+    ImGui::TextWrapped("%s", m.status.c_str());
+  }
   if (ImGui::Button("Keys and mouse (F1)")) s.show_help = !s.show_help;
   ImGui::SameLine();
   ImGui::TextDisabled("Tab hides the panels");
