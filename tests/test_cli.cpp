@@ -20,7 +20,11 @@
 #include <vector>
 
 #include "flashgs/demo_scene.h"
+#include "flashgs/generators.h"
+#include "flashgs/image.h"
+#include "flashgs/image_io.h"
 #include "flashgs/io.h"
+#include "flashgs/keyframe_path.h"
 #include "format_builders.h"
 #include "ply_builder.h"
 #include "test_support.h"
@@ -292,6 +296,46 @@ TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
                               {std::size_t{1} << 30});
   expect_one_line_error(r, "out of memory for a 2048x1024 frame", "pairs out of memory");
   EXPECT_EQ(r.exit_code, 2);
+}
+
+// A keyframed path round trip: written, read by `render --path`, and its frames at the two
+// keys' times are `render --eye/--look-at` at those poses; between them, neither.
+TEST(CliRender, ACameraPathRendersItsKeysAsTheExplicitCameraDoes) {
+  const std::string dir = scratch_dir("camera_path");
+  const std::string ext = image_io_has_oiio() ? ".png" : ".ppm";
+  const float up[3] = {0, -1, 0};
+  const float eye0[3] = {0.2f, -0.3f, -3.0f}, eye1[3] = {2.0f, -0.5f, -2.0f}, target[3] = {0, 0, 0};
+  KeyframePath path;
+  path.keys = {Keyframe::from_camera(look_at_camera(eye0, target, up, 160, 90, 70.0f), 0.0),
+               Keyframe::from_camera(look_at_camera(eye1, target, up, 160, 90, 55.0f), 1.0)};
+  path.fps = 4;  // frames at 0, 0.25, 0.5, 0.75 and 1 s
+  path.width = 160;
+  path.height = 90;
+  write_camera_path(path, dir + "/path.json");
+  const CliResult r = run_cli("render " + demo_scene_path() + " --backend cpu --path " + dir + "/path.json -o " + dir + "/frames");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote 5 frames to " + dir + "/frames"), std::string::npos) << r.output;
+  const auto explicit_render = [&](const float* eye, float fov, const std::string& name) {
+    const CliResult e = run_cli("render " + demo_scene_path() + " --backend cpu -r 160x90 --eye " + std::to_string(eye[0]) +
+                                "," + std::to_string(eye[1]) + "," + std::to_string(eye[2]) + " --look-at 0,0,0 --fov " +
+                                std::to_string(fov) + " -o " + dir + "/" + name + ext);
+    EXPECT_EQ(e.exit_code, 0) << e.output;
+    return read_image(dir + "/" + name + ext);
+  };
+  const Image key0 = explicit_render(eye0, 70.0f, "key0"), key1 = explicit_render(eye1, 55.0f, "key1");
+  const Image first = read_image(dir + "/frames/frame_00000" + ext), last = read_image(dir + "/frames/frame_00004" + ext);
+  const Image middle = read_image(dir + "/frames/frame_00002" + ext);
+  ASSERT_EQ(first.width, 160);
+  EXPECT_GE(compare_images(first, key0).psnr_db, 40.0);
+  EXPECT_GE(compare_images(last, key1).psnr_db, 40.0);
+  EXPECT_LT(compare_images(middle, key0).psnr_db, 30.0) << "the middle frame is not between the keys";
+  EXPECT_LT(compare_images(middle, key1).psnr_db, 30.0) << "the middle frame is not between the keys";
+  EXPECT_FALSE(fs::exists(dir + "/frames/frame_00005" + ext));
+  // A bad path file: one line naming it, nothing rendered.
+  std::ofstream(dir + "/bad.json") << R"({"format": "flashgs camera path", "version": 1, "fps": 30, "keyframes": []})";
+  const CliResult bad = run_cli("render " + demo_scene_path() + " --backend cpu --path " + dir + "/bad.json -o " + dir + "/none");
+  expect_one_line_error(bad, dir + "/bad.json: \"keyframes\" is empty", "empty path");
+  EXPECT_FALSE(fs::exists(dir + "/none/frame_00000" + ext));
 }
 
 // `bench --tile N` renders N copies of the scene (scale runs), reports the upload and the

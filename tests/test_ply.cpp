@@ -391,6 +391,26 @@ TEST(PlyMalformed, CountLargerThanData) {
   expect_error(b.bytes(), "truncated");
 }
 
+// The size the header asks for reads as a size ("2.7 MB", "2728 bytes"), not "0.002728 MB"
+// or "82.000000 MB".
+TEST(PlyMalformed, TheMissingSizeReadsAsAByteCount) {
+  PlyBuilder small = PlyBuilder::inria(0, 10);
+  small.declared_count = 11;
+  PlyBuilder large = PlyBuilder::inria(0, 2);
+  large.declared_count = 4000000;
+  for (const PlyBuilder* b : {&small, &large}) {
+    try {
+      parse(b->bytes());
+      ADD_FAILURE() << "a truncated file was read";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.find(".000000"), std::string::npos) << message;
+      EXPECT_NE(message.find(b == &small ? " bytes) but the file holds only" : " MB) but the file holds only"),
+                std::string::npos) << message;
+    }
+  }
+}
+
 TEST(PlyMalformed, CountSmallerThanData) {
   PlyBuilder b = PlyBuilder::inria(0, 10);
   b.declared_count = 9;

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <sys/stat.h>
@@ -17,6 +19,8 @@
 #include "flashgs/image_io.h"
 #include "flashgs/frame_memory.h"
 #include "flashgs/lod_build.h"
+#include "flashgs/generators.h"
+#include "flashgs/keyframe_path.h"
 #include "heatmap_legend.h"
 #include "camera_controller.h"
 #include "memory_budget.h"
@@ -354,6 +358,39 @@ TEST(Viewer, WindowResizeRecreatesTheFrame) {
   EXPECT_GE(d.psnr_db, 40.0);
 }
 
+// Made smaller, the window keeps its panels inside it: the statistics window, placed at the
+// right edge of a 1280-point window, comes back inside a 1024x600 one.
+TEST(Viewer, PanelsStayInsideTheWindowAfterAResize) {
+  REQUIRE_DISPLAY(prefix);
+  const RunResult r = run(prefix + viewer() + " --backend cpu --size 1280x800 --frames 6 --log-input "
+                          "--keys \"WAIT:0.05,RESIZE:1024:600,WAIT:0.1\" --exit");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const std::string name : {"Statistics corner", "panel corner"}) {
+    const std::string key = "widget \"" + name + "\" at ";
+    const auto at = r.output.rfind(key);
+    ASSERT_NE(at, std::string::npos) << name << "\n" << r.output;
+    int x = 0, y = 0;
+    ASSERT_EQ(std::sscanf(r.output.c_str() + at + key.size(), "%d,%d", &x, &y), 2) << r.output;
+    EXPECT_LE(x, 1024) << name;
+    EXPECT_LE(y, 600) << name;
+  }
+}
+
+// The first frame of a new scene is a coarse one, then the full frame follows (a large scene's
+// full frame takes seconds: the window showed "no frame yet" all that time).
+TEST(Viewer, TheFirstFrameOfASceneIsCoarseThenFull) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string steps = "wait_for \"first frame shown\" || status=10\n"
+                            "[ $status -eq 0 ] && { close_window || status=12; }\n";
+  const RunResult r = run_live_viewer(prefix, "coarse_first", "--backend cpu --size 1280x800 --log-input", steps, 11);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code << " (10 no full frame, 11 crash, 12 close)\n" << r.output;
+  const auto first = r.output.find("frame shown ");
+  ASSERT_NE(first, std::string::npos) << r.output;
+  const std::string line = r.output.substr(first, r.output.find('\n', first) - first);
+  EXPECT_NE(line.find("(reduced)"), std::string::npos) << line;
+  EXPECT_NE(r.output.find("(full)", first), std::string::npos) << r.output;
+}
+
 TEST(Viewer, FailedLoadKeepsTheCurrentScene) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir();
@@ -481,7 +518,7 @@ TEST(Viewer, MouseClickOnAPanelButtonWorks) {
   REQUIRE_DISPLAY(prefix);
   if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
-                            "[ $status -eq 0 ] && { click \"Compare this view (C)\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { click \"tab Compare\" && click \"Compare this view (C)\" || status=11; }\n"
                             "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=12; }\n";
   // The default window height (800): at 720 the Compare button sits below the panels' fold.
   const RunResult r = run_live_viewer(prefix, "click", "--backend cpu --size 1280x800 --log-input", steps, 13);
@@ -605,15 +642,25 @@ TEST(Viewer, ClickingAFrustumJumpsToThatCamera) {
   fv::CameraController controller;
   controller.snap_to(scene.cameras[0]);
   const flashgs::Camera view = controller.render_camera(1280, 720, 150.0f);
-  const auto centres = fv::project_segments(fv::camera_frustums(scene.cameras, 0.1f, -1), view, 1e-3f);
+  // A click on a frustum's body, well away from its centre (before, only a click within 14 px
+  // of the centre picked a camera); the frustums as the viewer draws them.
+  const float depth = 0.08f * scene.extent;
+  const auto segments = fv::project_segments(fv::camera_frustums(scene.cameras, depth, -1), view, 1e-3f);
+  ASSERT_EQ(segments.size(), scene.cameras.size() * 10) << "every frustum in front of the start view";
   int target = -1, x = 0, y = 0;
   for (std::size_t k = 1; k < scene.cameras.size() && target < 0; ++k) {
-    const fv::ScreenSegment& s = centres[k * 10];  // each frustum's first segment starts at its centre
-    if (s.x0 > 60 && s.x0 < 1220 && s.y0 > 60 && s.y0 < 660 &&
-        fv::pick_camera(scene.cameras, view, s.x0, s.y0, 14.0f) == int(k)) {
+    const fv::ScreenSegment* f = &segments[k * 10];  // segments 0, 2, 4, 6: centre to each image corner
+    float cx = 0, cy = 0;
+    for (int j = 0; j < 4; ++j) cx += 0.25f * f[2 * j].x1, cy += 0.25f * f[2 * j].y1;
+    const float px = f[0].x0 + 0.7f * (cx - f[0].x0), py = f[0].y0 + 0.7f * (cy - f[0].y0);
+    bool far_from_centres = true;
+    for (std::size_t i = 0; i < scene.cameras.size(); ++i)
+      far_from_centres = far_from_centres && std::hypot(segments[i * 10].x0 - px, segments[i * 10].y0 - py) > 20.0f;
+    if (far_from_centres && px > 60 && px < 1220 && py > 60 && py < 660 &&
+        fv::pick_camera(scene.cameras, view, px, py, 8.0f, depth) == int(k)) {
       target = int(k);
-      x = int(std::lround(s.x0));
-      y = int(std::lround(s.y0));
+      x = int(std::lround(px));
+      y = int(std::lround(py));
     }
   }
   ASSERT_GE(target, 0) << "no camera in the start view";
@@ -672,7 +719,10 @@ TEST(Viewer, F1ShowsHelpTabHidesThePanelsAndEscQuits) {
   // GLFW key codes: F1 290, Tab 258, Escape 256.
   const std::string steps = "wait_for \"UI ready\" || status=10\n"
                             "[ $status -eq 0 ] && { hold F1 \" key290 \" && wait_for \"help shown (F1)\" || status=11; }\n"
+                            // The status line stays with the panels hidden: it is drawn (its place logged) after Tab.
+                            "lines=$(grep -c 'widget \"status line\" at' \"$log\")\n"
                             "[ $status -eq 0 ] && { hold Tab \" key258 \" && wait_for \"panels hidden (Tab)\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { wait_count 'widget \"status line\" at' $((lines + 1)) || status=18; }\n"
                             "[ $status -eq 0 ] && { hold Escape \" key256 \" && wait_for \"press Esc again to quit\" || status=16; }\n"
                             "[ $status -eq 0 ] && { kill -0 $pid 2>/dev/null || status=17; }\n"
                             "[ $status -eq 0 ] && { \"$input\" down Escape; \"$input\" up Escape; "
@@ -682,10 +732,122 @@ TEST(Viewer, F1ShowsHelpTabHidesThePanelsAndEscQuits) {
   const RunResult r = run_live_viewer(prefix, "help_keys", "--backend cpu --size 800x450 --log-input", steps, 13);
   EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
                             << " failed (10 start, 11 no help, 12 panels not hidden, 13 crash, 14 exit status, 15 the second "
-                               "Esc did not quit, 16 the first Esc did not ask, 17 the first Esc quit)\n"
+                               "Esc did not quit, 16 the first Esc did not ask, 17 the first Esc quit, 18 no status line "
+                               "with the panels hidden)\n"
                             << r.output;
   EXPECT_NE(r.output.find("quit (Esc / Ctrl+Q)"), std::string::npos) << r.output;
 #endif
+}
+
+// A path typed into the scene field and sent with Enter that fails to open: the typing goes
+// on in the field, so a letter typed next is text, not a shortcut that the settings keep (B
+// used to switch to the baseline and leave it in settings.ini).
+TEST(Viewer, TypingOnAfterAFailedOpenStaysInThePathField) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string config = out_dir() + "/typing_config";
+  std::filesystem::remove_all(config);
+  // GLFW key code: B 66.
+  const std::string steps =
+      "wait_for \"UI ready\" || status=10\n"
+      // Each key held across two frames (GLFW key codes: letters their capitals' ASCII, Enter 257).
+      "[ $status -eq 0 ] && { click \"path field\" || status=11; }\n"
+      "for c in n o p e; do [ $status -eq 0 ] && { hold $c \" key$(printf '%d' \"'${c^^}\") \" || status=11; }; done\n"
+      "[ $status -eq 0 ] && { hold Return \" key257 \" || status=11; }\n"
+      // (A key held across slow frames may repeat: "nopppe" is as good a wrong path.)
+      "[ $status -eq 0 ] && { wait_for \"load failed, scene kept: no\" || status=12; }\n"
+      "[ $status -eq 0 ] && { hold b \" key66 \" || status=13; }\n"
+      "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "typing_on", "--backend cpu --size 1280x800 --log-input", steps, 14, "", config);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 typing, 12 the open did not fail, 13 B, 14 crash, 15 close)\n"
+                            << r.output;
+  EXPECT_EQ(r.output.find("options: baseline"), std::string::npos) << "B reached the shortcuts\n" << r.output;
+  std::ifstream settings(config + "/flashgs/settings.ini");
+  const std::string saved((std::istreambuf_iterator<char>(settings)), std::istreambuf_iterator<char>());
+  EXPECT_NE(saved.find("algorithm"), std::string::npos) << "no settings saved\n" << saved;
+  EXPECT_EQ(saved.find("baseline"), std::string::npos) << saved;
+#endif
+}
+
+// Authoring a camera path with real keys: I on camera 1, N, I on camera 2, Ctrl+S saves the
+// path; `flashgs render --path` of the saved file renders, at the keys' times, the cameras'
+// own views (`flashgs render -c`).
+TEST(Viewer, KeysAddedFromTheViewAreSavedAndRenderAsTheCameras) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string dir = out_dir() + "/keys_authored";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string file = dir + "/path.json";
+  // GLFW key codes: I 73, N 78, S 83.
+  const std::string steps =
+      "wait_for \"UI ready\" || status=10\n"
+      "[ $status -eq 0 ] && { hold i \" key73 \" && wait_for \"key 0 added from the view\" || status=11; }\n"
+      "[ $status -eq 0 ] && { hold n \" key78 \" && hold i \" key73 \" && wait_for \"key 1 added from the view\" || status=12; }\n"
+      "[ $status -eq 0 ] && { \"$input\" down Control_L; hold s \" key83 \"; \"$input\" up Control_L; "
+      "wait_for \"camera path saved to\" || status=13; }\n"
+      "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "keys_authored",
+                                      "--backend cpu --size 1280x720 --camera 1 --log-input --camera-path \"" + file + "\"",
+                                      steps, 14);
+  ASSERT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 first key, 12 second key, 13 save, 14 crash, 15 close)\n"
+                            << r.output;
+  const std::string ext = kExt;
+  const RunResult path = run(cli() + " render --backend cpu --path \"" + file + "\" -r 320x180 --fps 1 -o " + dir + "/frames");
+  ASSERT_EQ(path.exit_code, 0) << path.output;
+  EXPECT_NE(path.output.find("2 keyframes, 2.00 s at 1 fps: 3 frames at 320x180"), std::string::npos) << path.output;
+  for (int key : {0, 1}) {
+    const std::string ref = dir + "/camera" + std::to_string(key + 1) + ext;
+    const RunResult c = run(cli() + " render --backend cpu -c " + std::to_string(key + 1) + " -r 320x180 -o " + ref);
+    ASSERT_EQ(c.exit_code, 0) << c.output;
+    const flashgs::Image a = flashgs::read_image(dir + "/frames/frame_0000" + std::to_string(2 * key) + ext);
+    const flashgs::Image b = flashgs::read_image(ref);
+    const double psnr = flashgs::compare_images(a, b).psnr_db;
+    std::printf("key %d vs camera %d: PSNR %.2f dB\n", key, key + 1, psnr);
+    EXPECT_GE(psnr, 40.0) << "key " << key;
+  }
+#endif
+}
+
+// A loaded keyed path renders from the viewer (--export-path) exactly as `flashgs render
+// --path` renders it.
+TEST(Viewer, TheViewerRendersAKeyedPathAsTheCliDoes) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir() + "/keys_render";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string file = dir + "/path.json";
+  const float up[3] = {0, 1, 0}, target[3] = {0, 0, 0}, eye0[3] = {3.2f, 2.1f, 0}, eye1[3] = {0.3f, 1.5f, 3.0f};
+  flashgs::KeyframePath keys;
+  keys.keys = {flashgs::Keyframe::from_camera(flashgs::look_at_camera(eye0, target, up, 192, 108, 60.0f), 0.0),
+               flashgs::Keyframe::from_camera(flashgs::look_at_camera(eye1, target, up, 192, 108, 45.0f), 1.5)};
+  keys.fps = 2;
+  keys.width = 192;
+  keys.height = 108;
+  flashgs::write_camera_path(keys, file);
+  const RunResult v = run(prefix + "env PATH=/usr/bin:/bin " + viewer() + " --backend cpu --size 320x180 --frames 1 --camera-path " +
+                          file + " --export-path " + dir + "/viewer --exit");
+  ASSERT_EQ(v.exit_code, 0) << v.output;
+  EXPECT_NE(v.output.find("camera path loaded from " + file + ": 2 keys, 1.50 s, 192x108 at 2 fps"), std::string::npos)
+      << v.output;
+  const RunResult c = run(cli() + " render --backend cpu --path " + file + " -o " + dir + "/cli");
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  for (int i = 0; i < 4; ++i) {
+    const std::string name = "/frame_0000" + std::to_string(i) + kExt;
+    ASSERT_TRUE(std::filesystem::exists(dir + "/viewer" + name)) << name << "\n" << v.output;
+    const flashgs::Image a = flashgs::read_image(dir + "/viewer" + name), b = flashgs::read_image(dir + "/cli" + name);
+    EXPECT_EQ(a.width, 192);
+    EXPECT_GE(flashgs::compare_images(a, b).psnr_db, 60.0) << name;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/viewer/frame_00004" + kExt));
 }
 
 // Esc with a combo's list open closes the list, and neither quits nor asks to quit.
@@ -869,6 +1031,22 @@ TEST(Viewer, ScreenshotsIncludeTheHeatMapWhenAsked) {
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(on.pixel(320, 231)[c], want[c], 3.0f / 255.0f) << c;
   }
+  // Its tick values and caption too (white text above and below the bar; the screenshot had
+  // the bar alone): the ramp and the picture hold no white there.
+  std::size_t white_below = 0, white_above = 0, white_plain = 0;
+  for (int x = 170; x < 472; ++x) {
+    for (int y = 239; y < 256; ++y) {
+      white_below += on.pixel(x, y)[0] > 0.9f && on.pixel(x, y)[1] > 0.9f && on.pixel(x, y)[2] > 0.9f;
+      white_plain += off.pixel(x, y)[0] > 0.9f && off.pixel(x, y)[1] > 0.9f && off.pixel(x, y)[2] > 0.9f;
+    }
+    for (int y = 208; y < 222; ++y)
+      white_above += on.pixel(x, y)[0] > 0.9f && on.pixel(x, y)[1] > 0.9f && on.pixel(x, y)[2] > 0.9f;
+  }
+  std::printf("legend text in the screenshot: %zu white pixels below the bar, %zu above (%zu without the overlay)\n",
+              white_below, white_above, white_plain);
+  EXPECT_GT(white_below, 20u) << "no tick values";
+  EXPECT_GT(white_above, 40u) << "no caption";
+  EXPECT_EQ(white_plain, 0u) << "white there without the overlay: the checks above prove nothing";
 }
 
 // The split view: left of the divider the baseline's render, right of it the current
@@ -1351,7 +1529,7 @@ TEST(Viewer, TheUiAnswersWhileAComparisonRendersOnTheCpu) {
       "[ $status -eq 0 ] && { hold c \" key67 \" || status=11; }\n"
       "[ $status -eq 0 ] && { wait_for \"comparing flash vs baseline at 2048x1200 in the background\" || status=12; }\n"
       "[ $status -eq 0 ] && { hold c \" key67 \" && wait_for \"this request is ignored\" || status=13; }\n"
-      "[ $status -eq 0 ] && { click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=14; }\n"
+      "[ $status -eq 0 ] && { click \"tab Rendering\" && click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=14; }\n"
       "open_gate\n"
       "[ $status -eq 0 ] && { wait_for \"compare flash vs baseline\" || status=15; }\n"
       "[ $status -eq 0 ] && { close_window || status=17; }\n";
@@ -1430,10 +1608,10 @@ TEST(Viewer, TheUiAnswersWhileThePathExportsOnTheCpu) {
   // 1024x1000: the export row is on screen below the open sections.
   const std::string steps =
       "wait_for \"UI ready\" || status=10\n"
-      "[ $status -eq 0 ] && { click \"export folder\" && \"$input\" type exportwhilelive || status=11; }\n"
+      "[ $status -eq 0 ] && { click \"tab Overlay & output\" && click \"export folder\" && \"$input\" type exportwhilelive || status=11; }\n"
       "close_gate\n"
       "[ $status -eq 0 ] && { click \"Export path\" && wait_for \"path export: 3 frames into\" || status=12; }\n"
-      "[ $status -eq 0 ] && { click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
+      "[ $status -eq 0 ] && { click \"tab Rendering\" && click \"Tight box\" && wait_for \"options: flash-no_tight_bbox\" || status=13; }\n"
       "open_gate\n"
       "[ $status -eq 0 ] && { wait_for \"path export: 3 frames in \" || status=14; }\n"
       "[ $status -eq 0 ] && { close_window || status=16; }\n";

@@ -16,6 +16,9 @@
 #include "camera_controller.h"
 #include "camera_path.h"
 #include "compare_mode.h"
+#include "folder_listing.h"
+#include "path_editor.h"
+#include "process_clock.h"
 #include "file_dialog.h"
 #include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
@@ -673,10 +676,15 @@ TEST(ViewerHeatmap, TheLockKeepsTheMaximumAcrossConfigurations) {
   fv::HeatScale scale;
   EXPECT_EQ(scale.update(1771, false), 1771u);
   EXPECT_EQ(scale.update(900, false), 900u);
-  EXPECT_EQ(scale.update(1771, true), 1771u);  // locking takes this frame's maximum...
-  EXPECT_EQ(scale.update(600, true), 1771u);   // ...and keeps it
-  EXPECT_EQ(scale.update(2500, true), 1771u);
+  // Ticked while 900 is shown, the next frame (another configuration's) at 1771: the lock
+  // keeps the maximum the user saw.
+  EXPECT_EQ(scale.update(1771, true), 900u);
+  EXPECT_EQ(scale.update(600, true), 900u);
+  EXPECT_EQ(scale.update(2500, true), 900u);
   EXPECT_EQ(scale.update(600, false), 600u);   // unlocked: follows the frame again
+  fv::HeatScale locked_from_start;             // locked before any frame: the first one's
+  EXPECT_EQ(locked_from_start.update(1234, true), 1234u);
+  EXPECT_EQ(locked_from_start.update(99, true), 1234u);
 }
 
 TEST(ViewerHeatmap, TheRampIsViridisLikeAndMonotoneInLightness) {
@@ -749,6 +757,24 @@ TEST(ViewerCompare, AnyTwoConfigurationsAndTheSameOneTwiceIsRefused) {
   EXPECT_EQ(fv::same_configuration_problem(base, o), "");
 }
 
+// The panel lists configurations by name, not by label() token, and only those the backend
+// draws differently from flash: a GPU-only switch turned off renders flash on the CPU.
+TEST(ViewerCompare, ChoicesAreNamedForPeopleAndGpuOnlyOnesAreNotOfferedOnTheCpu) {
+  const int no_tight = fv::compare_choice_from_name("flash-no_tight_bbox");
+  const int no_warp = fv::compare_choice_from_name("flash-no_warp_emit");
+  ASSERT_GT(no_warp, 2);
+  EXPECT_EQ(fv::compare_choice_title(no_tight), "flash without Tight box");
+  EXPECT_EQ(fv::compare_choice_title(fv::kCompareBaseline), "baseline");
+  EXPECT_TRUE(fv::compare_choice_offered(no_tight, flashgs::Backend::cpu));
+  EXPECT_FALSE(fv::compare_choice_offered(no_warp, flashgs::Backend::cpu));
+  EXPECT_TRUE(fv::compare_choice_offered(no_warp, flashgs::Backend::cuda));
+  const flashgs::RenderOptions current;
+  const std::string problem = fv::compare_sides_problem(fv::kCompareBaseline, no_warp, current, flashgs::Backend::cpu);
+  EXPECT_NE(problem.find("flash without Warp emit renders as flash here (the CPU backend has no warps)"),
+            std::string::npos) << problem;
+  EXPECT_EQ(fv::compare_sides_problem(fv::kCompareBaseline, no_warp, current, flashgs::Backend::cuda), "");
+}
+
 TEST(ViewerScreenshots, NamesAreTimestampedAndNeverReused) {
   const std::string dir = scratch_dir("viewer_shots");
   const std::time_t t = 1764612345;
@@ -809,9 +835,13 @@ TEST(ViewerGuides, FrustumsProjectWhereTheCamerasAreAndAClickPicksOne) {
   // The first segment of camera k starts at its centre: clicking there picks k.
   for (int k : {0, 3, 5}) {
     const fv::ScreenSegment& s = segments[std::size_t(k) * 10];
-    EXPECT_EQ(fv::pick_camera(cameras, view, s.x0 + 2.0f, s.y0 - 2.0f, 14.0f), k);
+    EXPECT_EQ(fv::pick_camera(cameras, view, s.x0 + 2.0f, s.y0 - 2.0f, 14.0f, 0.1f), k);
   }
-  EXPECT_EQ(fv::pick_camera(cameras, view, -500.0f, -500.0f, 14.0f), -1);
+  EXPECT_EQ(fv::pick_camera(cameras, view, -500.0f, -500.0f, 14.0f, 0.1f), -1);
+  // Inside a frustum's body, far from its centre and its edges, picks it too.
+  const fv::ScreenSegment* f = &segments[3 * 10];
+  const float cx = 0.25f * (f[0].x1 + f[2].x1 + f[4].x1 + f[6].x1), cy = 0.25f * (f[0].y1 + f[2].y1 + f[4].y1 + f[6].y1);
+  EXPECT_EQ(fv::pick_camera(cameras, view, cx, cy, 1.0f, 0.1f), 3);
   // Segments crossing behind the view are cut at the near plane, never mirrored.
   const fv::WorldSegment through{view_point(view, 0, 0, 1), view_point(view, 0, 0, -1), {1, 1, 1, 1}};
   const auto cut = fv::project_segments({through}, view, 0.01f);
@@ -824,6 +854,145 @@ TEST(ViewerGuides, FrustumsProjectWhereTheCamerasAreAndAClickPicksOne) {
       EXPECT_NEAR(g.a.y, 0.0f, 1e-5f) << "grid lines lie in the ground plane";
     }
   }
+}
+
+// The centres view: a dot at each Gaussian's projected centre, in its base colour; those
+// behind the view or outside the image are left out, and a cap thins a large scene evenly.
+TEST(ViewerGuides, CentresAreDotsWhereTheGaussiansProject) {
+  flashgs::Scene scene;
+  const float positions[] = {0, 0, 5, 1, 0, 5, 0, 0, -5, 100, 0, 5};  // the third behind, the fourth off-image
+  scene.positions.assign(std::begin(positions), std::end(positions));
+  scene.sh_dc = {1.0f, 0, -1.0f, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  scene.opacities = {1, 1, 1, 1};
+  const float eye[3] = {0, 0, 0}, target[3] = {0, 0, 1}, up[3] = {0, -1, 0};
+  const flashgs::Camera view = flashgs::look_at_camera(eye, target, up, 200, 100, 90.0f);
+  const auto dots = fv::centre_marks(scene, view, 100);
+  ASSERT_EQ(dots.size(), 2u);
+  EXPECT_NEAR(0.5f * (dots[0].x0 + dots[0].x1), view.cx, 1e-3f);
+  EXPECT_NEAR(dots[0].y0, view.cy, 1e-3f);
+  EXPECT_NEAR(dots[0].rgba[0], 0.5f + 0.2820948f, 1e-5f);
+  EXPECT_NEAR(dots[0].rgba[2], 0.5f - 0.2820948f, 1e-5f);
+  EXPECT_NEAR(std::abs(0.5f * (dots[1].x0 + dots[1].x1) - view.cx), 0.2f * view.fx, 1e-2f);
+  EXPECT_EQ(fv::centre_marks(scene, view, 2).size(), 1u) << "every second Gaussian: the first and the third";
+}
+
+// After N or a snap in a window of another shape than the camera's images (16:10 vs 16:9),
+// the view is on the camera's pose and FOV: the panel says so (it said "free view").
+TEST(ViewerGuides, TheViewPanelNamesTheCameraWhoseShapeDiffersFromTheWindow) {
+  const auto cameras = orbit(4);
+  fv::CameraController c;
+  EXPECT_EQ(c.view_description(-1, 1280, 800, 60.0f), "free view");
+  c.snap_to(cameras[2]);
+  const float fov = cameras[2].horizontal_fov_degrees();
+  EXPECT_EQ(c.view_description(2, 1280, 720, fov), "on camera 2 (exact)");
+  EXPECT_EQ(c.view_description(2, 1280, 800, fov), "on camera 2: pose, window 1.60:1 vs 1.78:1");
+  EXPECT_EQ(c.view_description(2, 0, 0, fov), "on camera 2");
+  fv::NavigationInput forward;
+  forward.forward = true;
+  fv::ViewerSettings s;
+  c.update(forward, 0.5f, s);
+  EXPECT_EQ(c.view_description(2, 1280, 800, fov), "free view (last camera 2)");
+}
+
+// Keys from the view: added 2 s apart, replaced, retimed (kept in order, the selection
+// following), deleted; saved and loaded back; the preview plays from the first key to the last.
+TEST(ViewerKeyframes, KeysAreAddedReplacedRetimedDeletedAndSaved) {
+  const auto cameras = orbit(4);
+  fv::PathEditor e;
+  e.add(cameras[0]);
+  e.add(cameras[1]);
+  e.add(cameras[2]);
+  ASSERT_EQ(e.path().keys.size(), 3u);
+  EXPECT_EQ(e.selected(), 2);
+  EXPECT_DOUBLE_EQ(e.path().keys[2].time_s, 4.0);
+  EXPECT_FLOAT_EQ(e.path().keys[1].position[0], cameras[1].position[0]);
+  e.select(1);
+  e.replace_selected(cameras[3]);
+  EXPECT_FLOAT_EQ(e.path().keys[1].position[0], cameras[3].position[0]);
+  EXPECT_DOUBLE_EQ(e.path().keys[1].time_s, 2.0) << "a replaced key keeps its time";
+  e.set_time(1, 5.0);  // after key 2 now
+  EXPECT_EQ(e.selected(), 2);
+  EXPECT_FLOAT_EQ(e.path().keys[2].position[0], cameras[3].position[0]);
+  EXPECT_DOUBLE_EQ(e.path().duration_s(), 5.0);
+  e.set_duration(10.0);
+  EXPECT_DOUBLE_EQ(e.path().keys[1].time_s, 8.0);
+  e.delete_selected();
+  ASSERT_EQ(e.path().keys.size(), 2u);
+  EXPECT_EQ(e.selected(), 1);
+  const std::string dir = scratch_dir("keyframes");
+  EXPECT_EQ(e.save(dir + "/p.json"), "");
+  fv::PathEditor f;
+  EXPECT_EQ(f.load(dir + "/p.json"), "");
+  ASSERT_EQ(f.path().keys.size(), 2u);
+  EXPECT_DOUBLE_EQ(f.path().keys[1].time_s, 8.0);
+  EXPECT_NE(f.load(dir + "/absent.json").find("camera path not loaded: " + dir + "/absent.json"), std::string::npos);
+  EXPECT_EQ(f.path().keys.size(), 2u) << "a failed load keeps the path";
+  EXPECT_NE(fv::PathEditor().save(dir + "/empty.json").find("no keyframes"), std::string::npos);
+  // The preview: from key 0 to the last, then it stops on the last key.
+  f.start_preview();
+  ASSERT_TRUE(f.previewing());
+  flashgs::Camera c = f.preview_step(0.0, 160, 90);
+  EXPECT_NEAR(c.position[0], cameras[0].position[0], 1e-5f);
+  for (int i = 0; i < 100 && f.previewing(); ++i) c = f.preview_step(0.1, 160, 90);
+  EXPECT_FALSE(f.previewing());
+  EXPECT_NEAR(c.position[0], cameras[2].position[0], 1e-5f);
+}
+
+// The load's bar covers reading and decoding: all bytes read with a tenth of the Gaussians
+// decoded is not a full bar (it was: the bytes alone filled it).
+TEST(ViewerLoad, TheProgressBarCoversReadingAndDecoding) {
+  EXPECT_FLOAT_EQ(fv::load_fraction(574, 574, 35, 350), 0.55f);
+  EXPECT_FLOAT_EQ(fv::load_fraction(287, 574, 0, 350), 0.25f);
+  EXPECT_FLOAT_EQ(fv::load_fraction(574, 574, 350, 350), 1.0f);
+  EXPECT_FLOAT_EQ(fv::load_fraction(100, 400, 0, 0), 0.25f);  // a reader that reports bytes only
+  EXPECT_FLOAT_EQ(fv::load_fraction(0, 0, 30, 60), 0.5f);     // ...or Gaussians only
+  EXPECT_FLOAT_EQ(fv::load_fraction(0, 0, 0, 0), -1.0f);
+}
+
+// Start-up is measured from exec: this test process started before the test ran, and not an
+// hour ago (a wrong field of /proc/self/stat reads as years or as a negative age).
+TEST(ViewerStartup, TheProcessAgeCountsFromExec) {
+  const double age = fv::ms_since_process_start();
+  EXPECT_GE(age, 0.0);
+  EXPECT_LT(age, 3.6e6);
+}
+
+// The in-app browser lists every format the viewer reads (it listed *.ply only) and the
+// folders that are a scene, with a training output's iterations; other files are left out.
+TEST(ViewerFiles, TheBrowserListsEveryFormatAndSceneFoldersSorted) {
+  namespace fs = std::filesystem;
+  const std::string dir = scratch_dir("browser_listing");
+  std::ofstream(dir + "/b.ply") << std::string(300, 'x');
+  std::ofstream(dir + "/a.spz") << std::string(100, 'x');
+  std::ofstream(dir + "/c.SPLAT") << std::string(200, 'x');
+  std::ofstream(dir + "/notes.txt") << "x";
+  std::ofstream(dir + "/.hidden.ply") << "x";
+  fs::create_directories(dir + "/sog");
+  std::ofstream(dir + "/sog/meta.json") << "{}";
+  fs::create_directories(dir + "/plain");
+  for (const char* it : {"iteration_7000", "iteration_30000", "iteration_x"}) {
+    fs::create_directories(dir + "/train/point_cloud/" + it);
+    std::ofstream(dir + "/train/point_cloud/" + it + "/point_cloud.ply") << "x";
+  }
+  std::string error;
+  const auto by_name = fv::list_folder(dir, fv::FolderSort::name, &error);
+  EXPECT_EQ(error, "");
+  std::vector<std::string> names;
+  for (const auto& e : by_name) names.push_back(e.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"plain", "sog", "train", "a.spz", "b.ply", "c.SPLAT"}));
+  EXPECT_EQ(by_name[0].kind, fv::FolderEntry::Kind::folder);
+  EXPECT_EQ(by_name[1].kind, fv::FolderEntry::Kind::scene_folder);
+  ASSERT_EQ(by_name[2].iterations.size(), 2u);
+  EXPECT_EQ(by_name[2].iterations[0].first, 30000);
+  EXPECT_EQ(by_name[2].iterations[1].second, dir + "/train/point_cloud/iteration_7000/point_cloud.ply");
+  EXPECT_EQ(by_name[4].bytes, 300u);
+  const auto by_size = fv::list_folder(dir, fv::FolderSort::size, &error);
+  EXPECT_EQ(by_size[3].name, "b.ply");
+  EXPECT_EQ(by_size[5].name, "a.spz");
+  EXPECT_TRUE(fv::is_scene_file_name("lod-meta.json"));
+  EXPECT_FALSE(fv::is_scene_file_name("cameras.json"));
+  EXPECT_TRUE(fv::list_folder(dir + "/absent", fv::FolderSort::name, &error).empty());
+  EXPECT_NE(error.find(dir + "/absent: "), std::string::npos) << error;
 }
 
 TEST(ViewerFiles, TheDesktopDialogsAnswerIsTheChosenPath) {

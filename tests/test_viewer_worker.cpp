@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <condition_variable>
 #include <atomic>
+#include <functional>
 #include <future>
 #include <mutex>
 #include <thread>
@@ -92,15 +93,40 @@ class WorkerPath final : public fv::FramePath {
   bool m_background;
 };
 
-// Baseline (left) against flash (right) at `width` x 1, each side rendered once.
+// Baseline (left) against flash (right) at `width` x 1, one timed round: kJobRenders renders
+// (each side's warm-up, then each side once).
+constexpr int kJobRenders = 4;
 fv::CompareJob job_of_width(int width) {
   fv::CompareJob job;
   job.camera.width = width;
   job.camera.height = 1;
   job.left = flashgs::RenderOptions::baseline();
-  job.warm_up = false;
+  job.rounds = 1;
   return job;
 }
+
+// A frame path whose renders take no time but report the frame times `ms_of(render index,
+// baseline?)` says, recording which side each render drew.
+class TimedPath final : public fv::FramePath {
+ public:
+  explicit TimedPath(std::function<double(int, bool)> ms_of) : m_ms_of(std::move(ms_of)) {}
+  std::string name() const override { return "timed path"; }
+  void set_scene(std::shared_ptr<const flashgs::Scene>) override {}
+  void attach_textures(const unsigned*, int, int) override {}
+  void release_textures() override {}
+  void render_to_texture(const flashgs::Camera&, const flashgs::RenderOptions&, flashgs::FrameStats*) override {}
+  void render_image(const flashgs::Camera& camera, const flashgs::RenderOptions& options, flashgs::Image& out,
+                    flashgs::FrameStats* stats, const std::atomic<bool>*) override {
+    out.resize(camera.width, camera.height);
+    stats->times.total_ms = m_ms_of(int(sides.size()), options.is_baseline());
+    sides.push_back(options.is_baseline() ? 'B' : 'F');
+  }
+  void tile_counts(const flashgs::FrameStats&, std::vector<std::uint32_t>&) override {}
+  std::string sides;  // "FB..." in render order
+
+ private:
+  std::function<double(int, bool)> m_ms_of;
+};
 
 fv::FrameRequest request_of_width(int width) {
   fv::FrameRequest r;
@@ -313,14 +339,14 @@ TEST(ViewerCompareTask, ItRunsBesideTheCallerAndItsOutcomeIsTakenOnce) {
   auto start = std::async(std::launch::async, [&] { return task.start(path, job_of_width(6)); });
   gated->wait_started(1);
   const bool returned = start.wait_for(std::chrono::seconds(30)) == std::future_status::ready;
-  if (!returned) gated->release(2);  // a start() that waits for the renders: let it end
+  if (!returned) gated->release(kJobRenders);  // a start() that waits for the renders: let it end
   ASSERT_TRUE(returned) << "start() waited for the comparison's renders";
   ASSERT_TRUE(start.get());
   fv::CompareOutcome outcome;
   EXPECT_TRUE(task.busy());
   EXPECT_FALSE(task.take(&outcome)) << "nothing to take while it renders";
   EXPECT_FALSE(task.start(path, job_of_width(6))) << "one comparison at a time";
-  gated->release(2);
+  gated->release(kJobRenders);
   task.wait();
   EXPECT_EQ(wakes.load(), 1);
   ASSERT_TRUE(task.take(&outcome));
@@ -354,7 +380,7 @@ TEST(ViewerCompareTask, CancelStopsTheRenderInFlight) {
   EXPECT_TRUE(outcome.left_rgba.empty());
   EXPECT_EQ(gated->wait_started(1).size(), 1u) << "the second side never started";
   ASSERT_TRUE(task.start(path, job_of_width(5)));
-  gated->release(2);
+  gated->release(kJobRenders);
   task.wait();
   ASSERT_TRUE(task.take(&outcome));
   EXPECT_TRUE(outcome.result.valid) << outcome.result.error;
@@ -363,7 +389,7 @@ TEST(ViewerCompareTask, CancelStopsTheRenderInFlight) {
 // A comparison finished but not yet taken when the scene changes is dropped all the same.
 TEST(ViewerCompareTask, ACancelAfterTheRendersEndedStillDropsTheOutcome) {
   auto owned = std::make_unique<GatedRenderer>(true);
-  owned->release(2);
+  owned->release(kJobRenders);
   WorkerPath path(std::move(owned), true);
   fv::CompareTask task;
   ASSERT_TRUE(task.start(path, job_of_width(4)));
@@ -391,7 +417,7 @@ TEST(ViewerCompareTask, DestroyingItStopsTheComparisonInFlight) {
 // start() returns: one code path, no thread; a failing render is the outcome's error.
 TEST(ViewerCompareTask, OnAPathThatRendersHereItIsDoneWhenStartReturns) {
   auto owned = std::make_unique<GatedRenderer>(true);
-  owned->release(2);
+  owned->release(kJobRenders);
   WorkerPath path(std::move(owned), false);
   fv::CompareTask task;
   ASSERT_TRUE(task.start(path, job_of_width(3)));
@@ -402,6 +428,48 @@ TEST(ViewerCompareTask, OnAPathThatRendersHereItIsDoneWhenStartReturns) {
   ASSERT_TRUE(task.take(&outcome));
   EXPECT_FALSE(outcome.result.valid);
   EXPECT_EQ(outcome.result.error, "width 13 refused");
+}
+
+// The speed-up is a measurement: each side warmed up untimed, then rounds that render both
+// sides in alternating order; the figures are medians with their range, and rounds that
+// disagree on the faster side are called noise. (Before, one cold render per side was timed.)
+TEST(ViewerCompareTiming, WarmedInterleavedRoundsGiveAMedianWithItsSpread) {
+  // Warm-ups (renders 0 and 1) are slow, as a first render at a size is; then the baseline
+  // takes 200 ms and flash 100 ms, except one flash render that the machine slowed to 150 ms.
+  TimedPath path([](int render, bool baseline) {
+    if (render < 2) return 1000.0;
+    if (render == 6) return 150.0;  // round 2's flash render
+    return baseline ? 200.0 : 100.0;
+  });
+  flashgs::Camera camera;
+  camera.width = 4;
+  camera.height = 2;
+  std::vector<int> progress;
+  const fv::CompareResult r = fv::run_compare(path, camera, flashgs::RenderOptions::baseline(), flashgs::RenderOptions{},
+                                              5, nullptr, [&](int done, int total) {
+                                                EXPECT_EQ(total, 12);
+                                                progress.push_back(done);
+                                              });
+  ASSERT_TRUE(r.valid) << r.error;
+  EXPECT_EQ(path.sides, "FB" "FB" "BF" "FB" "BF" "FB") << "warm-up, then alternating order";
+  EXPECT_EQ(progress.size(), 12u);
+  EXPECT_EQ(progress.back(), 12);
+  EXPECT_EQ(r.right_ms.samples, 5);
+  EXPECT_DOUBLE_EQ(r.right_ms.median, 100.0) << "the warm-ups are not timed";
+  EXPECT_DOUBLE_EQ(r.right_ms.max, 150.0);
+  EXPECT_DOUBLE_EQ(r.left_ms.median, 200.0);
+  EXPECT_DOUBLE_EQ(r.speed_up.median, 2.0);
+  EXPECT_NEAR(r.speed_up.min, 200.0 / 150.0, 1e-9);
+  EXPECT_DOUBLE_EQ(r.speed_up.max, 2.0);
+  EXPECT_FALSE(fv::within_noise(r.speed_up));
+  EXPECT_EQ(fv::speed_up_text(r), "speed-up 2.00x (1.33-2.00 over 5 rounds)");
+
+  // Two configurations as fast as each other: the rounds disagree, and the panel says so.
+  TimedPath even([](int render, bool baseline) { return 100.0 + ((render / 2) % 2 == (baseline ? 0 : 1) ? 5.0 : 0.0); });
+  const fv::CompareResult e = fv::run_compare(even, camera, flashgs::RenderOptions::baseline(), flashgs::RenderOptions{}, 4);
+  ASSERT_TRUE(e.valid) << e.error;
+  EXPECT_TRUE(fv::within_noise(e.speed_up)) << fv::speed_up_text(e);
+  EXPECT_NE(fv::speed_up_text(e).find(": within noise"), std::string::npos) << fv::speed_up_text(e);
 }
 
 // A path export's frame job: beside the caller, one at a time, its outcome taken once; the

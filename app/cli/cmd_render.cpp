@@ -1,10 +1,12 @@
-// `flashgs render`: one frame of a scene to an image file, with its statistics.
+// `flashgs render`: one frame of a scene to an image file, with its statistics; or a keyframed camera path's frames.
 #include <cstdio>
 
 #include "backend_factory.h"
 #include "commands.h"
 #include "flashgs/image_io.h"
 #include "flashgs/io.h"
+#include "flashgs/keyframe_path.h"
+#include "flashgs/parse.h"
 #include "flashgs/scene_summary.h"
 #include "option_checks.h"
 #include "scene_source.h"
@@ -19,8 +21,11 @@ struct RenderCommand {
   RenderArgs render;
   std::string output = "render.png";
   int repeat = 1;
+  std::string path_file;  // --path: a camera path's frames into the folder `output`
+  int fps = 0;            // --fps: overrides the path file's
 
   void run() const {
+    if (!path_file.empty()) return run_path();
     check_output_image("--output", output);  // before the render, which may take long
     const std::string scene_path = scene.resolved_scene();
     auto loaded = load_scene_verbose(scene_path, scene.lod, scene.read_options());
@@ -42,6 +47,37 @@ struct RenderCommand {
     std::printf("%s", format_stats(stats).c_str());
     std::printf("wrote %s\n", output.c_str());
   }
+
+  // The path's frames, frame_00000.png on, at the path's size (or --resolution) and fps (or --fps).
+  void run_path() const {
+    KeyframePath path = read_camera_path(path_file);
+    if (fps > 0) path.fps = fps;
+    if (!camera.resolution.empty()) {
+      const Resolution size = parse_resolution(camera.resolution);
+      path.width = size.width;
+      path.height = size.height;
+    }
+    const std::vector<std::string> created = check_output_folder("--output", output);
+    const std::string scene_path = scene.resolved_scene();
+    auto loaded = load_scene_verbose(scene_path, scene.lod);
+    auto renderer = create_backend(render.backend);
+    check_frame_fits(*renderer, path.camera_at(path.frame_time(0), path.width, path.height), loaded->size(), "the path's size");
+    renderer->set_scene(loaded);
+    const RenderOptions options = render.options(*loaded);
+    const int frames = path.frame_count();
+    std::printf("%s: %zu keyframes, %.2f s at %d fps: %d frames at %dx%d, %s on %s\n", path_file.c_str(),
+                path.keys.size(), path.duration_s(), path.fps, frames, path.width, path.height,
+                options.label().c_str(), renderer->name().c_str());
+    Image image;
+    FrameStats stats;
+    for (int i = 0; i < frames; ++i) {
+      renderer->render(path.camera_at(path.frame_time(i), path.width, path.height), options, image, &stats);
+      char name[32];  // PNG where OpenImageIO is built in, else PPM (the same 8-bit bytes)
+      std::snprintf(name, sizeof name, "/frame_%05d%s", i, image_io_has_oiio() ? ".png" : ".ppm");
+      write_image(image, output + name);
+    }
+    std::printf("wrote %d frames to %s\n", frames, output.c_str());
+  }
 };
 
 }  // namespace
@@ -52,10 +88,20 @@ void register_render(CLI::App& app) {
   command->scene.add_to(sub);
   command->camera.add_to(sub);
   command->render.add_to(sub);
-  sub->add_option("--output,-o", command->output, "output image (the extension picks the format)");
+  sub->add_option("--output,-o", command->output,
+                  "output image (the extension picks the format); with --path, the frames' folder");
   sub->add_option("--repeat", command->repeat, "render this many times (statistics of the last)")
       ->check(whole_number())->check(CLI::PositiveNumber);
-  sub->callback([command] { command->run(); });
+  auto* path = sub->add_option("--path", command->path_file,
+                               "render a camera path (the viewer's JSON or nerfstudio's camera_path.json) as "
+                               "frame_00000.png ... into the --output folder");
+  sub->add_option("--fps", command->fps, "with --path: frames per second (default: the path file's)")
+      ->check(whole_number())->check(CLI::Range(1, kMaxPathFps))->needs(path);
+  path->excludes("--camera")->excludes("--eye")->excludes("--repeat");
+  sub->callback([command, sub] {
+    if (!command->path_file.empty() && sub->get_option("--output")->count() == 0) command->output = "path_frames";
+    command->run();
+  });
 }
 
 }  // namespace flashgs::cli

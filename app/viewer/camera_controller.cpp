@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -241,6 +242,19 @@ bool CameraController::exact_scene_camera(int width, int height, float fov_x_deg
   const double aspect_scene = double(m_snapped.width) / m_snapped.height;
   const double aspect_view = double(width) / height;
   return std::abs(aspect_scene / aspect_view - 1.0) < 1e-3;
+}
+
+std::string CameraController::view_description(int index, int width, int height, float fov_x_degrees) const {
+  char text[160];
+  if (index < 0) return "free view";
+  if (!m_snapped_valid) std::snprintf(text, sizeof text, "free view (last camera %d)", index);
+  else if (width <= 0 || height <= 0) std::snprintf(text, sizeof text, "on camera %d", index);  // no frame yet
+  else if (exact_scene_camera(width, height, fov_x_degrees)) std::snprintf(text, sizeof text, "on camera %d (exact)", index);
+  else if (!(std::abs(fov_x_degrees - m_snapped_fov) < 1e-4f)) std::snprintf(text, sizeof text, "on camera %d: pose, other FOV", index);
+  else
+    std::snprintf(text, sizeof text, "on camera %d: pose, window %.2f:1 vs %.2f:1", index, double(width) / height,
+                  double(m_snapped.width) / std::max(m_snapped.height, 1));
+  return text;
 }
 
 Camera CameraController::render_camera(int width, int height, float fov_x_degrees) const {

@@ -1,6 +1,8 @@
 // CameraController: fly and orbit navigation of the viewer camera, frame-rate independent (no GL, no window).
 #pragma once
 
+#include <string>
+
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -60,6 +62,10 @@ class CameraController {
   // Whether render_camera(width, height, fov) is the scene camera itself (same field of view
   // and aspect ratio), not just its pose.
   bool exact_scene_camera(int width, int height, float fov_x_degrees) const;
+  // What the View panel says of the view, one short line: "free view", "on camera 22
+  // (exact)", or, on the camera's pose and FOV in a window of another shape, "on camera 22:
+  // pose, window 1.60:1 vs 1.78:1" (`index` -1: no camera was chosen; width 0: no frame yet).
+  std::string view_description(int index, int width, int height, float fov_x_degrees) const;
 
  private:
   bool apply(const NavigationInput& input, float dt, ViewerSettings& settings);

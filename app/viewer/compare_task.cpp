@@ -17,6 +17,8 @@ bool CompareTask::start(FramePath& path, const CompareJob& job) {
     m_outcome = CompareOutcome{};
     m_started = Clock::now();
   }
+  m_renders_done = 0;
+  m_renders_total = 2 * (job.rounds + 1);
   return m_job.start(path.renders_in_background(), [this, &path, job](const std::atomic<bool>& cancel) {
     run(path, job, cancel);
     return std::string();
@@ -25,7 +27,11 @@ bool CompareTask::start(FramePath& path, const CompareJob& job) {
 
 void CompareTask::run(FramePath& path, const CompareJob& job, const std::atomic<bool>& cancel) {
   CompareOutcome outcome;
-  outcome.result = run_compare(path, job.camera, job.left, job.right, job.warm_up, &cancel);
+  outcome.result = run_compare(path, job.camera, job.left, job.right, job.rounds, &cancel,
+                               [this](int done, int total) {
+                                 m_renders_done = done;
+                                 m_renders_total = total;
+                               });
   if (outcome.result.valid && !cancel) {
     const CompareResult& r = outcome.result;
     to_rgba8(r.left_image, outcome.left_rgba);

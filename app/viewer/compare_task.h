@@ -1,6 +1,7 @@
 // CompareTask: one comparison (compare_mode.h's renders and the difference image) run beside the frame loop, so the window keeps answering while a slow backend renders it.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <mutex>
@@ -15,7 +16,7 @@ namespace flashgs::viewer {
 struct CompareJob {
   Camera camera;
   RenderOptions left, right;
-  bool warm_up = true;  // see run_compare
+  int rounds = kCompareRounds;  // see run_compare
 };
 
 struct CompareOutcome {
@@ -46,6 +47,9 @@ class CompareTask {
   bool busy() const;
   // Seconds since the comparison started (0 when none is busy).
   double elapsed_seconds() const;
+  // Renders done and to do of the comparison that runs (run_compare's progress).
+  int renders_done() const { return m_renders_done.load(); }
+  int renders_total() const { return m_renders_total.load(); }
   // The finished comparison, once; false while it runs or when none was started.
   bool take(CompareOutcome* out);
   // Stops the renders where the path can (the CPU backend between stages and tiles); it then
@@ -61,6 +65,7 @@ class CompareTask {
   mutable std::mutex m_mutex;  // guards the two below
   CompareOutcome m_outcome;
   std::chrono::steady_clock::time_point m_started;
+  std::atomic<int> m_renders_done{0}, m_renders_total{0};
   BackgroundJob m_job;  // last: its destructor stops the thread before the members above go
 };
 

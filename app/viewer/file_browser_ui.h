@@ -1,8 +1,10 @@
-// FileBrowser: the in-app "open a scene" window (ImGui) for desktops without zenity or kdialog: folders to walk, PLY files and 3DGS output folders to open.
+// FileBrowser: the in-app "open a scene" window (ImGui) for desktops without zenity or kdialog: a path field, folders to walk, the scene files and scene folders of every format the viewer reads, sorted, and a training output's iterations.
 #pragma once
 
 #include <string>
 #include <vector>
+
+#include "folder_listing.h"
 
 namespace flashgs::viewer {
 
@@ -19,7 +21,9 @@ class FileBrowser {
   bool m_open = false;
   bool m_just_opened = false;  // takes the focus in its first frame
   std::string m_folder;
-  std::vector<std::string> m_folders, m_files;  // names in m_folder
+  std::string m_typed;         // the path field
+  FolderSort m_sort = FolderSort::name;
+  std::vector<FolderEntry> m_entries;
   std::string m_error;
 };
 

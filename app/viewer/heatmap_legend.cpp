@@ -73,8 +73,8 @@ std::string legend_caption(int tile_size, bool log_scale, bool locked) {
 }
 
 std::uint64_t HeatScale::update(std::uint64_t frame_max, bool locked) {
-  if (!locked || !m_was_locked) m_max = std::max<std::uint64_t>(1, frame_max);
-  m_was_locked = locked;
+  if (!locked || !m_shown) m_max = std::max<std::uint64_t>(1, frame_max);
+  m_shown = true;
   return m_max;
 }
 

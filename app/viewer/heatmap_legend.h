@@ -40,8 +40,8 @@ std::vector<LegendTick> legend_ticks(std::uint64_t max_count, bool log_scale);
 // "pairs per 16x16 tile, log scale (max locked)": what the bar measures and how.
 std::string legend_caption(int tile_size, bool log_scale, bool locked);
 
-// The scale's top: the locked maximum while the lock is on (taken from the first frame after
-// locking), else this frame's.
+// The scale's top: while the lock is on, the maximum on screen when it was ticked (the frame
+// after it may already be another configuration's), else this frame's.
 class HeatScale {
  public:
   std::uint64_t update(std::uint64_t frame_max, bool locked);
@@ -49,7 +49,7 @@ class HeatScale {
 
  private:
   std::uint64_t m_max = 1;
-  bool m_was_locked = false;
+  bool m_shown = false;  // m_max is a frame's (a lock from the start takes the first frame's)
 };
 
 }  // namespace flashgs::viewer

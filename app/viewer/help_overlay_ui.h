@@ -21,6 +21,8 @@ inline constexpr Shortcut kShortcuts[] = {
     {"F", "frame the whole scene"},
     {"N / P", "next / previous training camera"},
     {"Space", "play / stop the path through the cameras"},
+    {"I", "add the view as a key of the camera path"},
+    {"Ctrl+S", "save the camera path (its file in the Camera path section)"},
     {"click a frustum", "jump to that training camera (frustums on)"},
     {"G", "ground grid and axes"},
     {"B", "baseline / flash (all optimisations)"},

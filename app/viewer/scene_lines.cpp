@@ -1,7 +1,10 @@
-// Grid, axes and frustum geometry, near-plane clipping and projection with the view camera.
+// Grid, axes, frustum and centre geometry, near-plane clipping and projection with the view camera.
 #include "scene_lines.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "flashgs/model_constants.h"
 
 namespace flashgs::viewer {
 namespace {
@@ -99,16 +102,78 @@ std::vector<ScreenSegment> project_segments(const std::vector<WorldSegment>& seg
   return out;
 }
 
-int pick_camera(const std::vector<Camera>& cameras, const Camera& view, float x, float y, float radius) {
-  int best = -1;
-  float best_d = radius;
-  for (std::size_t i = 0; i < cameras.size(); ++i) {
-    const glm::vec3 v = to_view(view, glm::vec3(cameras[i].position[0], cameras[i].position[1], cameras[i].position[2]));
+std::vector<ScreenSegment> centre_marks(const Scene& scene, const Camera& view, std::size_t max_marks) {
+  std::vector<ScreenSegment> out;
+  const std::size_t n = scene.size();
+  if (n == 0 || max_marks == 0) return out;
+  const std::size_t stride = (n + max_marks - 1) / max_marks;
+  out.reserve(n / stride + 1);
+  const float sh_c0 = static_cast<float>(model::kShC0);
+  for (std::size_t i = 0; i < n; i += stride) {
+    const glm::vec3 v = to_view(view, glm::vec3(scene.positions[3 * i], scene.positions[3 * i + 1], scene.positions[3 * i + 2]));
     if (v.z <= 0.0f) continue;
     const glm::vec2 p = to_pixels(view, v);
-    const float d = std::hypot(p.x - x, p.y - y);
-    if (d <= best_d) {
-      best_d = d;
+    if (!(p.x >= 0 && p.y >= 0 && p.x < float(view.width) && p.y < float(view.height))) continue;
+    std::array<float, 4> rgba{1, 1, 1, 1};
+    for (int c = 0; c < 3; ++c) rgba[c] = std::clamp(0.5f + sh_c0 * scene.sh_dc[3 * i + c], 0.0f, 1.0f);
+    out.push_back({p.x - 1.0f, p.y, p.x + 1.0f, p.y, rgba});
+  }
+  return out;
+}
+
+namespace {
+
+float distance_to_segment(const glm::vec2& p, const glm::vec2& a, const glm::vec2& b) {
+  const glm::vec2 ab = b - a;
+  const float len2 = glm::dot(ab, ab);
+  const float t = len2 > 0.0f ? glm::clamp(glm::dot(p - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
+  return glm::length(p - (a + t * ab));
+}
+
+bool inside_triangle(const glm::vec2& p, const glm::vec2& a, const glm::vec2& b, const glm::vec2& c) {
+  auto side = [](const glm::vec2& u, const glm::vec2& v, const glm::vec2& w) {
+    return (v.x - u.x) * (w.y - u.y) - (v.y - u.y) * (w.x - u.x);
+  };
+  const float d1 = side(a, b, p), d2 = side(b, c, p), d3 = side(c, a, p);
+  return !((d1 < 0 || d2 < 0 || d3 < 0) && (d1 > 0 || d2 > 0 || d3 > 0));
+}
+
+}  // namespace
+
+int pick_camera(const std::vector<Camera>& cameras, const Camera& view, float x, float y, float radius, float depth) {
+  const glm::vec2 click(x, y);
+  int best = -1;
+  float best_distance = 0.0f, best_depth = 0.0f;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const glm::vec3 apex = to_view(view, glm::vec3(cameras[i].position[0], cameras[i].position[1], cameras[i].position[2]));
+    if (apex.z <= 0.0f) continue;
+    // The frustum as drawn: its edges, and its faces (the apex with each image edge, the image
+    // rectangle) where every corner is in front of the view.
+    const std::vector<WorldSegment> edges = camera_frustums({cameras[i]}, depth, -1);
+    float distance = std::hypot(to_pixels(view, apex).x - x, to_pixels(view, apex).y - y);
+    for (const ScreenSegment& s : project_segments(edges, view, 1e-4f * depth))
+      distance = std::min(distance, distance_to_segment(click, {s.x0, s.y0}, {s.x1, s.y1}));
+    if (distance > 0.0f && edges.size() >= 8) {
+      glm::vec2 corner[4];
+      bool in_front = true;
+      for (int j = 0; j < 4; ++j) {
+        const glm::vec3 v = to_view(view, edges[std::size_t(2 * j)].b);
+        in_front = in_front && v.z > 0.0f;
+        if (in_front) corner[j] = to_pixels(view, v);
+      }
+      const glm::vec2 a = to_pixels(view, apex);
+      if (in_front) {
+        bool inside = inside_triangle(click, corner[0], corner[1], corner[2]) ||
+                      inside_triangle(click, corner[0], corner[2], corner[3]);
+        for (int j = 0; j < 4 && !inside; ++j) inside = inside_triangle(click, a, corner[j], corner[(j + 1) % 4]);
+        if (inside) distance = 0.0f;
+      }
+    }
+    // The nearest hit; among frustums the click is inside of, the one nearest the viewer.
+    if (distance <= radius &&
+        (best < 0 || distance < best_distance || (distance == 0.0f && best_distance == 0.0f && apex.z < best_depth))) {
+      best_distance = distance;
+      best_depth = apex.z;
       best = int(i);
     }
   }

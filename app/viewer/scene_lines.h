@@ -1,4 +1,4 @@
-// Scene guides as line segments: the ground grid and world axes, the training cameras' frustums, their projection into the view, and picking a frustum by a click (no GL).
+// Scene guides as line segments: the ground grid and world axes, the training cameras' frustums, the Gaussians' centres, their projection into the view, and picking a frustum by a click (no GL).
 #pragma once
 
 #include <array>
@@ -7,6 +7,7 @@
 #include <glm/glm.hpp>
 
 #include "flashgs/camera.h"
+#include "flashgs/scene.h"
 
 namespace flashgs::viewer {
 
@@ -34,8 +35,15 @@ std::vector<WorldSegment> camera_frustums(const std::vector<Camera>& cameras, fl
 std::vector<ScreenSegment> project_segments(const std::vector<WorldSegment>& segments, const Camera& view,
                                             float near_depth);
 
-// The camera whose centre projects within `radius` pixels of (x, y) in `view`'s image
-// (the nearest such, in front of the view), or -1.
-int pick_camera(const std::vector<Camera>& cameras, const Camera& view, float x, float y, float radius);
+// The Gaussians' centres seen by `view` as short dashes (2 pixels) in their base colour (the
+// SH DC term), for the "centres" debug view: at most `max_marks` of them, every k-th where the
+// scene has more (a dash per Gaussian of a 3.5M scene would cost more than the frame).
+std::vector<ScreenSegment> centre_marks(const Scene& scene, const Camera& view, std::size_t max_marks);
+
+// The camera whose frustum, as camera_frustums draws it at `depth`, is under (x, y) in
+// `view`'s image: inside its projected body or within `radius` pixels of an edge or its
+// centre. The nearest to the click wins; among bodies the click is inside, the one nearest the
+// viewer. -1 when none is.
+int pick_camera(const std::vector<Camera>& cameras, const Camera& view, float x, float y, float radius, float depth);
 
 }  // namespace flashgs::viewer

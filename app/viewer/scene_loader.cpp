@@ -1,6 +1,7 @@
-// Background scene loads on detached threads: the thread and the viewer share the job, so whichever finishes last frees it.
+// Background scene loads on detached threads (the thread and the viewer share the job, so whichever finishes last frees it), and how far one is.
 #include "scene_loader.h"
 
+#include <algorithm>
 #include <atomic>
 #include <exception>
 #include <mutex>
@@ -10,6 +11,18 @@
 #include "render_gate.h"
 
 namespace flashgs::viewer {
+
+float load_fraction(std::uint64_t bytes_done, std::uint64_t bytes_total, std::uint64_t gaussians_done,
+                    std::uint64_t gaussians_total) {
+  const auto part = [](std::uint64_t done, std::uint64_t total) {
+    return total > 0 ? std::min(1.0, double(done) / double(total)) : -1.0;
+  };
+  const double read = part(bytes_done, bytes_total), decoded = part(gaussians_done, gaussians_total);
+  if (read >= 0 && decoded >= 0) return float(0.5 * read + 0.5 * decoded);
+  if (read > 0) return float(read);
+  if (decoded > 0) return float(decoded);
+  return -1.0f;
+}
 namespace {
 
 std::atomic<int> g_running{0};

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -10,6 +11,13 @@
 #include "scene_state.h"
 
 namespace flashgs::viewer {
+
+// How far a load is, 0..1, over both of its steps: reading the file's bytes and decoding its
+// Gaussians, half the bar each where the reader reports both (the bytes of a large scene are
+// read long before its Gaussians are decoded); the one reported alone fills the bar. -1 while
+// nothing is reported.
+float load_fraction(std::uint64_t bytes_done, std::uint64_t bytes_total, std::uint64_t gaussians_done,
+                    std::uint64_t gaussians_total);
 
 class SceneLoader {
  public:

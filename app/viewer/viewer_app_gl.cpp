@@ -25,6 +25,7 @@
 #include "scene_lines.h"
 #include "split_view_gl.h"
 #include "path_note.h"
+#include "process_clock.h"
 #include "render_gate.h"
 #include "settings_store.h"
 #include "viewer_panels_ui.h"
@@ -66,6 +67,12 @@ ViewerApp::ViewerApp(ViewerArgs args)
       m_compare_task([] { glfwPostEmptyEvent(); }),  // a finished comparison wakes the loop
       m_export_job([] { glfwPostEmptyEvent(); }) {   // as does each exported frame
   m_scripted = m_args.scripted();
+  // The keyframed path's file: the one named, loaded when it exists (else saved there later).
+  m_key_fields.file = m_args.camera_path.empty() ? "camera_path.json" : m_args.camera_path;
+  m_key_fields.folder = "path_frames";
+  if (!m_args.camera_path.empty() && std::filesystem::exists(m_args.camera_path) && !load_keys(m_args.camera_path) &&
+      m_scripted)
+    m_exit_code = 2;
   // Interactive runs start from the saved settings, the command line over them; scripted
   // runs from the defaults and the command line only (repeatable, and they save nothing).
   m_persist = !m_scripted && !config_dir().empty();
@@ -93,6 +100,7 @@ ViewerApp::ViewerApp(ViewerArgs args)
   m_settings.show_help = m_args.help_window;
   m_settings.screenshot_overlay = m_args.screenshot_overlay;
   m_settings.show_grid = m_args.grid;
+  m_settings.show_centres = m_args.centres;
   m_settings.show_frustums = m_args.frustums;
   m_settings.up_axis = int(std::find(kUpAxisNames, kUpAxisNames + kUpAxisCount, m_args.up) - kUpAxisNames) % kUpAxisCount;
   m_settings.compare_view = m_args.compare_view == "numbers" ? CompareView::numbers
@@ -244,8 +252,15 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
 
   // ImGui runs with the panels hidden too (legend, help): its windows still take the input.
   const bool mouse_free = !(m_ui && m_ui->wants_mouse());
-  const bool keys_free = !(m_ui && m_ui->wants_keyboard());
+  // After Enter in the path field the typing goes on there (the field takes the focus back a
+  // frame or two later): until a click, letters are text, not shortcuts.
+  if (m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT) || m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT))
+    m_typing_in_path = false;
+  const bool keys_free = !(m_ui && m_ui->wants_keyboard()) && !m_typing_in_path;
   const std::vector<KeyPress> presses = m_window->take_key_presses();
+  // Esc leaves the field (ImGui ends its edit): the next keys are shortcuts again.
+  if (std::any_of(presses.begin(), presses.end(), [](const KeyPress& p) { return p.key == GLFW_KEY_ESCAPE; }))
+    m_typing_in_path = false;
   int mods = 0;
   auto pressed = [&](int key) {  // a press event since the last frame; `mods` its modifiers
     for (const KeyPress& p : presses)
@@ -257,7 +272,9 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   };
   if (keys_free) {
     nav.forward = m_window->key_down(GLFW_KEY_W);
-    nav.back = m_window->key_down(GLFW_KEY_S);
+    // Ctrl+S saves the camera path: it does not also move the view back.
+    nav.back = m_window->key_down(GLFW_KEY_S) && !m_window->key_down(GLFW_KEY_LEFT_CONTROL) &&
+               !m_window->key_down(GLFW_KEY_RIGHT_CONTROL);
     nav.left = m_window->key_down(GLFW_KEY_A);
     nav.right = m_window->key_down(GLFW_KEY_D);
     nav.down = m_window->key_down(GLFW_KEY_Q);
@@ -279,6 +296,8 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
   }
   if (pressed(GLFW_KEY_F)) actions.frame_scene = true;
   if (pressed(GLFW_KEY_G)) m_settings.show_grid = !m_settings.show_grid;
+  if (pressed(GLFW_KEY_I)) actions.add_key = true;
+  if (pressed(GLFW_KEY_S) && (mods & GLFW_MOD_CONTROL)) actions.save_keys = true;
   // Any other key or a click takes back a first Esc (see handle_escape).
   if (std::any_of(presses.begin(), presses.end(), [](const KeyPress& p) { return p.key != GLFW_KEY_ESCAPE; }) ||
       m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT) || m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT))
@@ -336,6 +355,7 @@ void ViewerApp::apply_actions(const UiActions& a) {
     m_loader.abandon();
   }
   if (!a.open_path.empty()) request_open(a.open_path);
+  if (a.path_entered) m_typing_in_path = true;
   if (a.lod_level >= 0) request_lod_level(a.lod_level);
   if (a.snap_camera >= 0) snap_to_camera(a.snap_camera);
   if (a.next_camera) snap_to_camera(m_camera_index + 1);
@@ -364,6 +384,7 @@ void ViewerApp::apply_actions(const UiActions& a) {
   if (a.open_dialog) open_file_dialog();
   if (!a.export_folder.empty()) start_path_export(a.export_folder, m_args.export_frames);
   if (a.cancel_export) stop_path_export("cancelled", "");
+  apply_key_actions(a);
   if (a.screenshot) {
     // The picture of the view at full resolution: a scripted run has it now; an interactive
     // one may still be rendering it (or showing a reduced frame) and saves it once it is shown.
@@ -388,7 +409,7 @@ void ViewerApp::start_comparison() {
   job.camera = m_last_camera;
   job.left = compare_choice_options(m_settings.compare_left, m_settings.options);
   job.right = compare_choice_options(m_settings.compare_right, m_settings.options);
-  job.warm_up = !m_path_is_cpu;
+  job.rounds = m_args.compare_rounds;
   m_compare = {};  // the last comparison's images are of another view: the frame shows meanwhile
   m_compare_camera = m_last_camera;
   m_compare_options = m_last_options;
@@ -431,11 +452,13 @@ void ViewerApp::finish_comparison(bool at_once) {
   m_compare = std::move(done.result);
   m_difference_factor = done.difference_factor;
   std::fprintf(stderr,
-               "flashgs-viewer: compare %s vs %s at %dx%d: PSNR %.2f dB, max abs %.6f, %.3f ms vs %.3f ms, "
-               "speed-up %.2fx, pair reduction %.1f%%, difference image x%.0f\n",
+               "flashgs-viewer: compare %s vs %s at %dx%d: PSNR %.2f dB, max abs %.6f, median %.3f ms (%.3f-%.3f) "
+               "vs %.3f ms (%.3f-%.3f), %s, pair reduction %.1f%%, difference image x%.0f\n",
                m_compare.right_label.c_str(), m_compare.left_label.c_str(), m_compare.width, m_compare.height,
-               m_compare.difference.psnr_db, m_compare.difference.max_abs, m_compare.right_ms, m_compare.left_ms,
-               m_compare.speed_up(), 100.0 * m_compare.pair_reduction(), m_difference_factor);
+               m_compare.difference.psnr_db, m_compare.difference.max_abs, m_compare.right_ms.median,
+               m_compare.right_ms.min, m_compare.right_ms.max, m_compare.left_ms.median, m_compare.left_ms.min,
+               m_compare.left_ms.max, speed_up_text(m_compare).c_str(), 100.0 * m_compare.pair_reduction(),
+               m_difference_factor);
   // The view or configuration asked for while it ran is not the one compared.
   if (m_have_request && (!same_camera(m_requested.camera, m_compare_camera) || !(m_requested.options == m_compare_options))) {
     m_compare.stale = true;
@@ -467,13 +490,16 @@ int ViewerApp::frustum_under_click(bool left_down, double x, double y) {
   m_window->window_size(&width, &height);
   if (width <= 0 || height <= 0) return -1;
   const float sx = float(m_last_camera.width) / float(width), sy = float(m_last_camera.height) / float(height);
-  const int index = pick_camera(m_scene.cameras, m_last_camera, float(x) * sx, float(y) * sy, 14.0f * sx);
+  const int index = pick_camera(m_scene.cameras, m_last_camera, float(x) * sx, float(y) * sy, 8.0f * sx,
+                                frustum_depth());
   if (index >= 0) std::fprintf(stderr, "flashgs-viewer: clicked the frustum of camera %d\n", index);
   return index;
 }
 
 void ViewerApp::draw_guides(int fb_w, int fb_h) {
-  if (!(m_settings.show_grid || m_settings.show_frustums) || !m_have_frame) return;
+  if (!(m_settings.show_grid || m_settings.show_frustums || m_settings.show_centres || !m_keys.path().keys.empty()) ||
+      !m_have_frame)
+    return;
   if (!m_lines) {
     m_lines = std::make_unique<LineOverlay>();
     m_lines->init();
@@ -481,12 +507,17 @@ void ViewerApp::draw_guides(int fb_w, int fb_h) {
   std::vector<WorldSegment> world;
   if (m_settings.show_grid) world = grid_and_axes(m_scene.centre, m_scene.extent, m_controller.world_up());
   if (m_settings.show_frustums) {
-    const std::vector<WorldSegment> f = camera_frustums(m_scene.cameras, 0.08f * m_scene.extent,
+    const std::vector<WorldSegment> f = camera_frustums(m_scene.cameras, frustum_depth(),
                                                         m_controller.on_scene_camera() ? m_camera_index : -1);
     world.insert(world.end(), f.begin(), f.end());
   }
-  m_lines->draw(project_segments(world, m_last_camera, 1e-3f * m_scene.extent), m_last_camera.width,
-                m_last_camera.height, fb_w, fb_h);
+  key_guides(world);
+  std::vector<ScreenSegment> screen = project_segments(world, m_last_camera, 1e-3f * m_scene.extent);
+  if (m_settings.show_centres && m_scene.scene) {
+    const std::vector<ScreenSegment> dots = centre_marks(*m_scene.scene, m_last_camera, kMaxCentreMarks);
+    screen.insert(screen.end(), dots.begin(), dots.end());
+  }
+  m_lines->draw(screen, m_last_camera.width, m_last_camera.height, fb_w, fb_h);
 }
 
 void ViewerApp::open_file_dialog() {
@@ -527,14 +558,25 @@ void ViewerApp::ensure_texture(int width, int height) {
 void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
   m_render_call_ms = 0;
   if (!m_scene.scene) return;
+  // The coarse first frame of a scene is not replaced while it renders: the next request
+  // (the full frame) would cancel it, and the window would stay empty until that one ends.
+  if (m_coarse_in_flight && m_path->busy()) return;
+  m_coarse_in_flight = false;
   // A slow backend renders fewer pixels while the view moves (about kMovingFrameMs a frame),
   // and the full frame once it stops: the camera then differs, so it is asked for again.
   float scale = m_settings.render_scale;
   // A screenshot waits for a full frame: none is reduced (or stopped) until it is taken.
   const bool shot_pending = !m_pending_screenshot.empty();
-  const bool reduced = !m_scripted && m_settings.adaptive_resolution && moving && m_full_render_ms > kMovingFrameMs &&
-                       !shot_pending;
-  if (reduced) scale *= std::clamp(float(std::sqrt(kMovingFrameMs / m_full_render_ms)), kMinMovingScale, 1.0f);
+  // The first frame of a new scene is coarse too: its full frame's time is not known yet.
+  // (A fixed --render-size has no coarser size.)
+  const bool coarse_first = !m_scripted && m_settings.adaptive_resolution && m_coarse_next_frame && !shot_pending &&
+                            m_settings.forced_width == 0;
+  const bool reduced = coarse_first || (!m_scripted && m_settings.adaptive_resolution && moving &&
+                                        m_full_render_ms > kMovingFrameMs && !shot_pending);
+  if (coarse_first) scale *= kMinMovingScale;
+  else if (reduced) scale *= std::clamp(float(std::sqrt(kMovingFrameMs / m_full_render_ms)), kMinMovingScale, 1.0f);
+  m_coarse_in_flight = coarse_first;
+  m_coarse_next_frame = false;
   const int wanted_w = m_settings.forced_width > 0 ? m_settings.forced_width : std::max(1, int(std::lround(fb_w * scale)));
   const int wanted_h = m_settings.forced_height > 0 ? m_settings.forced_height : std::max(1, int(std::lround(fb_h * scale)));
   int rw = 0, rh = 0;
@@ -625,8 +667,8 @@ void ViewerApp::collect_frame() {
                  m_frame_is_full ? "full" : "reduced", frame.wall_ms);
   if (!m_logged_first_frame && m_frame_is_full) {
     m_logged_first_frame = true;
-    std::fprintf(stderr, "flashgs-viewer: first frame shown %.0f ms after start (%dx%d, %s)\n", ms_since_start(),
-                 width, height, m_scene.path.c_str());
+    std::fprintf(stderr, "flashgs-viewer: first frame shown %.0f ms after start (%.0f ms after the process started) "
+                 "(%dx%d, %s)\n", ms_since_start(), ms_since_process_start(), width, height, m_scene.path.c_str());
   }
 }
 
@@ -660,12 +702,13 @@ void ViewerApp::draw_and_present(int fb_w, int fb_h) {
   if (comparing)
     m_split->draw(fb_w, fb_h, m_divider.fraction(), std::max(2.0f, 2.0f * m_ui_scale * m_window->framebuffer_scale()),
                   m_settings.compare_view == CompareView::difference);
-  if (!m_pending_overlay_shot.empty()) {  // the image as shown, heat map included, panels not
+  m_ui->end_frame();
+  if (m_overlay_shot_frame) {  // the image as shown, heat map and legend included, panels not
     save_window_screenshot(m_pending_overlay_shot, fb_w, fb_h);
     m_status = "saved " + m_pending_overlay_shot + " (heat map included)";
     m_pending_overlay_shot.clear();
+    m_overlay_shot_frame = false;
   }
-  m_ui->end_frame();
   if (!m_pending_window_shot.empty()) {
     save_window_screenshot(m_pending_window_shot, fb_w, fb_h);
     m_pending_window_shot.clear();
@@ -685,7 +728,8 @@ void ViewerApp::draw_and_present(int fb_w, int fb_h) {
   // a frame late: from the third frame with panels on after the first load ended (the scene's
   // lines in its panel), they are all on screen where they stay (tests click them from then on).
   if (m_settings.show_ui && !m_first_load_pending && ++m_ui_frames == 3)
-    std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start\n", ms_since_start());
+    std::fprintf(stderr, "flashgs-viewer: UI ready %.0f ms after start (%.0f ms after the process started)\n",
+                 ms_since_start(), ms_since_process_start());
 }
 
 void ViewerApp::log_popup_changes() {
@@ -820,7 +864,8 @@ void ViewerApp::finish_script() {
                   m_compare.left_label.c_str(), m_compare.difference.psnr_db, m_compare.difference.max_abs);
   }
   if (!m_args.export_path.empty()) {
-    start_path_export(m_args.export_path, m_args.export_frames);
+    if (m_keys.path().keys.size() >= 2) start_key_render(m_args.export_path);
+    else start_path_export(m_args.export_path, m_args.export_frames);
     while (m_export.active() || m_encoding_video) export_step();
   }
   if (m_args.check_frame && m_have_frame) check_displayed_frame();
@@ -921,9 +966,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   }
   model.recent = &m_recent;
   model.current_camera = m_camera_index;
-  model.on_scene_camera = m_controller.on_scene_camera() && m_have_frame &&
-                          m_controller.exact_scene_camera(m_last_camera.width, m_last_camera.height,
-                                                          m_settings.fov_x_degrees);
+  model.view_description = m_controller.view_description(m_camera_index, m_last_camera.width, m_last_camera.height,
+                                                         m_settings.fov_x_degrees);
   model.playing = m_playing;
   model.render_width = m_presenter->width();
   model.render_height = m_presenter->height();
@@ -932,6 +976,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.rendering = background_busy();
   if (comparing()) model.comparing = m_comparing;
   model.compare_elapsed_s = m_compare_task.elapsed_seconds();
+  model.compare_renders_done = m_compare_task.renders_done();
+  model.compare_renders_total = m_compare_task.renders_total();
   model.stats = m_have_frame ? &m_stats : nullptr;
   model.history = &m_history;
   model.compare = &m_compare;
@@ -940,8 +986,8 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.compare_shown = comparison_shown();
   model.divider = m_divider.fraction();
   model.difference_factor = m_difference_factor;
-  model.compare_problem = same_configuration_problem(compare_choice_options(m_settings.compare_left, m_settings.options),
-                                                     compare_choice_options(m_settings.compare_right, m_settings.options));
+  model.compare_problem = compare_sides_problem(m_settings.compare_left, m_settings.compare_right, m_settings.options,
+                                                model.backend);
   model.export_done = m_export.done_frames();
   model.export_total = m_export.active() ? m_export.total_frames() : 0;
   model.dialog_tool = m_dialog.tool();
@@ -954,9 +1000,17 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
   for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
   const ViewerSettings before = m_settings;
-  if (m_settings.show_ui) draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer);
-  draw_overlays(model, m_settings);
-  if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
+  // A screenshot with the overlay: this frame draws the legend's labels alone over the image
+  // (no panels, no help, no status line), and the picture is taken once it is drawn.
+  m_overlay_shot_frame = !m_pending_overlay_shot.empty();
+  if (m_overlay_shot_frame) {
+    draw_legend_labels(model, m_settings);
+  } else {
+    if (m_settings.show_ui)
+      draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer, m_keys, m_key_fields);
+    draw_overlays(model, m_settings);
+    if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
+  }
   keep_settings_valid(m_settings, before);
   if (const std::string chosen = m_dialog.take_choice(); !chosen.empty()) actions.open_path = chosen;
   if (!model.loading.empty() && !m_logged_load_progress) {
@@ -970,6 +1024,8 @@ bool ViewerApp::advance_camera(const NavigationInput& nav, float dt) {
   const bool steering = nav.forward || nav.back || nav.left || nav.right || nav.up || nav.down ||
                         nav.look_dx != 0.0f || nav.look_dy != 0.0f || nav.pan_dx != 0.0f || nav.pan_dy != 0.0f;
   if (m_playing && steering) m_playing = false;  // taking the controls stops the path
+  if (m_keys.previewing() && steering) m_keys.stop_preview();
+  if (preview_keys(dt)) return true;
   if (m_playing && m_camera_path && !m_camera_path->empty()) {
     m_path_t = m_camera_path->advance(m_path_t, dt, m_settings.path_seconds_per_camera);
     m_controller.set_pose(m_camera_path->pose_at(m_path_t));

@@ -15,7 +15,10 @@
 #include "file_dialog.h"
 #include "heatmap_legend.h"
 #include "lod_stream_view.h"
+#include "path_editor.h"
 #include "path_export.h"
+#include "scene_lines.h"
+#include "viewer_panels_ui.h"
 #include "frame_path.h"
 #include "scripted_run.h"
 #include "scene_loader.h"
@@ -111,12 +114,21 @@ class ViewerApp {
   void handle_divider_drag(bool left_down, double x);
   int frustum_under_click(bool left_down, double x, double y);  // on release of a click, else -1
   void draw_guides(int fb_w, int fb_h);  // grid, axes and frustums over the frame
+  float frustum_depth() const { return 0.08f * m_scene.extent; }  // how deep the frustums are drawn (and picked)
   void open_file_dialog();
   void start_path_export(const std::string& folder, int frames);
   void export_step();  // takes the export's finished frame and starts the next (or the video)
   std::string exported_frames_line() const;
   // Stops an export in progress: "path export VERB after N frames WHY" (a notice).
   void stop_path_export(const std::string& verb, const std::string& why);
+  // The keyframed camera path (viewer_keyframes_gl.cpp).
+  Camera view_for_key() const;        // the view as a key takes it
+  void show_key_view(int index);      // the view jumps to key `index`
+  void apply_key_actions(const UiActions& actions);
+  bool load_keys(const std::string& file);  // false: not loaded (a notice says why)
+  bool preview_keys(float dt);        // the preview moves the view: true while it plays
+  void key_guides(std::vector<WorldSegment>& world) const;  // the keys and the curve over the scene
+  void start_key_render(const std::string& folder);
   void log_legend();   // the heat-map legend's ticks, once per change
   void finish_script();
   void check_displayed_frame();
@@ -149,6 +161,8 @@ class ViewerApp {
   FrameRequest m_requested;
   bool m_have_request = false;
   bool m_requested_full = false;  // the last request was at the full render scale
+  bool m_coarse_next_frame = false;  // a scene was installed: its first frame is a coarse one...
+  bool m_coarse_in_flight = false;   // ...and it is being rendered
   Camera m_last_camera;
   RenderOptions m_last_options;
   bool m_have_frame = false;
@@ -178,10 +192,15 @@ class ViewerApp {
   std::string m_logged_legend;
   FileDialog m_dialog;
   FileBrowser m_browser;
+  PathEditor m_keys;             // the keyframed camera path being authored
+  PathFields m_key_fields;
+  KeyframePath m_export_keys;    // the keyed path being rendered...
+  bool m_export_from_keys = false;  // ...when the export renders it (else the loop through the cameras)
   PathExport m_export;
   BackgroundJob m_export_job;   // the export frame (or ffmpeg) in flight
   bool m_encoding_video = false;  // the job is ffmpeg making path.mp4
-  std::string m_pending_overlay_shot;  // a screenshot of the image with the heat map, taken before the panels are drawn
+  std::string m_pending_overlay_shot;  // a screenshot of the image with the heat map and its legend...
+  bool m_overlay_shot_frame = false;   // ...taken in this frame, which draws no panels
   bool m_compare_pending = false;  // asked for before there was a full frame to compare
   std::string m_status;
   RenderOptions m_logged_options;
@@ -212,6 +231,7 @@ class ViewerApp {
 
   // Input state between frames.
   double m_last_cursor_x = 0, m_last_cursor_y = 0;
+  bool m_typing_in_path = false;  // Enter sent the path field: its typing goes on until a click
   std::string m_path_buffer, m_export_buffer;
   std::string m_pending_screenshot;  // waits for a full-resolution frame of the view
 

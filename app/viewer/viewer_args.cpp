@@ -89,6 +89,7 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   auto* orbit = app.add_flag("--orbit", a->orbit, "start in orbit mode (default: orbit for object-sized scenes, else fly)");
   app.add_flag("--fly", a->fly, "start in fly mode")->excludes(orbit);
   app.add_flag("--grid", a->grid, "start with the ground grid and axes shown (G)");
+  app.add_flag("--centres", a->centres, "start with the Gaussians' centres drawn as dots (a debug view)");
   app.add_flag("--frustums", a->frustums, "start with the training cameras drawn as frustums");
   app.add_flag("--help-window", a->help_window, "start with the shortcut table open (F1)");
   app.add_option("--compare-view", a->compare_view, "what a comparison shows: numbers, split or difference")
@@ -101,6 +102,9 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   }, "CONFIG");
   app.add_option("--compare-left", a->compare_left, "the comparison's left side (default baseline)")->check(choice);
   app.add_option("--compare-right", a->compare_right, "the comparison's right side (default current)")->check(choice);
+  app.add_option("--compare-rounds", a->compare_rounds,
+                 "timed rounds of a comparison, each rendering both sides after one warm-up each")
+      ->check(CLI::Range(1, 100));
   app.add_option("--split-at", a->split_at, "the split view's divider, a fraction of the width")
       ->check(finite_in(ValueRange{0.02f, 0.98f}));
   app.add_flag("--screenshot-overlay", a->screenshot_overlay,
@@ -110,6 +114,9 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_option("--export-path", a->export_path,
                  "scripted: write the camera path as an image sequence (frame_00000.png, ...) into this folder, "
                  "and path.mp4 when ffmpeg is on PATH");
+  app.add_option("--camera-path", a->camera_path,
+                 "a keyframed camera path (JSON, or nerfstudio's camera_path.json): loaded at start when it exists, "
+                 "and where the panel saves; with it, --export-path renders its frames at its size and fps");
   app.add_option("--export-frames", a->export_frames, "frames of --export-path (default 120)")->check(CLI::Range(1, 100000));
   app.add_flag("--no-ui", a->no_ui, "hide the panels (Tab toggles them)");
   app.add_flag("--no-vsync", a->no_vsync, "present without waiting for vertical sync");

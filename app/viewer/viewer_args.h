@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "flashgs/options.h"
+#include "compare_mode.h"
 #include "kernel_option.h"
 #include "switch_flags.h"
 
@@ -42,15 +43,17 @@ struct ViewerArgs {
   bool heatmap = false;
   bool orbit = false;            // start in orbit mode
   bool fly = false;              // start in fly mode (neither: orbit for object-sized scenes)
-  bool grid = false, frustums = false;
+  bool grid = false, frustums = false, centres = false;
   bool help_window = false;      // start with the shortcut table open
   std::string compare_view = "split";  // numbers | split | difference
   std::string compare_left = "baseline", compare_right = "current";  // compare_mode.h choice names
+  int compare_rounds = kCompareRounds;
   float split_at = 0.5f;         // the divider, a fraction of the width
   bool screenshot_overlay = false;  // screenshots show the heat map as the window does
   std::string screenshot_dir;    // F12's folder; empty: the XDG pictures folder or the working directory
   std::string export_path;       // scripted: write the camera path as an image sequence into this folder
   int export_frames = 120;
+  std::string camera_path;       // keyframed path file: loaded at start when it exists, the panel's save target
   bool no_ui = false;
   bool no_vsync = false;
 

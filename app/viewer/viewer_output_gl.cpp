@@ -103,7 +103,7 @@ void ViewerApp::check_displayed_frame() {
 }
 
 void ViewerApp::start_path_export(const std::string& folder, int frames) {
-  if (!m_camera_path || m_camera_path->empty()) {
+  if (!m_export_from_keys && (!m_camera_path || m_camera_path->empty())) {
     set_notice("path export: the scene has no cameras to make a path from");
     if (m_scripted) m_exit_code = 2;
     return;
@@ -144,7 +144,8 @@ void ViewerApp::export_step() {
     }
     m_export.advance();
     if (!m_export.active()) {
-      const std::string video = m_export.video_command(30);
+      const std::string video = m_export.video_command(m_export_from_keys ? m_export_keys.fps : 30);
+      m_export_from_keys = false;
       if (video.empty()) {
         set_notice(exported_frames_line() + " (no ffmpeg on PATH: image sequence only)");
       } else {
@@ -160,11 +161,18 @@ void ViewerApp::export_step() {
   if (m_export_job.busy() || !m_export.active()) return;
   // The next frame renders and is written beside the frame loop where the path renders in the
   // background (the CPU), so the window keeps answering; scripted runs wait for each.
-  const int width = m_presenter->width() > 0 ? m_presenter->width() : 1280;
-  const int height = m_presenter->height() > 0 ? m_presenter->height() : 720;
-  CameraController at = m_controller;
-  at.set_pose(m_camera_path->pose_at(m_export.next_t()));
-  const Camera camera = at.render_camera(width, height, m_camera_path->fov_at(m_export.next_t()));
+  // The keyed path at its own size and fps; the loop through the scene's cameras at the window's size.
+  Camera camera;
+  if (m_export_from_keys) {
+    camera = m_export_keys.camera_at(m_export_keys.frame_time(m_export.done_frames()), m_export_keys.width,
+                                     m_export_keys.height);
+  } else {
+    const int width = m_presenter->width() > 0 ? m_presenter->width() : 1280;
+    const int height = m_presenter->height() > 0 ? m_presenter->height() : 720;
+    CameraController at = m_controller;
+    at.set_pose(m_camera_path->pose_at(m_export.next_t()));
+    camera = at.render_camera(width, height, m_camera_path->fov_at(m_export.next_t()));
+  }
   RenderOptions options = m_settings.options;
   options.collect_tile_counts = false;
   FramePath* path = m_path.get();
@@ -184,6 +192,7 @@ void ViewerApp::stop_path_export(const std::string& verb, const std::string& why
   if (!m_export.active()) return;
   set_notice("path export " + verb + " after " + std::to_string(m_export.done_frames()) + " frames" + why);
   m_export.cancel();
+  m_export_from_keys = false;
   // The frame in flight stops at its renderer's next check (the CPU's are between tiles);
   // export_step takes it and drops it, and a new export waits for that.
   m_export_job.cancel();

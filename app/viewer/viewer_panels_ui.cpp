@@ -9,6 +9,7 @@
 #include <imgui_stdlib.h>
 
 #include "count_text.h"
+#include "scene_loader.h"
 #include "heatmap_legend.h"
 #include "help_overlay_ui.h"
 #include "widget_places_ui.h"
@@ -20,12 +21,8 @@ namespace {
 // screen; 1 on a Retina Mac, where ImGui's points already cover two pixels).
 float g_ui = 1.0f;
 float ui(float v) { return v * g_ui; }
-
-// The sections below Scene and View start open only in a window tall enough to leave the
-// picture visible beside them (at 800x450 they start folded; ImGui keeps what the user chose).
-ImGuiTreeNodeFlags open_if_roomy() {
-  return ImGui::GetMainViewport()->WorkSize.y >= ui(600) ? ImGuiTreeNodeFlags_DefaultOpen : 0;
-}
+// The main panel's right edge this frame (the status line stays right of it).
+float g_panel_right = 0;
 
 // Every slider clamps what is typed into it (Ctrl+click) to its range, not just what is dragged.
 constexpr ImGuiSliderFlags kClamp = ImGuiSliderFlags_AlwaysClamp;
@@ -34,6 +31,35 @@ std::string megabytes(std::uint64_t bytes) {
   char text[32];
   std::snprintf(text, sizeof text, "%.0f MB", double(bytes) / 1e6);
   return text;
+}
+
+// Coloured text wrapped at the window's edge (a long path or message is never cut off).
+void colored_wrapped(const ImVec4& colour, const std::string& text) {
+  ImGui::PushStyleColor(ImGuiCol_Text, colour);
+  ImGui::TextWrapped("%s", text.c_str());
+  ImGui::PopStyleColor();
+}
+
+// A checkbox that can be greyed out: then its tick is grey too (ImGui only dims the bright
+// tick, which still reads as "on and active").
+bool greyed_checkbox(const char* label, bool* value, bool enabled) {
+  ImGui::BeginDisabled(!enabled);
+  if (!enabled) ImGui::PushStyleColor(ImGuiCol_CheckMark, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+  const bool changed = ImGui::Checkbox(label, value);
+  if (!enabled) ImGui::PopStyleColor();
+  ImGui::EndDisabled();
+  return changed;
+}
+
+// Call after Begin: a window that a resize (or a drag) left partly outside the viewport comes
+// back inside it, as far as it fits. `name` logs its bottom-right corner (--log-input).
+void keep_inside_viewport(const char* name) {
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  const ImVec2 inside(std::clamp(pos.x, vp->WorkPos.x, std::max(vp->WorkPos.x, vp->WorkPos.x + vp->WorkSize.x - size.x)),
+                      std::clamp(pos.y, vp->WorkPos.y, std::max(vp->WorkPos.y, vp->WorkPos.y + vp->WorkSize.y - size.y)));
+  if (inside.x != pos.x || inside.y != pos.y) ImGui::SetWindowPos(inside);
+  note_drawn_place(name, inside.x + size.x, inside.y + size.y, inside.x + size.x, inside.y + size.y);
 }
 
 // A progress bar; with `fraction` < 0 (not known) a block sliding along it, so that the
@@ -70,14 +96,15 @@ void load_window(const UiModel& m, UiActions& a) {
   ImGui::SetNextWindowBgAlpha(0.9f);
   ImGui::Begin("Loading###load", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
-                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoFocusOnAppearing);
-  ImGui::TextColored(ImVec4(0.5f, 0.8f, 1.0f, 1), "Loading %s", m.loading.c_str());
+                   ImGuiWindowFlags_NoFocusOnAppearing);  // its height fits (size 0 above): its text wraps
+  colored_wrapped(ImVec4(0.5f, 0.8f, 1.0f, 1), "Loading " + m.loading);
   const LoadView& l = m.load;
-  float fraction = -1.0f;
-  if (l.bytes_total > 0 && l.bytes_done > 0) fraction = float(double(l.bytes_done) / double(l.bytes_total));
-  else if (l.gaussians_total > 0 && l.gaussians_done > 0) fraction = float(double(l.gaussians_done) / double(l.gaussians_total));
-  char elapsed[32];
-  std::snprintf(elapsed, sizeof elapsed, "%.1f s", l.elapsed_s);
+  const float fraction = load_fraction(l.bytes_done, l.bytes_total, l.gaussians_done, l.gaussians_total);
+  // Which step: the bytes read in full, the Gaussians still being decoded.
+  const bool decoding = l.bytes_total > 0 && l.bytes_done >= l.bytes_total && l.gaussians_total > 0 &&
+                        l.gaussians_done < l.gaussians_total;
+  char elapsed[64];
+  std::snprintf(elapsed, sizeof elapsed, "%s%.1f s", decoding ? "decoding, " : "", l.elapsed_s);
   progress_bar(fraction, elapsed, l.elapsed_s);
   std::string detail;
   if (l.bytes_total > 0)
@@ -91,8 +118,9 @@ void load_window(const UiModel& m, UiActions& a) {
   if (!detail.empty()) ImGui::SameLine();
   if (ImGui::SmallButton("Cancel")) a.cancel_load = true;
   if (!m.scene_path.empty()) {
-    ImGui::SameLine();
-    ImGui::TextDisabled("(the current scene stays until it is ready)");
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+    ImGui::TextWrapped("(the current scene stays until the new one is ready)");
+    ImGui::PopStyleColor();
   }
   ImGui::End();
 }
@@ -104,7 +132,10 @@ void hud_line(const UiModel& m, float panel_right) {
   const char* busy = !m.comparing.empty() ? " | comparing..." : m.rendering ? " | rendering..." : "";
   char rate[64], size[32];
   if (m.fps > 0) std::snprintf(rate, sizeof rate, "%.1f FPS | %.0f ms/frame", m.fps, m.last_frame_ms);
-  else std::snprintf(rate, sizeof rate, "idle | last frame %.0f ms", m.last_frame_ms);
+  // Still (nothing to redraw): the rate the last frame's time allows, said to be that.
+  else if (m.last_frame_ms > 0)
+    std::snprintf(rate, sizeof rate, "%.1f FPS at last frame's %.0f ms", 1000.0 / m.last_frame_ms, m.last_frame_ms);
+  else std::snprintf(rate, sizeof rate, "no frame timed yet");
   std::snprintf(size, sizeof size, " | %dx%d", m.render_width, m.render_height);
   const std::string pairs = m.stats ? human_count(double(m.stats->kv_pairs)) + " kv pairs" : std::string();
   const std::string full = m.stats ? std::string(rate) + " | " + pairs + " | " + backend + size + busy
@@ -122,6 +153,7 @@ void hud_line(const UiModel& m, float panel_right) {
   ImDrawList* draw = ImGui::GetForegroundDrawList();
   draw->AddRectFilled(ImVec2(at.x - ui(6), at.y - ui(3)), ImVec2(at.x + extent.x + ui(6), at.y + extent.y + ui(3)),
                       IM_COL32(0, 0, 0, 160), ui(3.0f));
+  note_drawn_place("status line", at.x, at.y, at.x + extent.x, at.y + extent.y);
   draw->AddText(at, m.rendering ? IM_COL32(255, 220, 120, 255) : IM_COL32(255, 255, 255, 255), text.c_str());
 }
 
@@ -181,10 +213,19 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
     ImGui::SliderFloat("budget (M)", &s.stream_budget_millions, 0.0f, 100.0f, s.stream_budget_millions > 0 ? "%.2f M" : "caps only");
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("Gaussians drawn at most, in millions (0: what the memory caps allow)");
   }
-  if (!m.scene_note.empty()) ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.scene_note.c_str());
+  if (!m.scene_note.empty()) {
+    colored_wrapped(ImVec4(0.9f, 0.8f, 0.4f, 1), m.scene_note);
+  }
   ImGui::SetNextItemWidth(ui(-170));
-  const bool enter = ImGui::InputTextWithHint("##open", "PLY path or folder (or drop a file)", &path_buffer,
+  const bool enter = ImGui::InputTextWithHint("##open", "scene file or folder", &path_buffer,
                                               ImGuiInputTextFlags_EnterReturnsTrue);
+  // Enter ends the edit, but the typing goes on in the box (a mistyped path is corrected
+  // there): letters typed next must not reach the single-key shortcuts.
+  if (enter) {
+    ImGui::SetKeyboardFocusHere(-1);
+    a.path_entered = true;
+  }
+  note_widget_place("path field");
   ImGui::SameLine();
   if ((ImGui::Button("Open") || enter) && !path_buffer.empty()) a.open_path = path_buffer;
   ImGui::SameLine();
@@ -192,10 +233,6 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   if (ImGui::Button("Browse...")) a.open_dialog = true;
   ImGui::EndDisabled();
   if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("the desktop's file dialog (Ctrl+O)");
-  if (m.dialog_open) {
-    ImGui::SameLine();
-    ImGui::TextDisabled("waiting for %s", m.dialog_tool.empty() ? "the file browser" : m.dialog_tool.c_str());
-  }
   // The recent scenes behind an arrow on the same row: the panel's layout does not move.
   ImGui::SameLine();
   const bool any_recent = m.recent && !m.recent->empty();
@@ -210,10 +247,10 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   ImGui::EndDisabled();
   if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
     ImGui::SetTooltip(any_recent ? "recently opened scenes" : "no recent scenes yet");
+  // On a line of its own: beside the Browse button it was cut off at the panel's edge.
+  if (m.dialog_open) ImGui::TextDisabled("waiting for %s", m.dialog_tool.empty() ? "the file browser" : m.dialog_tool.c_str());
   if (!m.load_error.empty()) {
-    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1));
-    ImGui::TextWrapped("%s", m.load_error.c_str());
-    ImGui::PopStyleColor();
+    colored_wrapped(ImVec4(1.0f, 0.45f, 0.4f, 1), m.load_error);
   }
 }
 
@@ -242,8 +279,7 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
     ImGui::SliderFloat("s per camera", &s.path_seconds_per_camera, kPathSecondsRange.min, kPathSecondsRange.max, "%.1f",
                        kClamp | ImGuiSliderFlags_Logarithmic);
     note_widget_place("s per camera");
-    if (m.current_camera < 0) ImGui::TextUnformatted("free view");
-    else ImGui::Text(m.on_scene_camera ? "on camera %d (exact)" : "free view (last camera %d)", m.current_camera);
+    ImGui::TextUnformatted(m.view_description.c_str());  // one line: the sliders below stay put
   } else if (!m.scene_path.empty()) {
     ImGui::TextDisabled("no cameras.json: free navigation");
   }
@@ -266,9 +302,7 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   ImGui::SameLine();
   ImGui::Checkbox("Grid, axes (G)", &s.show_grid);
   ImGui::SameLine();
-  ImGui::BeginDisabled(m.camera_count == 0);
-  ImGui::Checkbox("Frustums", &s.show_frustums);
-  ImGui::EndDisabled();
+  greyed_checkbox("Frustums", &s.show_frustums, m.camera_count > 0);
   if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
     ImGui::SetTooltip(m.camera_count ? "the training cameras; click one to jump to it" : "the scene has no cameras");
 }
@@ -277,10 +311,8 @@ void view_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
 // tooltip saying what it removes, where the paper has it, its CLI flag and why it is grey.
 void switch_checkbox(const RenderSwitch& sw, RenderOptions& o, Backend backend) {
   const bool honoured = sw.honoured_by(backend);
-  ImGui::BeginDisabled(!honoured);
-  ImGui::Checkbox(sw.ui_name, &(o.*(sw.member)));
+  greyed_checkbox(sw.ui_name, &(o.*(sw.member)), honoured && !o.is_baseline());
   note_widget_place(sw.ui_name);
-  ImGui::EndDisabled();
   if (!ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) return;
   std::string tip = std::string(sw.help) + "\nFlashGS paper: " + sw.paper + "\nCLI: --no-" + sw.cli_name;
   if (!honoured) tip += std::string("\nGreyed out: the ") + backend_name(backend) + " backend ignores it (" +
@@ -290,7 +322,6 @@ void switch_checkbox(const RenderSwitch& sw, RenderOptions& o, Backend backend) 
 }
 
 void render_panel(const UiModel& m, ViewerSettings& s) {
-  if (!ImGui::CollapsingHeader("Rendering", open_if_roomy())) return;
   RenderOptions& o = s.options;
   int algo = o.is_baseline() ? 0 : 1;
   ImGui::RadioButton("Baseline (3DGS)", &algo, 0);
@@ -307,11 +338,9 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
   if (ImGui::BeginTable("opts", 2, ImGuiTableFlags_SizingStretchSame)) {
     for (const bool geometry : {true, false}) {
       ImGui::TableNextColumn();
-      ImGui::BeginDisabled(o.is_baseline());
       ImGui::TextDisabled(geometry ? "geometry" : "GPU kernels");
       for (const RenderSwitch& sw : kRenderSwitches)
         if (sw.changes_pairs == geometry) switch_checkbox(sw, o, m.backend);
-      ImGui::EndDisabled();
       if (!geometry) continue;
       ImGui::TextDisabled("precision");
       ImGui::SetNextItemWidth(ui(40));
@@ -326,9 +355,7 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
         ImGui::SetTooltip("fp16 shape: rotation, scale and opacity as half values: 16 GPU bytes instead of 32, not exact");
       // The half blend exists only as a CUDA kernel, and only for the exp2 loop.
       const bool half_blend_runs = m.backend == Backend::cuda && !o.is_baseline() && o.exp2_alpha;
-      ImGui::BeginDisabled(!half_blend_runs);
-      ImGui::Checkbox("fp16 blend", &o.fp16_blend);
-      ImGui::EndDisabled();
+      greyed_checkbox("fp16 blend", &o.fp16_blend, half_blend_runs);
       if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
         ImGui::SetTooltip("%s", half_blend_runs ? "the blend in half arithmetic, two pixels per instruction: faster, not exact"
                                                 : "the blend in half arithmetic: a CUDA kernel of the flash path with exp2 "
@@ -350,19 +377,27 @@ void render_panel(const UiModel& m, ViewerSettings& s) {
   ImGui::Checkbox("VSync", &s.vsync);
 }
 
+// "114.2 (110.1-119.0)": a median and its range.
+std::string spread_cell(const Spread& s) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.1f (%.1f-%.1f)", s.median, s.min, s.max);
+  return text;
+}
+
 void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
-  if (!ImGui::CollapsingHeader("Compare", open_if_roomy())) return;
-  // The two sides: any two of the configurations compare_mode.h lists.
+  // The two sides: any two of the configurations compare_mode.h lists that the backend draws
+  // differently (a switch it ignores renders flash itself).
   auto side = [&](const char* label, int* choice) {
-    ImGui::SetNextItemWidth(ui(118));
-    if (ImGui::BeginCombo(label, compare_choice_name(*choice).c_str())) {
+    ImGui::SetNextItemWidth(ui(150));
+    if (ImGui::BeginCombo(label, compare_choice_title(*choice).c_str())) {
       for (int c = 0; c < compare_choice_count(); ++c)
-        if (ImGui::Selectable(compare_choice_name(c).c_str(), c == *choice)) *choice = c;
+        if (compare_choice_offered(c, m.backend) && ImGui::Selectable(compare_choice_title(c).c_str(), c == *choice))
+          *choice = c;
       ImGui::EndCombo();
     }
+    note_widget_place(label);
   };
   side("left", &s.compare_left);
-  ImGui::SameLine();
   side("right", &s.compare_right);
   ImGui::BeginDisabled(!m.compare_problem.empty() || !m.comparing.empty());  // one comparison at a time
   if (ImGui::Button("Compare this view (C)")) a.compare = true;
@@ -375,30 +410,40 @@ void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   ImGui::Combo("##view", &view, views, 3);
   s.compare_view = static_cast<CompareView>(view);
   if (!m.comparing.empty()) {
-    ImGui::TextColored(ImVec4(1.0f, 0.86f, 0.47f, 1), "comparing %s ... %.1f s", m.comparing.c_str(), m.compare_elapsed_s);
+    colored_wrapped(ImVec4(1.0f, 0.86f, 0.47f, 1), "comparing " + m.comparing);
+    char overlay[64];
+    std::snprintf(overlay, sizeof overlay, "render %d of %d, %.1f s", std::min(m.compare_renders_done + 1, m.compare_renders_total),
+                  m.compare_renders_total, m.compare_elapsed_s);
+    progress_bar(m.compare_renders_total > 0 ? float(m.compare_renders_done) / float(m.compare_renders_total) : -1.0f,
+                 overlay, m.compare_elapsed_s);
     return;
   }
   if (!m.compare_problem.empty()) {
-    ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "%s", m.compare_problem.c_str());
+    colored_wrapped(ImVec4(0.9f, 0.8f, 0.4f, 1), m.compare_problem);
     return;
   }
   const CompareResult* c = m.compare;
   if (!c || (!c->valid && c->error.empty())) return;
   if (!c->error.empty()) {
-    ImGui::TextColored(ImVec4(1, 0.45f, 0.4f, 1), "%s", c->error.c_str());
+    colored_wrapped(ImVec4(1, 0.45f, 0.4f, 1), c->error);
     return;
   }
-  if (c->stale) {
-    ImGui::SameLine();
-    ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "(view changed: C again)");
-  }
-  ImGui::Text("%s (right) vs %s (left) at %dx%d", c->right_label.c_str(), c->left_label.c_str(), c->width, c->height);
+  if (c->stale) ImGui::TextColored(ImVec4(0.9f, 0.8f, 0.4f, 1), "(view changed: C again)");
+  ImGui::TextWrapped("%s (right) vs %s (left) at %dx%d", c->right_label.c_str(), c->left_label.c_str(), c->width, c->height);
   if (std::isinf(c->difference.psnr_db)) ImGui::Text("PSNR: identical   max abs: 0");
   else ImGui::Text("PSNR %.2f dB   max abs %.5f (%.2f/255)", c->difference.psnr_db, c->difference.max_abs,
                    c->difference.max_abs * 255.0);
   ImGui::Text("pixels off by > 1/255: %.4f%%", 100.0 * c->difference.fraction_over_1_255);
   if (s.compare_view == CompareView::difference) ImGui::Text("difference image: |error| x %.0f", m.difference_factor);
-  ImGui::Text("speed-up %.2fx   pair reduction %.1f%%", c->speed_up(), 100.0 * c->pair_reduction());
+  const bool noise = within_noise(c->speed_up);
+  ImGui::PushStyleColor(ImGuiCol_Text, noise ? ImVec4(0.9f, 0.8f, 0.4f, 1) : ImGui::GetStyle().Colors[ImGuiCol_Text]);
+  ImGui::TextWrapped("%s", speed_up_text(*c).c_str());
+  ImGui::PopStyleColor();
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("median of the rounds' left time / right time, and its range; each side rendered once untimed "
+                      "first, then both sides each round, in alternating order.\nWithin noise: some rounds found "
+                      "the other side faster.");
+  ImGui::Text("pair reduction %.1f%%", 100.0 * c->pair_reduction());
   if (ImGui::BeginTable("cmp", 3, ImGuiTableFlags_BordersInnerH)) {
     ImGui::TableSetupColumn("");
     ImGui::TableSetupColumn("left");
@@ -406,12 +451,12 @@ void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
     ImGui::TableHeadersRow();
     ImGui::TableNextRow();
     ImGui::TableNextColumn(); ImGui::Text("frame ms");
-    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->left_ms);
-    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->right_ms);
+    ImGui::TableNextColumn(); ImGui::TextUnformatted(spread_cell(c->left_ms).c_str());
+    ImGui::TableNextColumn(); ImGui::TextUnformatted(spread_cell(c->right_ms).c_str());
     ImGui::TableNextRow();
     ImGui::TableNextColumn(); ImGui::Text("wall ms");
-    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->left_wall_ms);
-    ImGui::TableNextColumn(); ImGui::Text("%.2f", c->right_wall_ms);
+    ImGui::TableNextColumn(); ImGui::TextUnformatted(spread_cell(c->left_wall_ms).c_str());
+    ImGui::TableNextColumn(); ImGui::TextUnformatted(spread_cell(c->right_wall_ms).c_str());
     ImGui::TableNextRow();
     ImGui::TableNextColumn(); ImGui::Text("kv pairs");
     ImGui::TableNextColumn(); ImGui::Text("%s", human_count(double(c->left_kv)).c_str());
@@ -420,8 +465,91 @@ void compare_panel(const UiModel& m, ViewerSettings& s, UiActions& a) {
   }
 }
 
+// The keyframed camera path: keys from the view (I), their times, easing, preview, the file,
+// and the render of its frames (size, fps, duration, folder; progress and Cancel).
+void keyframe_panel(const UiModel& m, UiActions& a, PathEditor& keys, PathFields& f) {
+  KeyframePath& p = keys.path();
+  if (ImGui::Button("Add view (I)")) a.add_key = true;
+  note_widget_place("Add view (I)");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(keys.selected() < 0);
+  if (ImGui::Button("Replace")) a.replace_key = true;
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) ImGui::SetTooltip("the selected key takes the view");
+  ImGui::SameLine();
+  if (ImGui::Button("Delete")) a.delete_key = true;
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(p.keys.size() < 2);
+  if (ImGui::Button(keys.previewing() ? "Stop" : "Preview")) a.toggle_preview = true;
+  ImGui::EndDisabled();
+  if (!p.keys.empty()) {
+    ImGui::BeginChild("keys", ImVec2(0, ImGui::GetTextLineHeightWithSpacing() * std::min<float>(4.5f, p.keys.size() + 0.5f)),
+                      true);
+    for (std::size_t i = 0; i < p.keys.size(); ++i) {
+      char row[96];
+      std::snprintf(row, sizeof row, "key %zu   %.2f s   FOV %.1f", i, p.keys[i].time_s, p.keys[i].fov_x_degrees);
+      if (ImGui::Selectable(row, int(i) == keys.selected())) a.select_key = int(i);
+    }
+    ImGui::EndChild();
+  }
+  if (keys.selected() >= 0) {
+    double t = p.keys[std::size_t(keys.selected())].time_s;
+    ImGui::SetNextItemWidth(ui(90));
+    if (ImGui::InputDouble("key time (s)", &t, 0.1, 1.0, "%.2f")) keys.set_time(keys.selected(), t);
+    ImGui::SameLine();
+  }
+  int easing = p.easing == PathEasing::linear ? 0 : 1;
+  const char* easings[] = {"linear", "ease in/out"};
+  ImGui::SetNextItemWidth(ui(100));
+  if (ImGui::Combo("easing", &easing, easings, 2)) p.easing = easing == 0 ? PathEasing::linear : PathEasing::ease_in_out;
+  ImGui::SetNextItemWidth(ui(-110));
+  ImGui::InputTextWithHint("##keysfile", "path file (.json)", &f.file);
+  ImGui::SameLine();
+  ImGui::BeginDisabled(p.keys.empty() || f.file.empty());
+  if (ImGui::Button("Save##keys")) a.save_keys = true;
+  note_widget_place("Save path");
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(f.file.empty());
+  if (ImGui::Button("Load##keys")) a.load_keys = true;
+  ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("this viewer's path files, or nerfstudio's camera_path.json");
+  if (p.keys.size() < 2) return;
+  // The render: its size is its own, not the window's.
+  int size[2] = {p.width, p.height};
+  ImGui::SetNextItemWidth(ui(110));
+  if (ImGui::InputInt2("size", size)) {
+    p.width = std::clamp(size[0], 16, kMaxPathSide);
+    p.height = std::clamp(size[1], 16, kMaxPathSide);
+  }
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(ui(40));
+  if (ImGui::InputInt("fps", &p.fps, 0)) p.fps = std::clamp(p.fps, 1, kMaxPathFps);
+  ImGui::SameLine();
+  double duration = p.duration_s();
+  ImGui::SetNextItemWidth(ui(60));
+  if (ImGui::InputDouble("s", &duration, 0, 0, "%.1f") && duration > 0.05) keys.set_duration(duration);
+  if (m.export_total > 0) {
+    ImGui::ProgressBar(float(m.export_done) / float(m.export_total), ImVec2(ui(-70), 0));
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel##keys")) a.cancel_export = true;
+    return;
+  }
+  ImGui::SetNextItemWidth(ui(-110));
+  ImGui::InputTextWithHint("##keysfolder", "folder for the frames", &f.folder);
+  ImGui::SameLine();
+  ImGui::BeginDisabled(f.folder.empty());
+  char label[48];
+  std::snprintf(label, sizeof label, "Render %d", p.frame_count());
+  if (ImGui::Button(label)) a.render_keys_folder = f.folder;
+  note_widget_place("Render path");
+  ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("frame_00000.png, ... at this size and fps; path.mp4 too when ffmpeg is on PATH");
+}
+
 void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& export_folder) {
-  if (!ImGui::CollapsingHeader("Overlay, screenshots, export", open_if_roomy())) return;
   ImGui::Checkbox("Tile heat map (H)", &s.heatmap);
   ImGui::SameLine();
   ImGui::Checkbox("log", &s.heatmap_log);
@@ -432,11 +560,14 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
   ImGui::SliderFloat("opacity", &s.heatmap_opacity, kHeatmapOpacityRange.min, kHeatmapOpacityRange.max, "%.2f", kClamp);
   ImGui::SameLine();
   ImGui::Checkbox("in screenshots", &s.screenshot_overlay);
+  ImGui::Checkbox("Gaussian centres", &s.show_centres);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("each Gaussian's centre as a dot in its base colour (at most %d; every k-th beyond)",
+                      int(kMaxCentreMarks));
   ImGui::SetNextItemWidth(ui(-90));
   ImGui::InputTextWithHint("##shotdir", "screenshot folder", &s.screenshot_folder);
   ImGui::SameLine();
   if (ImGui::Button("Save (F12)")) a.screenshot = true;
-  if (!m.status.empty()) ImGui::TextWrapped("%s", m.status.c_str());
   if (m.export_total > 0) {
     ImGui::ProgressBar(float(m.export_done) / float(m.export_total), ImVec2(ui(-70), 0));
     ImGui::SameLine();
@@ -464,11 +595,14 @@ void stats_window(const UiModel& m) {
   // The title keeps the frame rate in view when the window is folded.
   char title[256];
   if (m.fps > 0) std::snprintf(title, sizeof title, "%.1f FPS | %s###Statistics", m.fps, m.frame_path.c_str());
-  else std::snprintf(title, sizeof title, "idle | %s###Statistics", m.frame_path.c_str());
+  else if (m.last_frame_ms > 0)  // still: the last frame's time (the title's width is fixed)
+    std::snprintf(title, sizeof title, "%.0f ms/frame | %s###Statistics", m.last_frame_ms, m.frame_path.c_str());
+  else std::snprintf(title, sizeof title, "no frame yet | %s###Statistics", m.frame_path.c_str());
   // A fixed width: the anchor above places its right edge from the first frame on.
   ImGui::SetNextWindowSizeConstraints(ImVec2(ui(330), 0), ImVec2(ui(330), vp->WorkSize.y));
   ImGui::Begin(title, nullptr, ImGuiWindowFlags_AlwaysAutoResize);
-  ImGui::TextColored(ImVec4(0.5f, 0.9f, 0.6f, 1), "%s", m.frame_path.c_str());
+  keep_inside_viewport("Statistics corner");
+  colored_wrapped(ImVec4(0.5f, 0.9f, 0.6f, 1), m.frame_path);
   if (!m.frame_path_note.empty()) ImGui::TextWrapped("%s", m.frame_path_note.c_str());
   ImGui::Text("rendered: %.1f FPS   render %dx%d", m.fps, m.render_width, m.render_height);
   if (const FrameStats* st = m.stats) {
@@ -516,10 +650,17 @@ void legend_labels(const UiModel& m, const ViewerSettings& s) {
   // Caption above the bar, tick marks and values below it, each on a dark backing that
   // leaves the bar's colours (the GL pass under this) untouched.
   const ImU32 backing = IM_COL32(0, 0, 0, 160);
-  draw->AddRectFilled(ImVec2(r[0] - ui(6), r[1] - line - ui(6)), ImVec2(r[2] + ui(6), r[1]), backing, ui(3.0f));
-  draw->AddRectFilled(ImVec2(r[0] - ui(16), r[3]), ImVec2(r[2] + ui(16), r[3] + line + ui(6)), backing, ui(3.0f));
+  // The caption starts over the bar's left end, or further left where it would pass the
+  // window's right edge (the locked caption is longer than the bar).
   const std::string caption = legend_caption(m.tile_size, s.heatmap_log, s.heatmap_lock_max);
-  draw->AddText(ImVec2(r[0], r[1] - line - ui(3)), white, caption.c_str());
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  const float caption_x = std::max(vp->WorkPos.x + ui(6), std::min(r[0], vp->WorkPos.x + vp->WorkSize.x - ui(6) -
+                                                                     ImGui::CalcTextSize(caption.c_str()).x));
+  draw->AddRectFilled(ImVec2(caption_x - ui(6), r[1] - line - ui(6)), ImVec2(r[2] + ui(6), r[1]), backing, ui(3.0f));
+  draw->AddRectFilled(ImVec2(r[0] - ui(16), r[3]), ImVec2(r[2] + ui(16), r[3] + line + ui(6)), backing, ui(3.0f));
+  draw->AddText(ImVec2(caption_x, r[1] - line - ui(3)), white, caption.c_str());
+  note_drawn_place("legend caption", caption_x, r[1] - line - ui(3),
+                   caption_x + ImGui::CalcTextSize(caption.c_str()).x, r[1] - ui(3));
   for (const LegendTick& t : legend_ticks(m.heatmap_max, s.heatmap_log)) {
     const float x = r[0] + t.position * (r[2] - r[0]);
     draw->AddLine(ImVec2(x, r[3]), ImVec2(x, r[3] + ui(4)), white, ui(1.0f));
@@ -553,9 +694,48 @@ void compare_labels(const UiModel& m, const ViewerSettings& s) {
   label(at + ui(12), c->right_label);
 }
 
+// A tab of the sections' bar; its place is logged as "tab NAME" (--log-input).
+bool section_tab(const char* name, bool select) {
+  const bool open = ImGui::BeginTabItem(name, nullptr, select ? ImGuiTabItemFlags_SetSelected : 0);
+  note_widget_place((std::string("tab ") + name).c_str());
+  return open;
+}
+
+// Below Scene and View, one section at a time: the panel stays short enough at 1280x800 that
+// every action is on screen without scrolling (stacked, the Compare results and the export
+// were below the fold).
+void section_tabs(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& export_folder, PathEditor& keys,
+                  PathFields& key_fields) {
+  // A comparison started with C (from any tab), or its result arriving, brings its tab forward once.
+  static bool was_comparing = false, had_result = false;
+  const bool comparing = !m.comparing.empty(), result = m.compare && (m.compare->valid || !m.compare->error.empty());
+  const bool show_compare = (comparing && !was_comparing) || (result && !had_result);
+  was_comparing = comparing;
+  had_result = result;
+  if (!ImGui::BeginTabBar("sections")) return;
+  if (section_tab("Rendering", false)) {
+    render_panel(m, s);
+    ImGui::EndTabItem();
+  }
+  if (section_tab("Compare", show_compare)) {
+    compare_panel(m, s, a);
+    ImGui::EndTabItem();
+  }
+  if (section_tab("Camera path", false)) {
+    keyframe_panel(m, a, keys, key_fields);
+    ImGui::EndTabItem();
+  }
+  if (section_tab("Overlay & output", false)) {
+    overlay_panel(m, s, a, export_folder);
+    ImGui::EndTabItem();
+  }
+  ImGui::EndTabBar();
+}
+
 }  // namespace
 
-void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer, std::string& export_folder) {
+void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer, std::string& export_folder,
+                 PathEditor& keys, PathFields& key_fields) {
   g_ui = m.ui_scale;
   ImGui::SetNextWindowPos(ImVec2(ui(10), ui(10)), ImGuiCond_FirstUseEver);
   const ImGuiViewport* vp = ImGui::GetMainViewport();
@@ -571,14 +751,18 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   fitted_for = scene_key;
   ImGui::SetNextWindowBgAlpha(0.85f);
   ImGui::Begin("flashgs-viewer");
+  keep_inside_viewport("panel corner");
   panel_width = ImGui::GetWindowSize().x;
   const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
   ImGui::PushItemWidth(ImGui::GetWindowWidth() * 0.5f);  // leaves room for the labels
   scene_panel(m, s, a, path_buffer);
   view_panel(m, s, a);
-  render_panel(m, s);
-  compare_panel(m, s, a);
-  overlay_panel(m, s, a, export_folder);
+  section_tabs(m, s, a, export_folder, keys, key_fields);
+  // The last notice (a screenshot saved, a key added, a refusal) under the tabs, whichever is open.
+  if (!m.status.empty()) {
+    ImGui::Separator();
+    ImGui::TextWrapped("%s", m.status.c_str());
+  }
   if (ImGui::Button("Keys and mouse (F1)")) s.show_help = !s.show_help;
   ImGui::SameLine();
   ImGui::TextDisabled("Tab hides the panels");
@@ -586,7 +770,12 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   ImGui::End();
   stats_window(m);
   load_window(m, a);
-  hud_line(m, panel_right);
+  g_panel_right = panel_right;
+}
+
+void draw_legend_labels(const UiModel& m, const ViewerSettings& s) {
+  g_ui = m.ui_scale;
+  if (s.heatmap && !m.compare_shown) legend_labels(m, s);
 }
 
 void draw_overlays(const UiModel& m, ViewerSettings& s) {
@@ -595,6 +784,8 @@ void draw_overlays(const UiModel& m, ViewerSettings& s) {
   compare_labels(m, s);
   draw_help_window(&s.show_help, m.ui_scale);
   if (!s.show_ui) draw_hidden_panels_hint(m.ui_scale);
+  // With the panels hidden (Tab) too: the rate and the render size are what one hides them to watch.
+  hud_line(m, s.show_ui ? g_panel_right : ImGui::GetMainViewport()->WorkPos.x - ui(12));
 }
 
 }  // namespace flashgs::viewer

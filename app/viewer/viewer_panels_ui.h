@@ -6,6 +6,7 @@
 
 #include "compare_mode.h"
 #include "heatmap_legend.h"
+#include "path_editor.h"
 #include "flashgs/stats.h"
 #include "stats_history.h"
 #include "viewer_settings.h"
@@ -38,7 +39,7 @@ struct UiModel {
   LoadView load;                  // its progress
   const std::vector<std::string>* recent = nullptr;  // recently opened scenes, newest first
   int current_camera = -1;        // the scene camera the view sits on, -1 when moved
-  bool on_scene_camera = false;
+  std::string view_description;   // CameraController::view_description
   bool playing = false;
   int render_width = 0, render_height = 0;
   double fps = 0;                 // finished frames per second over the last second (0: idle)
@@ -49,6 +50,7 @@ struct UiModel {
   const CompareResult* compare = nullptr;
   std::string comparing;          // the comparison running now ("flash vs baseline at WxH"), if any
   double compare_elapsed_s = 0;   // for how long it has run
+  int compare_renders_done = 0, compare_renders_total = 0;  // and how far it is
   std::uint32_t heatmap_max = 0;  // the scale's top (locked or this frame's)
   int tile_size = 16;
   bool compare_shown = false;     // the split or difference image is on screen
@@ -67,6 +69,7 @@ struct UiModel {
 
 struct UiActions {
   std::string open_path;          // non-empty: load this scene
+  bool path_entered = false;      // ...sent with Enter from the path field, where the typing goes on
   int lod_level = -1;             // >= 0: load this level of the current SOG LOD set
   bool cancel_load = false;       // stop waiting for the scene being loaded
   int snap_camera = -1;           // >= 0: go to this camera
@@ -81,15 +84,32 @@ struct UiActions {
   std::string export_folder;      // non-empty: export the camera path into this folder
   bool cancel_export = false;
   bool screenshot = false;        // save the rendered image under a timestamped name in the folder
+  // The keyframed camera path (PathEditor): what needs the view or the files.
+  bool add_key = false;           // I: the view as a new key
+  bool replace_key = false;       // the selected key takes the view
+  bool delete_key = false;
+  int select_key = -1;            // >= 0: select this key and show its view
+  bool save_keys = false, load_keys = false;  // to / from the path file field
+  bool toggle_preview = false;
+  std::string render_keys_folder; // non-empty: render the keyed path's frames into this folder
+};
+
+// The text fields of the camera-path section, kept between frames.
+struct PathFields {
+  std::string file;    // the path file
+  std::string folder;  // where its frames are rendered
 };
 
 // Draws every panel for this frame (the caller puts typed values back in range afterwards:
 // keep_settings_valid). `path_buffer` and `export_buffer` hold the text fields' contents
 // between frames.
+// `keys` is the authored camera path: its timing, easing and render settings are edited in place.
 void draw_panels(const UiModel& model, ViewerSettings& settings, UiActions& actions, std::string& path_buffer,
-                 std::string& export_buffer);
+                 std::string& export_buffer, PathEditor& keys, PathFields& key_fields);
 // What stays on screen with the panels hidden too: the heat-map legend, the comparison's
 // labels, the help window and the hint that the panels are hidden.
 void draw_overlays(const UiModel& model, ViewerSettings& settings);
+// The heat-map legend's caption, tick marks and values alone (a screenshot with the overlay).
+void draw_legend_labels(const UiModel& model, const ViewerSettings& settings);
 
 }  // namespace flashgs::viewer

@@ -37,6 +37,7 @@ void ViewerApp::install_scene(LoadedScene scene) {
   }
   stop_path_export("stopped", ": another scene was opened");  // its frames follow the old scene's cameras
   m_camera_path = std::make_unique<CameraPath>(m_scene.cameras);
+  m_coarse_next_frame = true;  // something on screen soon: the full frame of a large scene takes seconds
   m_playing = false;
   m_camera_index = -1;
   m_compare = {};

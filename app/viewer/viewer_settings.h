@@ -1,6 +1,8 @@
 // ViewerSettings: every user-facing choice of the viewer in one plain struct (the UI and the script both edit it), with the range of each value.
 #pragma once
 
+#include <cstddef>
+
 #include <string>
 
 #include "flashgs/options.h"
@@ -15,6 +17,9 @@ enum class CompareView { numbers, split, difference };
 // The up-axis choices of the View panel and --up: 0 is "auto" (guessed from the cameras).
 inline constexpr const char* kUpAxisNames[] = {"auto", "+x", "-x", "+y", "-y", "+z", "-z"};
 inline constexpr int kUpAxisCount = 7;
+// The most centres the "Gaussian centres" view draws (a dot per Gaussian of a multi-million
+// scene would cost more than its frame under llvmpipe).
+inline constexpr std::size_t kMaxCentreMarks = 200000;
 // The comparison's two configurations by default: baseline | current (compare_mode.h lists them all).
 inline constexpr int kCompareCurrent = 0, kCompareBaseline = 1;
 
@@ -62,6 +67,7 @@ struct ViewerSettings {
   int up_axis = 0;                  // index into kUpAxisNames
   bool show_grid = false;           // ground grid and axes over the image (G)
   bool show_frustums = false;       // the training cameras as frustums, clickable
+  bool show_centres = false;        // the Gaussians' centres as dots (a debug view; kMaxCentreMarks)
   bool heatmap_lock_max = false;    // keep the heat map's maximum while switching configurations
   bool screenshot_overlay = false;  // screenshots show the heat map as the window does
   std::string screenshot_folder;    // where F12 saves (timestamped names); empty: working directory

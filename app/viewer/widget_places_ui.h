@@ -8,5 +8,7 @@ void set_widget_place_logging(bool on);
 
 // After an ImGui item: logs `widget "NAME" at X,Y` (window coordinates, the cursor's) when its place changed.
 void note_widget_place(const char* name);
+// The same for something drawn outside ImGui's items (the status line), given its corners.
+void note_drawn_place(const char* name, float x0, float y0, float x1, float y1);
 
 }  // namespace flashgs::viewer

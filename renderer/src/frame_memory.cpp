@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <fstream>
 #include <sstream>
 
@@ -118,9 +119,16 @@ std::string format_bytes(std::uint64_t bytes) {
   char text[32];
   if (bytes >= 1000000000ull)
     std::snprintf(text, sizeof text, "%.1f GB", bytes / 1e9);
+  else if (bytes < 1000000ull)
+    std::snprintf(text, sizeof text, "%llu bytes", static_cast<unsigned long long>(bytes));
   else
     std::snprintf(text, sizeof text, "%.1f MB", bytes / 1e6);
   return text;
+}
+
+std::uint64_t byte_count(double bytes) {
+  if (!(bytes > 0)) return 0;
+  return bytes >= 18446744073709551615.0 ? std::numeric_limits<std::uint64_t>::max() : static_cast<std::uint64_t>(bytes);
 }
 
 std::string frame_memory_shortfall(const FrameMemory& need, int width, int height, const AvailableMemory& available) {

@@ -14,6 +14,7 @@
 
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
+#include "flashgs/frame_memory.h"
 #include "flashgs/io.h"
 #include "format_readers.h"
 #include "kernel_marks.h"
@@ -287,8 +288,8 @@ std::unique_ptr<RecordSource> binary_source(const Header& header, std::size_t ve
   if (vertex.count > (available - offset) / vertex.record_size)
     fail(name, "the header declares " + std::to_string(vertex.count) + " vertices of " +
                    std::to_string(vertex.record_size) + " bytes (" +
-                   std::to_string(static_cast<double>(vertex.count) * vertex.record_size / 1e6) +
-                   " MB) but the file holds only " + std::to_string(available - offset) +
+                   format_bytes(byte_count(static_cast<double>(vertex.count) * vertex.record_size)) +
+                   ") but the file holds only " + std::to_string(available - offset) +
                    " bytes after the header: truncated file or wrong vertex count");
   std::size_t expected = offset + vertex.count * vertex.record_size;
   for (std::size_t i = vertex_index + 1; i < header.elements.size(); ++i)

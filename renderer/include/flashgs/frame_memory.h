@@ -46,7 +46,10 @@ std::uint64_t system_available_memory();
 // empty when it fits (or the available memory is unknown).
 std::string frame_memory_shortfall(const FrameMemory& need, int width, int height, const AvailableMemory& available);
 
-// "12.3 GB", "512.0 MB": a byte count for messages.
+// "12.3 GB", "512.0 MB", "2728 bytes": a byte count for messages.
 std::string format_bytes(std::uint64_t bytes);
+// A byte count computed in floating point (a header's count times a record size), saturated
+// at the largest std::uint64_t for format_bytes.
+std::uint64_t byte_count(double bytes);
 
 }  // namespace flashgs
