@@ -108,11 +108,10 @@ py::object report_dict(const PyScene& s) {
 }
 
 void save(const PyScene& s, const std::string& path) {
-  const SceneWriter write = scene_writer_for(path);
-  if (!write)
-    throw Error(path + ": unknown scene format (the extension picks it: " + writable_scene_extensions() + ")");
+  if (!writable_format_for(path))
+    throw Error(path + ": unknown scene format (the name picks it: " + writable_scene_extensions() + ")");
   py::gil_scoped_release unlocked;
-  write(*s.scene, path);
+  save_scene_file(*s.scene, path);
 }
 
 }  // namespace
