@@ -293,6 +293,53 @@ TEST(Spz, HostileFilesGetOneClearMessage) {
   }
 }
 
+// A gzip stream whose own header is corrupt is an SPZ file that is corrupt, not "no scene file".
+TEST(Spz, CorruptGzipHeaderIsSaidSo) {
+  std::mt19937 rng(5);
+  std::string file = test::spz_gzip_file(test::random_spz(4, 0, 3, rng));
+  file[2] = 7;  // the compression method: 8 is deflate
+  EXPECT_TRUE(looks_like_spz(file.data(), file.size()));
+  const std::string message = error_of([&] { parse_scene_bytes(file.data(), file.size(), "bad.spz"); });
+  EXPECT_EQ(message.rfind("bad.spz: ", 0), 0u) << message;
+  EXPECT_NE(message.find("gzip data is corrupt"), std::string::npos) << message;
+}
+
+// A zstd frame (one raw block of `data`) whose header asks for a window of 2^window_log bytes.
+std::string zstd_frame_with_window(const std::vector<std::uint8_t>& data, int window_log) {
+  std::string frame = "\x28\xb5\x2f\xfd";
+  frame.push_back(0);                                         // no content size, no checksum
+  frame.push_back(static_cast<char>((window_log - 10) << 3));  // window descriptor: exponent only
+  const std::uint32_t block = static_cast<std::uint32_t>(data.size()) << 3 | 1;  // raw, last
+  for (int i = 0; i < 3; ++i) frame.push_back(static_cast<char>(block >> (8 * i) & 0xff));
+  return frame + std::string(data.begin(), data.end());
+}
+
+// The 128 MB window limit is a size limit, and the message says so.
+TEST(Spz, ZstdWindowAboveTheLimitIsSaidTooLarge) {
+  std::mt19937 rng(6);
+  const test::SpzContent c = test::random_spz(3, 0, 4, rng);
+  const std::string good = test::spz_v4_file(c);
+  // Replace the positions' frame (the first) by one of the same bytes that asks for 256 MB.
+  const auto u64 = [&good](std::size_t at) {
+    std::uint64_t v = 0;
+    for (int i = 7; i >= 0; --i) v = v << 8 | static_cast<unsigned char>(good[at + i]);
+    return v;
+  };
+  const std::size_t frames_at = 32 + 5 * 16, first = static_cast<std::size_t>(u64(32));
+  for (int window_log : {27, 28}) {
+    const std::string frame = zstd_frame_with_window(c.attribute[0], window_log);
+    std::string file = good.substr(0, frames_at) + frame + good.substr(frames_at + first);
+    for (int i = 0; i < 8; ++i) file[32 + i] = static_cast<char>(std::uint64_t(frame.size()) >> (8 * i) & 0xff);
+    if (window_log == 27) {  // at the limit: read
+      EXPECT_EQ(parse_spz(file.data(), file.size(), "window.spz").size(), 3u);
+      continue;
+    }
+    const std::string message = error_of([&] { parse_spz(file.data(), file.size(), "window.spz"); });
+    EXPECT_NE(message.find("window larger than the 128 MB"), std::string::npos) << message;
+    EXPECT_EQ(message.find("corrupt"), std::string::npos) << message;
+  }
+}
+
 // ---------------------------------------------------------------- SOG against its twin
 
 std::string playbot() { return formats_dir() + "/playbot_sog"; }

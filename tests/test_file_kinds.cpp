@@ -200,6 +200,20 @@ TEST(SceneLocation, ATrainingOutputFolder) {
   EXPECT_EQ(locate_scene(latest.string()).cameras, (model / "cameras.json").string());
 }
 
+// Iteration numbers past 64 bits (19 digits and more) still compare as numbers.
+TEST(SceneLocation, ATrainingOutputWithIterationNumbersOfAnyLength) {
+  const fs::path model = fresh_dir("training_output_long");
+  for (const char* iteration : {"iteration_999999999999999999", "iteration_1000000000000000000",
+                                "iteration_0000000000000000000000000000007"}) {
+    fs::create_directories(model / "point_cloud" / iteration);
+    write_file(model / "point_cloud" / iteration / "point_cloud.ply", small_ply());
+  }
+  const fs::path latest = model / "point_cloud" / "iteration_1000000000000000000";
+  EXPECT_EQ(locate_scene(model.string()).ply, (latest / "point_cloud.ply").string());
+  write_file(model / "cameras.json", demo_cameras_json());
+  EXPECT_EQ(locate_scene(latest.string()).cameras, (model / "cameras.json").string());
+}
+
 TEST(SceneLocation, WhatIsNoScene) {
   SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const fs::path dir = fresh_dir("no_scene");

@@ -269,8 +269,11 @@ bool looks_like_spz(const char* data, std::size_t size) {
     // Any gzip file starts so: the SPZ magic must open the stream as well. Without zlib a
     // gzip file is taken for SPZ, whose reader then says zlib is missing.
     if (!have_gzip_support()) return true;
-    const std::vector<std::uint8_t> start = gzip_peek(bytes, size, 4);
-    return start.size() == 4 && read_u32(start.data()) == kSpzMagic;
+    // A corrupt stream is taken for SPZ too, so that its reader says "corrupt gzip" rather
+    // than the file being no scene at all.
+    bool corrupt = false;
+    const std::vector<std::uint8_t> start = gzip_peek(bytes, size, 4, &corrupt);
+    return corrupt || (start.size() == 4 && read_u32(start.data()) == kSpzMagic);
   }
   return size >= 8 && read_u32(bytes) == kSpzMagic;
 }
