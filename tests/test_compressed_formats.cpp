@@ -413,7 +413,11 @@ TEST(SogLod, DefaultLevelIsTheFinestThatFits) {
   EXPECT_EQ(choose_sog_lod_level(set, 2 * finest), 0);
   EXPECT_EQ(choose_sog_lod_level(set, 2 * finest - 1), 1);
   EXPECT_EQ(choose_sog_lod_level(set, 2 * middle - 1), 2);
-  EXPECT_EQ(choose_sog_lod_level(set, 1), 2);  // none fits: the coarsest
+  // None fits: refused with the figures, not the coarsest taken anyway.
+  set.path = "set/lod-meta.json";
+  const std::string message = error_of([&] { choose_sog_lod_level(set, 1); });
+  EXPECT_EQ(message.rfind("set/lod-meta.json: no level fits", 0), 0u) << message;
+  EXPECT_NE(message.find("250 Gaussians"), std::string::npos) << message;
 }
 
 // ---------------------------------------------------------------- SOG by hand
@@ -586,6 +590,19 @@ TEST(SogLod, HostileLodMetaGetsOneClearMessage) {
       {"missing chunk", [](nlohmann::json& j) { j["filenames"][0] = "9_9/meta.json"; }, "cannot open"},
       {"no tree", [](nlohmann::json& j) { j.erase("tree"); }, "not a SOG lod-meta.json"},
       {"no levels", [](nlohmann::json& j) { j["lodLevels"] = 0; }, "no level"},
+      {"overlapping leaves", [](nlohmann::json& j) {
+         j["tree"]["children"][0]["lods"]["0"]["count"] = 24;
+         j["tree"]["children"][1]["lods"]["0"] = {{"file", 0}, {"offset", 0}, {"count", 24}};
+       }, "level 0 takes Gaussians 0..23 of 0_0/meta.json in two leaves"},
+      {"a gap between leaves", [](nlohmann::json& j) { j["tree"]["children"][1]["lods"]["0"]["offset"] = 21; j["tree"]["children"][1]["lods"]["0"]["count"] = 29; },
+       "level 0 leaves Gaussians 20..20 of 0_0/meta.json (50 Gaussians) in no leaf"},
+      {"the chunk's end in no leaf", [](nlohmann::json& j) { j["tree"]["children"][1]["lods"]["0"]["count"] = 6; },
+       "leaves Gaussians 26..49"},
+      {"200,000 leaves taking the whole chunk each", [](nlohmann::json& j) {
+         const nlohmann::json leaf = {{"lods", {{"0", {{"file", 0}, {"offset", 0}, {"count", 50}}}}}};
+         j["tree"]["children"] = nlohmann::json::array();
+         for (int i = 0; i < 200000; ++i) j["tree"]["children"].push_back(leaf);
+       }, "in two leaves"},
   };
   for (const Case& c : cases) {
     nlohmann::json spoilt = good;
@@ -594,6 +611,10 @@ TEST(SogLod, HostileLodMetaGetsOneClearMessage) {
     const std::string message = error_of([&] { read_sog_lod(path, 0); });
     EXPECT_NE(message.find(c.expected), std::string::npos) << c.what << ": " << message;
     EXPECT_NE(message.find("hostile_lod"), std::string::npos) << c.what << ": " << message;
+    // The set's description (info, the level choice) checks the same.
+    if (c.expected == std::string("in two leaves")) {
+      EXPECT_NE(error_of([&] { describe_sog_lod(path); }).find(c.expected), std::string::npos) << c.what;
+    }
   }
   std::ofstream(path) << good.dump();
   EXPECT_NE(error_of([&] { read_sog_lod(path, 1); }).find("level 1 does not exist"), std::string::npos);
