@@ -13,6 +13,7 @@
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
 #include "flashgs/frame_memory.h"
+#include "format_readers.h"
 #include "kernel_marks.h"
 
 namespace flashgs {
@@ -262,6 +263,22 @@ Scene unpack(const Packed& packed, const Header& header, const std::string& name
 }
 
 }  // namespace
+
+DeclaredScene declare_spz(const char* start, std::size_t start_size, const std::string& name) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(start);
+  std::vector<std::uint8_t> head;
+  if (start_size >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b)
+    head = gzip_peek(bytes, start_size, kGzipHeaderBytes);
+  else
+    head.assign(bytes, bytes + std::min(start_size, kV4HeaderBytes));
+  if (head.size() < kGzipHeaderBytes) return {};  // the reader says what is wrong
+  const Header header = parse_header(head.data(), name);
+  DeclaredScene declared;
+  declared.gaussians = header.count;
+  declared.sh_degree = std::min(header.sh_degree, 3);
+  declared.extra_bytes_per_gaussian = Layout(header).total();
+  return declared;
+}
 
 bool looks_like_spz(const char* data, std::size_t size) {
   const auto* bytes = reinterpret_cast<const unsigned char*>(data);
