@@ -458,6 +458,28 @@ TEST(CliConvert, ConvertsBetweenTheFormats) {
     EXPECT_EQ(entry.path().string().find(".partial"), std::string::npos) << entry.path();
 }
 
+// A .splat scale may be negative; PLY stores log scales: the conversion says how many
+// Gaussians it changes, and the PLY holds them all, with finite scales of the same size.
+TEST(CliConvert, NegativeScalesAreNamedAndKept) {
+  const std::string dir = scratch_dir("convert_negative");
+  std::string records;
+  for (int i = 0; i < 16; ++i) {
+    const float values[6] = {0.1f * i, 0.0f, 2.0f, i < 4 ? -0.05f : 0.05f, 0.05f, 0.05f};
+    records.append(reinterpret_cast<const char*>(values), sizeof values);
+    records += std::string("\xc8\x64\x32\xff\xff\x80\x80\x80", 8);
+  }
+  std::ofstream(dir + "/negative.splat", std::ios::binary) << records;
+  const CliResult result = run_cli("convert " + dir + "/negative.splat " + dir + "/negative.ply");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("note: 4 of 16 Gaussians of " + dir + "/negative.splat have a negative scale"),
+            std::string::npos) << result.output;
+  LoadReport report;
+  const Scene back = load_ply(dir + "/negative.ply", &report);
+  EXPECT_EQ(back.size(), 16u);
+  EXPECT_EQ(report.dropped_non_finite, 0u);
+  EXPECT_NEAR(back.scales[0], 0.05f, 1e-7f);
+}
+
 TEST(CliConvert, BadOutputsAreRefusedBeforeReading) {
   const std::string dir = scratch_dir("convert_bad");
   ASSERT_EQ(run_cli("generate demo --count 300 -o " + dir).exit_code, 0);

@@ -49,6 +49,11 @@ void run(const ConvertArgs& args) {
                  "with --kernel %s\n",
                  input_file.c_str(), scene.trained_kernel.kernel.description().c_str(),
                  scene.trained_kernel.source.c_str(), scene.trained_kernel.kernel.spec().c_str());
+  if (const std::size_t negative = write == save_ply ? count_negative_scales(scene) : 0)
+    std::fprintf(stderr,
+                 "note: %zu of %zu Gaussians of %s have a negative scale, which PLY's log scales cannot hold; "
+                 "written as its magnitude (the same ellipsoid)\n",
+                 negative, scene.size(), input_file.c_str());
   write(scene, args.output);
   std::printf("read %s (%s, %zu Gaussians, SH degree %d, decoded in %.3f s), wrote %s\n", input_file.c_str(),
               report.format.c_str(), scene.size(), scene.sh_degree, report.decode_seconds, args.output.c_str());
