@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <map>
 #include <sstream>
 #include <string>
@@ -279,9 +280,10 @@ TEST(CliMemory, FrameTooLargeForTheAddressSpaceIsRefused) {
 }
 
 // A frame whose image is small but whose Gaussian-tile pairs are not: 20000 Gaussians, each
-// covering all 8192 tiles of a 2048x1024 frame, are 164M pairs (2 GB) that run out of address
-// space inside the emit stage's parallel region. That is an error naming the frame, exit 2.
-TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
+// covering all 8192 tiles of a 2048x1024 frame, are 164M pairs (2 GB) that ran out of address
+// space inside the emit stage's parallel region. They are counted from the projected boxes and
+// refused before emit allocates them: an error naming the frame and the figures, exit 2.
+TEST(CliMemory, PairsThatCannotFitAreRefusedBeforeTheyAreMade) {
   SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const std::string dir = scratch_dir("pairs_oom");
   test::PlyBuilder b = test::PlyBuilder::inria(0, 20000);
@@ -294,8 +296,36 @@ TEST(CliMemory, OutOfMemoryInsideAParallelRegionIsAnError) {
   const CliResult r = run_cli("render " + dir + "/point_cloud.ply --backend cpu --eye 0,0,-5 --look-at 0,0,0 " +
                                   "-r 2048x1024 -o " + dir + "/x.ppm",
                               {std::size_t{1} << 30});
-  expect_one_line_error(r, "out of memory for a 2048x1024 frame", "pairs out of memory");
+  expect_one_line_error(r, "cpu renderer: a 2048x1024 frame of these 20000 visible Gaussians would make about 0.164 "
+                           "billion Gaussian-tile pairs", "pairs out of memory");
   EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("is available (the address-space limit, RLIMIT_AS)"), std::string::npos) << r.output;
+}
+
+// 50,000 needles: the baseline's square boxes give them 3DGS's pairs, far more than flash's
+// ellipses touch. Under a 2 GB address-space limit the baseline frame is refused with its
+// exact count before any pair is made, and flash renders the same frame.
+TEST(CliMemory, BaselineNeedlesAreRefusedWhereFlashRenders) {
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
+  const std::string dir = scratch_dir("needles");
+  test::PlyBuilder b = test::PlyBuilder::inria(0, 50000);
+  std::mt19937 rng(51);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (auto& v : b.vertices) {
+    for (const char* axis : {"x", "y", "z"}) v[b.index_of(axis)] = unit(rng);
+    v[b.index_of("scale_0")] = 0.5;
+    v[b.index_of("scale_1")] = v[b.index_of("scale_2")] = -9.0;
+    v[b.index_of("opacity")] = 3.0;
+    for (const char* r : {"rot_0", "rot_1", "rot_2", "rot_3"}) v[b.index_of(r)] = unit(rng);
+  }
+  std::ofstream(dir + "/needles.ply", std::ios::binary) << b.bytes();
+  const std::string render = "render " + dir + "/needles.ply --backend cpu --eye 0,0,-5 --look-at 0,0,0 -o " + dir;
+  const CliResult baseline = run_cli(render + "/baseline.ppm -a baseline", {std::size_t{2} << 30});
+  expect_one_line_error(baseline, "cpu renderer: a 1920x1080 frame of these", "baseline needles");
+  EXPECT_NE(baseline.output.find("visible Gaussians would make 0."), std::string::npos) << baseline.output;
+  EXPECT_FALSE(fs::exists(dir + "/baseline.ppm"));
+  const CliResult flash = run_cli(render + "/flash.ppm", {std::size_t{2} << 30});
+  EXPECT_EQ(flash.exit_code, 0) << flash.output;
 }
 
 // A keyframed path round trip: written, read by `render --path`, and its frames at the two
@@ -531,6 +561,28 @@ TEST(CliConvert, TheNamePicksTheFormatAndTheLossIsPrinted) {
   expect_one_line_error(run_cli("convert " + ply + " " + dir + "/y.spz --spz-axes opengl"), "--spz-axes", "bad axes");
   expect_one_line_error(run_cli("convert " + ply + " " + dir + "/y.spz --spz-version 2"), "--spz-version", "bad version");
   EXPECT_FALSE(fs::exists(dir + "/y.spz"));
+}
+
+// A .splat scale may be negative; PLY stores log scales: the conversion says how many
+// Gaussians it changes, and the PLY holds them all, with finite scales of the same size.
+TEST(CliConvert, NegativeScalesAreNamedAndKept) {
+  const std::string dir = scratch_dir("convert_negative");
+  std::string records;
+  for (int i = 0; i < 16; ++i) {
+    const float values[6] = {0.1f * i, 0.0f, 2.0f, i < 4 ? -0.05f : 0.05f, 0.05f, 0.05f};
+    records.append(reinterpret_cast<const char*>(values), sizeof values);
+    records += std::string("\xc8\x64\x32\xff\xff\x80\x80\x80", 8);
+  }
+  std::ofstream(dir + "/negative.splat", std::ios::binary) << records;
+  const CliResult result = run_cli("convert " + dir + "/negative.splat " + dir + "/negative.ply");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("note: 4 of 16 Gaussians of " + dir + "/negative.splat have a negative scale"),
+            std::string::npos) << result.output;
+  LoadReport report;
+  const Scene back = load_ply(dir + "/negative.ply", &report);
+  EXPECT_EQ(back.size(), 16u);
+  EXPECT_EQ(report.dropped_non_finite, 0u);
+  EXPECT_NEAR(back.scales[0], 0.05f, 1e-7f);
 }
 
 TEST(CliConvert, BadOutputsAreRefusedBeforeReading) {

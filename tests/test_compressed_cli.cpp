@@ -24,9 +24,10 @@ struct CliRun {
   std::string output;  // stdout and stderr
 };
 
-CliRun flashgs(const std::string& arguments) {
+// `shell_first`: shell commands run before flashgs (a ulimit).
+CliRun flashgs(const std::string& arguments, const std::string& shell_first = "") {
   CliRun r;
-  FILE* pipe = popen((std::string(FLASHGS_CLI) + " " + arguments + " 2>&1").c_str(), "r");
+  FILE* pipe = popen((shell_first + std::string(FLASHGS_CLI) + " " + arguments + " 2>&1").c_str(), "r");
   if (!pipe) return r;
   char buffer[4096];
   for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) r.output.append(buffer, n);
@@ -48,6 +49,35 @@ std::string output_dir() {
   const fs::path dir = fs::path(FLASHGS_TEST_OUTPUT_DIR) / "compressed_cli";
   fs::create_directories(dir);
   return dir.string();
+}
+
+// An SPZ that honestly declares 12M Gaussians in a few hundred KB (a gzip of zeros): loading
+// them fits under a 2 GB address-space limit, a 1920x1080 frame of them on top does not. The
+// render is refused from the header, before anything is inflated, naming the file and figures.
+TEST(CompressedCli, DeclaredGaussiansWithoutRoomForAFrameAreRefusedBeforeLoading) {
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
+  const std::string path = output_dir() + "/zeros.spz";
+  test::SpzContent header;
+  header.count = 12000000;  // version 3, SH degree 0: 20 bytes each
+  const std::string head = test::spz_payload(header);
+  gzFile out = gzopen(path.c_str(), "wb");
+  ASSERT_NE(out, nullptr);
+  gzwrite(out, head.data(), static_cast<unsigned>(head.size()));
+  const std::string zeros(1 << 20, '\0');
+  for (std::size_t left = std::size_t{20} * header.count; left > 0;) {
+    const std::size_t n = std::min(left, zeros.size());
+    gzwrite(out, zeros.data(), static_cast<unsigned>(n));
+    left -= n;
+  }
+  ASSERT_EQ(gzclose(out), Z_OK);
+  const CliRun r = flashgs("render " + path + " --backend cpu --eye 0,0,-5 --look-at 0,0,0 -o " + output_dir() +
+                               "/zeros.png",
+                           "ulimit -v 2000000; ");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("zeros.spz: 12000000 Gaussians need about 912."), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("for a 1920x1080 frame (the camera's size), but "), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(output_dir() + "/zeros.png"));
 }
 
 TEST(CompressedCli, InfoAndRenderOpenBikerSpz) {

@@ -293,6 +293,53 @@ TEST(Spz, HostileFilesGetOneClearMessage) {
   }
 }
 
+// A gzip stream whose own header is corrupt is an SPZ file that is corrupt, not "no scene file".
+TEST(Spz, CorruptGzipHeaderIsSaidSo) {
+  std::mt19937 rng(5);
+  std::string file = test::spz_gzip_file(test::random_spz(4, 0, 3, rng));
+  file[2] = 7;  // the compression method: 8 is deflate
+  EXPECT_TRUE(looks_like_spz(file.data(), file.size()));
+  const std::string message = error_of([&] { parse_scene_bytes(file.data(), file.size(), "bad.spz"); });
+  EXPECT_EQ(message.rfind("bad.spz: ", 0), 0u) << message;
+  EXPECT_NE(message.find("gzip data is corrupt"), std::string::npos) << message;
+}
+
+// A zstd frame (one raw block of `data`) whose header asks for a window of 2^window_log bytes.
+std::string zstd_frame_with_window(const std::vector<std::uint8_t>& data, int window_log) {
+  std::string frame = "\x28\xb5\x2f\xfd";
+  frame.push_back(0);                                         // no content size, no checksum
+  frame.push_back(static_cast<char>((window_log - 10) << 3));  // window descriptor: exponent only
+  const std::uint32_t block = static_cast<std::uint32_t>(data.size()) << 3 | 1;  // raw, last
+  for (int i = 0; i < 3; ++i) frame.push_back(static_cast<char>(block >> (8 * i) & 0xff));
+  return frame + std::string(data.begin(), data.end());
+}
+
+// The 128 MB window limit is a size limit, and the message says so.
+TEST(Spz, ZstdWindowAboveTheLimitIsSaidTooLarge) {
+  std::mt19937 rng(6);
+  const test::SpzContent c = test::random_spz(3, 0, 4, rng);
+  const std::string good = test::spz_v4_file(c);
+  // Replace the positions' frame (the first) by one of the same bytes that asks for 256 MB.
+  const auto u64 = [&good](std::size_t at) {
+    std::uint64_t v = 0;
+    for (int i = 7; i >= 0; --i) v = v << 8 | static_cast<unsigned char>(good[at + i]);
+    return v;
+  };
+  const std::size_t frames_at = 32 + 5 * 16, first = static_cast<std::size_t>(u64(32));
+  for (int window_log : {27, 28}) {
+    const std::string frame = zstd_frame_with_window(c.attribute[0], window_log);
+    std::string file = good.substr(0, frames_at) + frame + good.substr(frames_at + first);
+    for (int i = 0; i < 8; ++i) file[32 + i] = static_cast<char>(std::uint64_t(frame.size()) >> (8 * i) & 0xff);
+    if (window_log == 27) {  // at the limit: read
+      EXPECT_EQ(parse_spz(file.data(), file.size(), "window.spz").size(), 3u);
+      continue;
+    }
+    const std::string message = error_of([&] { parse_spz(file.data(), file.size(), "window.spz"); });
+    EXPECT_NE(message.find("window larger than the 128 MB"), std::string::npos) << message;
+    EXPECT_EQ(message.find("corrupt"), std::string::npos) << message;
+  }
+}
+
 // ---------------------------------------------------------------- SOG against its twin
 
 std::string playbot() { return formats_dir() + "/playbot_sog"; }
@@ -366,7 +413,11 @@ TEST(SogLod, DefaultLevelIsTheFinestThatFits) {
   EXPECT_EQ(choose_sog_lod_level(set, 2 * finest), 0);
   EXPECT_EQ(choose_sog_lod_level(set, 2 * finest - 1), 1);
   EXPECT_EQ(choose_sog_lod_level(set, 2 * middle - 1), 2);
-  EXPECT_EQ(choose_sog_lod_level(set, 1), 2);  // none fits: the coarsest
+  // None fits: refused with the figures, not the coarsest taken anyway.
+  set.path = "set/lod-meta.json";
+  const std::string message = error_of([&] { choose_sog_lod_level(set, 1); });
+  EXPECT_EQ(message.rfind("set/lod-meta.json: no level fits", 0), 0u) << message;
+  EXPECT_NE(message.find("250 Gaussians"), std::string::npos) << message;
 }
 
 // ---------------------------------------------------------------- SOG by hand
@@ -539,6 +590,19 @@ TEST(SogLod, HostileLodMetaGetsOneClearMessage) {
       {"missing chunk", [](nlohmann::json& j) { j["filenames"][0] = "9_9/meta.json"; }, "cannot open"},
       {"no tree", [](nlohmann::json& j) { j.erase("tree"); }, "not a SOG lod-meta.json"},
       {"no levels", [](nlohmann::json& j) { j["lodLevels"] = 0; }, "no level"},
+      {"overlapping leaves", [](nlohmann::json& j) {
+         j["tree"]["children"][0]["lods"]["0"]["count"] = 24;
+         j["tree"]["children"][1]["lods"]["0"] = {{"file", 0}, {"offset", 0}, {"count", 24}};
+       }, "level 0 takes Gaussians 0..23 of 0_0/meta.json in two leaves"},
+      {"a gap between leaves", [](nlohmann::json& j) { j["tree"]["children"][1]["lods"]["0"]["offset"] = 21; j["tree"]["children"][1]["lods"]["0"]["count"] = 29; },
+       "level 0 leaves Gaussians 20..20 of 0_0/meta.json (50 Gaussians) in no leaf"},
+      {"the chunk's end in no leaf", [](nlohmann::json& j) { j["tree"]["children"][1]["lods"]["0"]["count"] = 6; },
+       "leaves Gaussians 26..49"},
+      {"200,000 leaves taking the whole chunk each", [](nlohmann::json& j) {
+         const nlohmann::json leaf = {{"lods", {{"0", {{"file", 0}, {"offset", 0}, {"count", 50}}}}}};
+         j["tree"]["children"] = nlohmann::json::array();
+         for (int i = 0; i < 200000; ++i) j["tree"]["children"].push_back(leaf);
+       }, "in two leaves"},
   };
   for (const Case& c : cases) {
     nlohmann::json spoilt = good;
@@ -547,6 +611,10 @@ TEST(SogLod, HostileLodMetaGetsOneClearMessage) {
     const std::string message = error_of([&] { read_sog_lod(path, 0); });
     EXPECT_NE(message.find(c.expected), std::string::npos) << c.what << ": " << message;
     EXPECT_NE(message.find("hostile_lod"), std::string::npos) << c.what << ": " << message;
+    // The set's description (info, the level choice) checks the same.
+    if (c.expected == std::string("in two leaves")) {
+      EXPECT_NE(error_of([&] { describe_sog_lod(path); }).find(c.expected), std::string::npos) << c.what;
+    }
   }
   std::ofstream(path) << good.dump();
   EXPECT_NE(error_of([&] { read_sog_lod(path, 1); }).find("level 1 does not exist"), std::string::npos);

@@ -1,9 +1,11 @@
-// Randomised mutation fuzzing of the SPZ and SOG readers under AddressSanitizer and UBSan:
+// Randomised mutation fuzzing of the SPZ and SOG readers (chunks and LOD trees) under AddressSanitizer and UBSan:
 // every mutated file must load to finite values or throw flashgs::Error, never crash, read out
 // of bounds or take memory its data cannot justify.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
 
 #include "compressed_builders.h"
@@ -122,6 +124,86 @@ TEST(SogFuzz, MutatedBundlesLoadOrFailCleanly) {
     expect_clean([&] { return parse_scene_bytes(copy.data(), copy.size(), "fuzz.sog"); }, loaded, rejected);
   }
   std::printf("SOG bundle fuzz: %d loaded, %d refused\n", loaded, rejected);
+  EXPECT_GT(loaded, 0);
+  EXPECT_GT(rejected, 0);
+}
+
+// A random change to a LOD tree's leaves: ranges that move, grow, shrink, repeat or name
+// another file or level; the readers must refuse any that no longer split the chunks exactly.
+void spoil_tree(nlohmann::json& tree, std::mt19937& rng) {
+  nlohmann::json& leaves = tree["children"];
+  nlohmann::json& leaf = leaves[rng() % leaves.size()];
+  nlohmann::json& range = leaf["lods"][rng() % 2 ? "0" : "1"];
+  const auto any = [&rng]() -> nlohmann::json {
+    switch (rng() % 4) {
+      case 0: return static_cast<int>(rng() % 120) - 10;
+      case 1: return std::uint64_t{1} << (rng() % 64);
+      case 2: return "7";
+      default: return static_cast<int>(rng() % 60);
+    }
+  };
+  switch (rng() % 6) {
+    case 0: range["offset"] = any(); break;
+    case 1: range["count"] = any(); break;
+    case 2: range["file"] = any(); break;
+    case 3: leaves.push_back(leaf); break;  // the same ranges twice
+    case 4: leaves.erase(rng() % leaves.size()); break;
+    default: leaf["lods"][std::to_string(rng() % 4)] = range;
+  }
+}
+
+TEST(SogLodFuzz, MutatedTreesLoadOrFailCleanly) {
+  namespace fs = std::filesystem;
+  std::mt19937 rng(20241203);
+  const fs::path folder = fs::path(FLASHGS_TEST_OUTPUT_DIR) / "fuzz_lod";
+  fs::remove_all(folder);
+  // Two levels of 40 and 12 Gaussians, each split between three leaves.
+  const std::size_t counts[2] = {40, 12};
+  for (int level = 0; level < 2; ++level) {
+    const test::SogChunk chunk = test::random_sog_chunk(counts[level], level, rng);
+    const fs::path dir = folder / (std::to_string(level) + "_0");
+    fs::create_directories(dir);
+    std::ofstream(dir / "meta.json") << chunk.meta.dump();
+    for (const auto& [name, bytes] : chunk.files)
+      std::ofstream(dir / name, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+  }
+  nlohmann::json good = {{"lodLevels", 2}, {"filenames", {"0_0/meta.json", "1_0/meta.json"}}};
+  good["tree"]["children"] = nlohmann::json::array();
+  const std::size_t splits[2][4] = {{0, 10, 25, 40}, {0, 4, 5, 12}};
+  for (int leaf = 0; leaf < 3; ++leaf) {
+    nlohmann::json lods;
+    for (int level = 0; level < 2; ++level)
+      lods[std::to_string(level)] = {{"file", level},
+                                     {"offset", splits[level][leaf]},
+                                     {"count", splits[level][leaf + 1] - splits[level][leaf]}};
+    good["tree"]["children"].push_back({{"lods", lods}});
+  }
+  const std::string path = (folder / "lod-meta.json").string();
+  int loaded = 0, rejected = 0;
+  for (int round = 0; round < 600; ++round) {
+    std::string text;
+    if (round == 0) {
+      text = good.dump();  // the seed itself loads
+    } else if (rng() % 3) {
+      nlohmann::json tree = good;
+      for (int edits = 1 + static_cast<int>(rng() % 3); edits > 0; --edits) spoil_tree(tree["tree"], rng);
+      text = tree.dump();
+    } else {
+      text = mutate(good.dump(), rng, 80);
+    }
+    std::ofstream(path, std::ios::trunc) << text;
+    const int level = static_cast<int>(rng() % 2);
+    expect_clean(
+        [&] {
+          const SogLodSet set = describe_sog_lod(path);
+          const Scene scene = read_sog_lod(path, level);
+          EXPECT_EQ(scene.size(), set.levels.at(level).gaussians);
+          EXPECT_EQ(scene.size(), counts[level]) << text;  // a level that loads holds its chunk exactly
+          return scene;
+        },
+        loaded, rejected);
+  }
+  std::printf("SOG LOD tree fuzz: %d loaded, %d refused\n", loaded, rejected);
   EXPECT_GT(loaded, 0);
   EXPECT_GT(rejected, 0);
 }

@@ -21,6 +21,7 @@
 #include "flashgs/file_access.h"
 #include "flashgs/load_progress.h"
 #include "flashgs/io.h"
+#include "flashgs/scene_formats.h"
 #include "ply_builder.h"
 #include "test_support.h"
 
@@ -131,6 +132,33 @@ TEST(FileKinds, CameraFileOverTheSizeLimit) {
   expect_refused([&] { load_cameras(path.string()); }, path, "the file is 65 MB, more than the 64 MB");
 }
 
+// A header that contradicts the file's size, or Gaussians that cannot fit in memory, are
+// refused from the file's start: a sparse 10 GB PLY or 3 GB .splat is never read whole (the
+// child may not grow past 2 GB, and reading either would need more).
+TEST(FileKinds, SizesAreCheckedBeforeTheFileIsRead) {
+  SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
+  const fs::path dir = fresh_dir("sparse_scenes");
+  const std::string ply = small_ply();
+  const std::string header = ply.substr(0, ply.find("end_header\n") + 11);
+  for (const std::uint64_t size : {3000000000ull, 10000000000ull}) {
+    const fs::path path = dir / ("sparse_" + std::to_string(size / 1000000000) + "gb.ply");
+    write_file(path, header);
+    fs::resize_file(path, size);
+    expect_refused([&] { load_scene_file(path.string()); }, path,
+                   "bytes after the header: the vertex count does not match the file size");
+  }
+  const fs::path splat = dir / "zeros.splat";
+  write_file(splat, "");
+  fs::resize_file(splat, 3000000000ull - 3000000000ull % 32);
+  expect_refused([&] { load_scene_file(splat.string()); }, splat,
+                 "93750000 Gaussians in 3.0 GB need about 8.2 GB of memory to load");
+  // What a file declares, without reading it.
+  const SceneDeclaration declared = declare_scene_file(splat.string());
+  EXPECT_EQ(declared.format, SceneFormat::splat);
+  EXPECT_EQ(declared.gaussians, 93750000u);
+  EXPECT_EQ(declared.file_bytes, 3000000000ull - 3000000000ull % 32);
+}
+
 TEST(FileKinds, UnreadableFile) {
   SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   const fs::path path = fresh_dir("unreadable") / "point_cloud.ply";
@@ -197,6 +225,20 @@ TEST(SceneLocation, ATrainingOutputFolder) {
   const SceneLocation location = locate_scene(model.string());
   EXPECT_EQ(location.ply, (latest / "point_cloud.ply").string());
   EXPECT_EQ(location.cameras, (model / "cameras.json").string());
+  EXPECT_EQ(locate_scene(latest.string()).cameras, (model / "cameras.json").string());
+}
+
+// Iteration numbers past 64 bits (19 digits and more) still compare as numbers.
+TEST(SceneLocation, ATrainingOutputWithIterationNumbersOfAnyLength) {
+  const fs::path model = fresh_dir("training_output_long");
+  for (const char* iteration : {"iteration_999999999999999999", "iteration_1000000000000000000",
+                                "iteration_0000000000000000000000000000007"}) {
+    fs::create_directories(model / "point_cloud" / iteration);
+    write_file(model / "point_cloud" / iteration / "point_cloud.ply", small_ply());
+  }
+  const fs::path latest = model / "point_cloud" / "iteration_1000000000000000000";
+  EXPECT_EQ(locate_scene(model.string()).ply, (latest / "point_cloud.ply").string());
+  write_file(model / "cameras.json", demo_cameras_json());
   EXPECT_EQ(locate_scene(latest.string()).cameras, (model / "cameras.json").string());
 }
 

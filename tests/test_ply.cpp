@@ -96,6 +96,22 @@ TEST(PlyLoad, ZeroQuaternionBecomesIdentityAndIsCounted) {
   EXPECT_EQ(s.rotations[4], 1.0f);
 }
 
+// Double components of 1e300 square to infinity: still a rotation, normalised, not a zero one.
+TEST(PlyLoad, HugeDoubleQuaternionsAreNormalisedNotRepaired) {
+  PlyBuilder b = PlyBuilder::inria(0, 2);
+  for (auto& [type, name] : b.properties) type = "double";
+  b.vertices[0][b.index_of("rot_0")] = 1e300;
+  b.vertices[0][b.index_of("rot_1")] = 1e300;
+  b.vertices[1][b.index_of("rot_0")] = -1e300;
+  LoadReport report;
+  const Scene s = parse(b.bytes(), &report);
+  EXPECT_EQ(report.repaired_zero_quaternion, 0u);
+  EXPECT_EQ(report.dropped_non_finite, 0u);
+  EXPECT_NEAR(s.rotations[0], std::sqrt(0.5), 1e-6);
+  EXPECT_NEAR(s.rotations[1], std::sqrt(0.5), 1e-6);
+  EXPECT_EQ(s.rotations[4], -1.0f);
+}
+
 TEST(PlyLoad, BigEndianAndAsciiReadTheSameValues) {
   const PlyBuilder little = PlyBuilder::inria(2, 4);
   PlyBuilder big = little, ascii = little;

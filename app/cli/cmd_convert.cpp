@@ -95,6 +95,11 @@ void run(const ConvertArgs& args) {
   const Scene input = load_scene_at_level(location.ply, args.lod, &report, options);
   const Scene scene = with_sh_degree(input, std::min(args.sh_degree, format.max_sh_degree));
   print_notes(format, input, location.ply);
+  if (const std::size_t negative = format.format == SceneFormat::inria_ply ? count_negative_scales(scene) : 0)
+    std::fprintf(stderr,
+                 "note: %zu of %zu Gaussians of %s have a negative scale, which PLY's log scales cannot hold; "
+                 "written as its magnitude (the same ellipsoid)\n",
+                 negative, scene.size(), location.ply.c_str());
   SceneWriteOptions write_options;
   write_options.spz_version = args.spz_version;
   write_options.spz_axes = options.spz_axes;

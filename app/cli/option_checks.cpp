@@ -12,6 +12,7 @@
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
 #include "flashgs/frame_memory.h"
+#include "flashgs/scene_formats.h"
 #include "flashgs/image_io.h"
 
 namespace flashgs::cli {
@@ -107,6 +108,25 @@ void check_frame_fits(const Renderer& renderer, const Camera& camera, std::size_
     std::fprintf(stderr, "note: a %dx%d frame needs about %s of memory (%s available)\n", camera.width, camera.height,
                  format_bytes(need.host).c_str(),
                  available.limited_by.empty() ? "unknown" : format_bytes(available.bytes).c_str());
+}
+
+void check_declared_scene_fits(const Renderer& renderer, const Camera& camera, const std::string& scene_path,
+                               const std::string& option) {
+  const SceneDeclaration declared = declare_scene_file(scene_path);
+  if (declared.gaussians == 0) return;
+  const BackendKind kind = renderer.name().rfind("cpu", 0) == 0 ? BackendKind::cpu : BackendKind::cuda;
+  const int threads = static_cast<int>(std::thread::hardware_concurrency());
+  // One pair per Gaussian: the floor, as in check_frame_fits.
+  const FrameMemory frame =
+      estimate_frame_memory(kind, declared.gaussians, camera.width, camera.height, declared.gaussians, threads);
+  const AvailableMemory available = available_host_memory();
+  if (available.limited_by.empty() || declared.load_bytes + frame.host <= available.bytes) return;
+  // A frame too large by its size alone is the size option's fault: check_frame_fits says so.
+  if (estimate_frame_memory(kind, 0, camera.width, camera.height, 0, threads).host > available.bytes) return;
+  throw Error(scene_path + ": " + std::to_string(declared.gaussians) + " Gaussians need about " +
+              format_bytes(declared.load_bytes) + " to load and " + format_bytes(frame.host) + " for a " +
+              std::to_string(camera.width) + "x" + std::to_string(camera.height) + " frame (" + option + "), but " +
+              format_bytes(available.bytes) + " is available (" + available.limited_by + ")");
 }
 
 void check_look_at(const std::vector<float>& eye, const std::vector<float>& target, const std::vector<float>& up) {

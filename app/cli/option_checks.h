@@ -46,6 +46,12 @@ void remove_created_folders(const std::vector<std::string>& created);
 void check_frame_fits(const Renderer& renderer, const Camera& camera, std::size_t gaussians,
                       const std::string& option);
 
+// Refuses (flashgs::Error naming the scene file, with the figures) a scene whose file declares
+// more Gaussians than loading them and one frame of `camera` on `renderer` leave room for,
+// before the file is read (declare_scene_file; formats that cannot say so cheaply pass).
+void check_declared_scene_fits(const Renderer& renderer, const Camera& camera, const std::string& scene_path,
+                               const std::string& option);
+
 // Turns an explicit camera's --eye / --look-at / --up into an error naming them when they do
 // not define a view (eye at the target, or looking along up).
 void check_look_at(const std::vector<float>& eye, const std::vector<float>& target, const std::vector<float>& up);

@@ -11,6 +11,7 @@
 #endif
 #ifdef FLASHGS_HAVE_ZSTD
 #include <zstd.h>
+#include <zstd_errors.h>
 #endif
 
 namespace flashgs {
@@ -99,16 +100,19 @@ void GzipReader::expect_end(const std::string& expected_total) {
     fail(s.name, std::to_string(s.stream.avail_in) + " bytes follow the gzip stream (a second stream or junk)");
 }
 
-std::vector<std::uint8_t> gzip_peek(const unsigned char* data, std::size_t size, std::size_t n) {
+std::vector<std::uint8_t> gzip_peek(const unsigned char* data, std::size_t size, std::size_t n, bool* corrupt) {
   std::vector<std::uint8_t> out(n);
   z_stream stream{};
+  if (corrupt) *corrupt = false;
   if (inflateInit2(&stream, 16 + MAX_WBITS) != Z_OK) return {};
   stream.next_in = const_cast<Bytef*>(data);
   stream.avail_in = static_cast<uInt>(std::min<std::size_t>(size, UINT_MAX));
   stream.next_out = out.data();
   stream.avail_out = static_cast<uInt>(n);
-  while (stream.avail_out > 0 && inflate(&stream, Z_NO_FLUSH) == Z_OK) {
+  int result = Z_OK;
+  while (stream.avail_out > 0 && (result = inflate(&stream, Z_NO_FLUSH)) == Z_OK) {
   }
+  if (corrupt) *corrupt = result == Z_DATA_ERROR;
   out.resize(n - stream.avail_out);
   inflateEnd(&stream);
   return out;
@@ -125,12 +129,18 @@ GzipReader::GzipReader(const unsigned char*, std::size_t, const std::string& nam
 GzipReader::~GzipReader() = default;
 void GzipReader::read(std::size_t, std::vector<std::uint8_t>&, const std::string&) {}
 void GzipReader::expect_end(const std::string&) {}
-std::vector<std::uint8_t> gzip_peek(const unsigned char*, std::size_t, std::size_t) { return {}; }
+std::vector<std::uint8_t> gzip_peek(const unsigned char*, std::size_t, std::size_t, bool* corrupt) {
+  if (corrupt) *corrupt = false;
+  return {};
+}
 bool have_gzip_support() { return false; }
 
 #endif
 
 #ifdef FLASHGS_HAVE_ZSTD
+
+constexpr int kMaxZstdWindowLog = 27;
+constexpr int kMaxZstdWindowMegabytes = (1 << kMaxZstdWindowLog) >> 20;
 
 std::vector<std::uint8_t> zstd_decompress_exact(const unsigned char* data, std::size_t size, std::size_t expected,
                                                 const std::string& name, const std::string& what,
@@ -138,7 +148,7 @@ std::vector<std::uint8_t> zstd_decompress_exact(const unsigned char* data, std::
   std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> context(ZSTD_createDCtx(), ZSTD_freeDCtx);
   if (!context) fail(name, "cannot start the zstd decoder");
   // A window beyond 128 MB is not a splat attribute stream; it would only cost memory.
-  ZSTD_DCtx_setParameter(context.get(), ZSTD_d_windowLogMax, 27);
+  ZSTD_DCtx_setParameter(context.get(), ZSTD_d_windowLogMax, kMaxZstdWindowLog);
   std::vector<std::uint8_t> out;
   ZSTD_inBuffer in{data, size, 0};
   std::size_t pending = 1;  // ZSTD_decompressStream's "more to do" hint; 0 once the frame is complete
@@ -151,6 +161,9 @@ std::vector<std::uint8_t> zstd_decompress_exact(const unsigned char* data, std::
     const std::size_t in_before = in.pos;
     pending = ZSTD_decompressStream(context.get(), &buffer, &in);
     out.resize(before + buffer.pos);
+    if (ZSTD_isError(pending) && ZSTD_getErrorCode(pending) == ZSTD_error_frameParameter_windowTooLarge)
+      fail(name, "the zstd frame of the " + what + " asks for a decoding window larger than the " +
+                     std::to_string(kMaxZstdWindowMegabytes) + " MB allowed here: too large for a splat stream");
     if (ZSTD_isError(pending))
       fail(name, "the zstd data of the " + what + " is corrupt (" + ZSTD_getErrorName(pending) + ")");
     add_progress(progress, in.pos - in_before, name);

@@ -33,8 +33,10 @@ class GzipReader {
 };
 
 // Up to the first `n` bytes a gzip stream inflates to (fewer when it is corrupt or shorter);
-// empty without zlib. For recognising a file by what its stream starts with.
-std::vector<std::uint8_t> gzip_peek(const unsigned char* data, std::size_t size, std::size_t n);
+// empty without zlib. For recognising a file by what its stream starts with; `corrupt`, when
+// given, says whether zlib found the stream corrupt (a bad gzip header or deflate data).
+std::vector<std::uint8_t> gzip_peek(const unsigned char* data, std::size_t size, std::size_t n,
+                                    bool* corrupt = nullptr);
 
 // Decompresses one zstd frame to exactly `expected` bytes; throws flashgs::Error naming
 // `name` and `what` when it is corrupt, shorter, or would grow past `expected`.

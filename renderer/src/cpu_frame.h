@@ -165,6 +165,10 @@ inline void set_row_pruning(BlendGaussian& g) {
 void order_by_depth(Frame& frame, std::int64_t gaussians);
 // The same on `threads` threads, however many processors there are (the tests' uneven splits).
 void order_by_depth_on(Frame& frame, std::int64_t gaussians, int threads);
+// Throws flashgs::Error, with the figures, when the pairs emit would make for the visible
+// Gaussians (counted from their boxes; for the exact tile test, estimated from a sample of
+// them) cannot fit in the memory available. Run after order_by_depth, before emit.
+void check_pairs_fit(const RenderOptions& options, const Frame& frame);
 // Emits the pairs of the visible Gaussians, walking them in depth order.
 void emit(const RenderOptions& options, Frame& frame, FrameStats& stats);
 // The tiles of f's box that gm::footprint_touches_tile keeps, as tile indices in row-major

@@ -95,6 +95,7 @@ class CpuRenderer final : public Renderer {
     cpu::order_by_depth(frame_, static_cast<std::int64_t>(scene_->size()));
     const double depth_order_ms = ms_since(t);
     if (cancelled()) return finish_cancelled();
+    cpu::check_pairs_fit(options, frame_);
     t = Clock::now();
     cpu::emit(options, frame_, stats);
     stats.times.emit_ms = ms_since(t);

@@ -1,6 +1,7 @@
 // The checks every scene reader applies to a decoded Gaussian, and the progress of decoding.
 #include "format_readers.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "flashgs/error.h"
@@ -28,8 +29,16 @@ void append_gaussian(Scene& scene, const DecodedGaussian& g, const float* sh_res
     report.dropped_non_finite++;
     return;
   }
-  double norm = std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
-  if (!(norm > 0.0) || !std::isfinite(norm)) {
+  // Scaled by the largest component first: rotations of 1e300 (double PLY) would square to
+  // infinity, yet they are a rotation like any other.
+  double largest = 0.0;
+  for (const double q : quat) largest = std::max(largest, std::abs(q));
+  double norm = 0.0;
+  if (largest > 0.0) {
+    for (double& q : quat) q /= largest;
+    norm = std::sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3]);
+  }
+  if (!(norm > 0.0)) {
     // A zero quaternion has no rotation; 3DGS would divide by zero. Identity keeps the scales.
     report.repaired_zero_quaternion++;
     quat[0] = 1;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include "flashgs/load_progress.h"
@@ -44,6 +45,24 @@ class DecodeProgress {
   LoadProgress* m_progress;
   const std::string& m_name;
 };
+
+// What a file's start declares before the whole file is read: the Gaussians it holds (0 when
+// the start cannot say) and their SH degree; `extra_bytes_per_gaussian` is what decoding holds
+// per Gaussian beside the file's bytes and the scene (SPZ's inflated attributes).
+struct DeclaredScene {
+  std::uint64_t gaussians = 0;
+  int sh_degree = 0;
+  std::uint64_t extra_bytes_per_gaussian = 0;
+};
+// From a PLY header held whole in `start` (the first bytes of a file of `file_size` bytes):
+// throws flashgs::Error naming `name` when the header is invalid or a binary file's size is
+// not what its elements declare. Unknown (0 Gaussians) when `start` ends inside the header.
+DeclaredScene declare_ply(const char* start, std::size_t start_size, std::uint64_t file_size,
+                          const std::string& name);
+// A .splat file of `file_size` bytes: throws unless it is a whole number of records.
+DeclaredScene declare_splat(std::uint64_t file_size, const std::string& name);
+// An SPZ header, from the file's first bytes (inside the gzip stream for versions 1-3).
+DeclaredScene declare_spz(const char* start, std::size_t start_size, const std::string& name);
 
 // One parser per format, on the file's bytes (`name` is the path, used in messages), beside
 // parse_ply (io.h). Each throws flashgs::Error naming the file and the problem, and fills

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -127,6 +128,22 @@ int chunk_sh_degree(const std::string& path) {
   return 0;
 }
 
+std::uint64_t chunk_gaussians(const std::string& path) {
+  if (is_sog_chunk(path)) {
+    const std::vector<char> text = read_regular_file(path, kMaxSogJsonBytes);
+    return parse_sog_meta(std::string(text.begin(), text.end()), path).count;
+  }
+  const std::vector<char> head = read_recognition_start(path, 64 << 10);
+  const ply::Header header = ply::parse_header(head.data(), head.size(), path);
+  for (const ply::Element& e : header.elements)
+    if (e.name == "vertex") return e.count;
+  fail(path, "the header declares no vertex element");
+}
+
+std::string gaussian_span(std::uint64_t begin, std::uint64_t end) {
+  return "Gaussians " + std::to_string(begin) + ".." + std::to_string(end - 1);
+}
+
 Scene read_chunk_internal(const std::string& path, LoadReport* report, LoadProgress* progress) {
   return is_sog_chunk(path) ? read_sog_chunk(path, report, progress) : load_scene_file(path, report, progress);
 }
@@ -170,6 +187,39 @@ std::uint64_t lod_chunk_bytes(const std::string& path) { return chunk_bytes_inte
 int lod_chunk_sh_degree(const std::string& path) { return chunk_sh_degree(path); }
 Scene read_lod_chunk(const std::string& path, LoadReport* report, LoadProgress* progress) {
   return read_chunk_internal(path, report, progress);
+}
+
+std::uint64_t lod_chunk_gaussians(const std::string& path) { return chunk_gaussians(path); }
+
+void check_lod_ranges(const LodSet& set, int level) {
+  std::map<int, std::vector<LodRange>> by_file;
+  for (const LodLeaf& leaf : set.leaves) {
+    const LodRange& r = leaf.levels[static_cast<std::size_t>(level)];
+    if (r.file >= 0 && r.count > 0) by_file[r.file].push_back(r);
+  }
+  const std::string prefix = "level " + std::to_string(level) + " ";
+  for (auto& [file, ranges] : by_file) {
+    const std::uint64_t count = chunk_gaussians(set.file_path(file));
+    const std::string of_file = " of " + printable_file_text(set.files[static_cast<std::size_t>(file)]);
+    const std::string uncovered = " Gaussians) in no leaf: the leaves' ranges must cover each chunk";
+    std::sort(ranges.begin(), ranges.end(), [](const LodRange& a, const LodRange& b) { return a.offset < b.offset; });
+    std::uint64_t covered = 0;  // the ranges so far cover [0, covered)
+    for (const LodRange& r : ranges) {
+      if (r.offset > count || r.count > count - r.offset)
+        fail(set.meta_path, prefix + "takes " + gaussian_span(r.offset, r.offset + r.count) + of_file +
+                                ", which has " + std::to_string(count) + " Gaussians");
+      if (r.offset < covered)
+        fail(set.meta_path, prefix + "takes " + gaussian_span(r.offset, std::min(covered, r.offset + r.count)) +
+                                of_file + " in two leaves: the leaves' ranges overlap");
+      if (r.offset > covered)
+        fail(set.meta_path, prefix + "leaves " + gaussian_span(covered, r.offset) + of_file + " (" +
+                                std::to_string(count) + uncovered);
+      covered = r.offset + r.count;
+    }
+    if (covered < count)
+      fail(set.meta_path, prefix + "leaves " + gaussian_span(covered, count) + of_file + " (" +
+                              std::to_string(count) + uncovered);
+  }
 }
 
 std::uint64_t LodSet::gaussians(int level) const {

@@ -396,6 +396,38 @@ Scene parse_ply(const char* data, std::size_t size, const std::string& name, Loa
   return scene;
 }
 
+DeclaredScene declare_ply(const char* start, std::size_t start_size, std::uint64_t file_size,
+                          const std::string& name) {
+  if (std::string_view(start, start_size).find("end_header") == std::string_view::npos && start_size < file_size)
+    return {};  // a header longer than the start: the full read checks it
+  const Header header = parse_header(start, start_size, name);
+  DeclaredScene declared;
+  std::uint64_t data_bytes = 0;
+  bool sized = header.format != Format::ascii;
+  for (const Element& e : header.elements) {
+    if (e.name == "vertex") declared.gaussians = e.count;
+    for (const Property& p : e.properties)
+      if (p.name.compare(0, 7, "f_rest_") == 0 || e.name == "sh") declared.sh_degree++;
+    sized &= !e.has_list();
+    if (e.record_size != 0 && e.count > (std::numeric_limits<std::uint64_t>::max() - data_bytes) / e.record_size)
+      sized = false;  // the check below would overflow; the full read refuses it
+    else data_bytes += e.count * e.record_size;
+  }
+  // f_rest (or sh) values per Gaussian to the degree they make (45 or more: degree 3).
+  const int rest = declared.sh_degree;
+  declared.sh_degree = rest >= 45 ? 3 : rest >= 24 ? 2 : rest >= 9 ? 1 : 0;
+  const std::uint64_t available = file_size - std::min<std::uint64_t>(file_size, header.data_offset);
+  if (sized && data_bytes != available) {
+    const bool vertex_only = header.elements.size() == 1;
+    fail(name, "the header declares " + declared_counts(header) + " (" + std::to_string(data_bytes) +
+                   " bytes of data) but the file has " + std::to_string(available) + " bytes after the header: " +
+                   (data_bytes > available ? "truncated file or wrong count"
+                    : vertex_only           ? "the vertex count does not match the file size"
+                                            : "the element counts do not match the file size"));
+  }
+  return declared;
+}
+
 Scene load_ply(const std::string& path, LoadReport* report, LoadProgress* progress) {
   const std::vector<char> bytes = read_regular_file(path, std::numeric_limits<std::size_t>::max(), progress);
   return parse_ply(bytes.data(), bytes.size(), path, report, progress);

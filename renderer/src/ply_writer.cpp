@@ -43,7 +43,7 @@ void write_inria_records(const Scene& scene, OutputFile& file) {
     // Logit of the opacity, clamped so that 0 and 1 stay finite.
     const double o = std::min(std::max(static_cast<double>(scene.opacities[i]), 1e-12), 1.0 - 1e-7);
     *r++ = static_cast<float>(std::log(o / (1.0 - o)));
-    for (int k = 0; k < 3; ++k) *r++ = std::log(scene.scales[i * 3 + k]);
+    for (int k = 0; k < 3; ++k) *r++ = std::log(std::abs(scene.scales[i * 3 + k]));
     for (int k = 0; k < 4; ++k) *r++ = scene.rotations[i * 4 + k];
     // The file format is little endian; so are all hosts we build for (x86-64, arm64).
     file.write(record.data(), record.size() * sizeof(float));
@@ -56,6 +56,14 @@ void save_ply(const Scene& scene, const std::string& path) {
     file.write(header);
     write_inria_records(scene, file);
   });
+}
+
+std::size_t count_negative_scales(const Scene& scene) {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < scene.size(); ++i)
+    count += std::signbit(scene.scales[i * 3]) || std::signbit(scene.scales[i * 3 + 1]) ||
+             std::signbit(scene.scales[i * 3 + 2]);
+  return count;
 }
 
 }  // namespace flashgs

@@ -6,6 +6,8 @@
 #include <cctype>
 #include <chrono>
 #include <cstring>
+#include <filesystem>
+#include <new>
 #include <limits>
 #include <string_view>
 #include <vector>
@@ -13,6 +15,7 @@
 #include "flashgs/compressed_formats.h"
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
+#include "flashgs/frame_memory.h"
 #include "flashgs/io.h"
 #include "format_readers.h"
 #include "format_writers.h"
@@ -30,6 +33,8 @@ struct FileStart {
 };
 
 using Recogniser = bool (*)(const FileStart&);
+// What the file's start declares, given the file's size; throws when the two disagree.
+using Declarer = DeclaredScene (*)(const FileStart&, std::uint64_t file_size);
 using Parser = Scene (*)(const char*, std::size_t, const std::string&, LoadReport&, LoadProgress*,
                          const SceneReadOptions&);
 using PathReader = Scene (*)(const std::string&, LoadReport&, LoadProgress*);
@@ -41,6 +46,7 @@ struct FormatReader {
   Recogniser recognises;
   Parser parse;
   PathReader read = nullptr;
+  Declarer declare = nullptr;
 };
 
 // Bytes a recogniser may look at: more than any PLY header of a Gaussian scene.
@@ -120,14 +126,24 @@ Scene read_sog_file(const std::string& path, LoadReport& report, LoadProgress* p
   return parse_sog_file(text.data(), text.size(), path, &report, progress);
 }
 
+DeclaredScene declare_ply_file(const FileStart& f, std::uint64_t file_size) {
+  return declare_ply(f.bytes.data(), f.bytes.size(), file_size, f.name);
+}
+DeclaredScene declare_spz_file(const FileStart& f, std::uint64_t) {
+  return declare_spz(f.bytes.data(), f.bytes.size(), f.name);
+}
+DeclaredScene declare_splat_file(const FileStart& f, std::uint64_t file_size) {
+  return declare_splat(file_size, f.name);
+}
+
 // In order: formats with a magic number or header first, extension-only formats last.
 const FormatReader kReaders[] = {
-    {SceneFormat::compressed_ply, is_compressed_ply, without_options<parse_compressed_ply>},
-    {SceneFormat::inria_ply, is_ply, parse_inria_ply},
-    {SceneFormat::spz, is_spz, parse_spz_file},
+    {SceneFormat::compressed_ply, is_compressed_ply, without_options<parse_compressed_ply>, nullptr, declare_ply_file},
+    {SceneFormat::inria_ply, is_ply, parse_inria_ply, nullptr, declare_ply_file},
+    {SceneFormat::spz, is_spz, parse_spz_file, nullptr, declare_spz_file},
     {SceneFormat::sog, is_sog, nullptr, read_sog_file},
     {SceneFormat::sog_bundle, is_zip, parse_sog_bundle},
-    {SceneFormat::splat, is_splat, without_options<parse_splat>},
+    {SceneFormat::splat, is_splat, without_options<parse_splat>, nullptr, declare_splat_file},
     {SceneFormat::ksplat, is_ksplat, without_options<parse_ksplat>},
 };
 
@@ -203,25 +219,75 @@ Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& n
   return scene;
 }
 
-Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress* progress,
-                      const SceneReadOptions& options) {
-  LoadReport local_report;
-  if (!report) report = &local_report;
-  // Recognised from its start first: a file of no known format is not read whole.
+namespace {
+
+std::uint64_t file_size_of(const std::string& path) {
+  std::error_code error;
+  const auto size = std::filesystem::file_size(path, error);
+  return error ? 0 : static_cast<std::uint64_t>(size);
+}
+
+// The file's start recognised and its header checked against its size, before it is read whole.
+SceneDeclaration declare(const std::string& path, const FormatReader** reader_out) {
   const std::vector<char> start = read_recognition_start(path, kStartBytes);
-  const FormatReader& reader = recognise({path, std::string_view(start.data(), start.size())});
+  const FileStart file_start{path, std::string_view(start.data(), start.size())};
+  const FormatReader& reader = recognise(file_start);
+  if (reader_out) *reader_out = &reader;
+  SceneDeclaration out;
+  out.format = reader.format;
+  out.file_bytes = file_size_of(path);
+  // A size below what was read is no size (files of /proc report 0): the full read checks all.
+  if (!reader.declare || out.file_bytes < start.size()) return out;
+  const DeclaredScene declared = reader.declare(file_start, out.file_bytes);
+  out.gaussians = declared.gaussians;
+  out.sh_degree = declared.sh_degree;
+  const std::uint64_t scene_bytes = sizeof(float) * (14 + 3 * std::uint64_t(sh_coefficient_count(out.sh_degree) - 1));
+  out.load_bytes = out.file_bytes + out.gaussians * (scene_bytes + declared.extra_bytes_per_gaussian);
+  return out;
+}
+
+Scene load_recognised(const std::string& path, const FormatReader& reader, LoadReport& report, LoadProgress* progress,
+                      const SceneReadOptions& options) {
   const auto began = std::chrono::steady_clock::now();
   if (reader.read) {  // reading and decoding interleave: all of it counts as decoding
-    Scene scene = reader.read(path, *report, progress);
-    report->decode_seconds = seconds_since(began);
-    note_format(*report, reader.format);
+    Scene scene = reader.read(path, report, progress);
+    report.decode_seconds = seconds_since(began);
+    note_format(report, reader.format);
     return scene;
   }
   const std::vector<char> bytes = read_regular_file(path, std::numeric_limits<std::size_t>::max(), progress);
   const double read_seconds = seconds_since(began);
-  Scene scene = parse_scene_bytes(bytes.data(), bytes.size(), path, report, progress, options);
-  report->read_seconds = read_seconds;
+  Scene scene = parse_scene_bytes(bytes.data(), bytes.size(), path, &report, progress, options);
+  report.read_seconds = read_seconds;
   return scene;
+}
+
+}  // namespace
+
+SceneDeclaration declare_scene_file(const std::string& path) { return declare(path, nullptr); }
+
+Scene load_scene_file(const std::string& path, LoadReport* report, LoadProgress* progress,
+                      const SceneReadOptions& options) {
+  LoadReport local_report;
+  if (!report) report = &local_report;
+  // Recognised from its start first: a file of no known format is not read whole, nor one
+  // whose header contradicts its size or whose declared Gaussians cannot fit in memory.
+  const FormatReader* reader = nullptr;
+  const SceneDeclaration declared = declare(path, &reader);
+  const std::string name = printable_file_text(path, kMaxPrintedPathBytes);
+  const AvailableMemory available = available_host_memory();
+  if (available.bytes > 0 && declared.load_bytes > available.bytes)
+    throw Error(name + ": " + std::to_string(declared.gaussians) + " Gaussians in " +
+                format_bytes(declared.file_bytes) + " need about " + format_bytes(declared.load_bytes) +
+                " of memory to load, but " + format_bytes(available.bytes) + " is available (" +
+                available.limited_by + ")");
+  try {
+    return load_recognised(path, *reader, *report, progress, options);
+  } catch (const std::bad_alloc&) {
+    throw Error(name + ": out of memory while loading it (" + format_bytes(declared.file_bytes) + " of file" +
+                (declared.gaussians ? ", " + std::to_string(declared.gaussians) + " Gaussians declared" : "") +
+                "; " + format_bytes(available.bytes) + " was available)");
+  }
 }
 
 bool parse_spz_axes(const std::string& text, SpzAxes& out) {

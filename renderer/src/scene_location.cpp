@@ -19,24 +19,29 @@ bool something_at(const fs::path& path) {
   return fs::exists(fs::symlink_status(path, error));
 }
 
-// The N of a folder named iteration_<N>, or -1.
-long long iteration_number(const std::string& folder_name) {
+// The N of a folder named iteration_<N> as its digits without leading zeros ("0" for zero), or
+// empty. Kept as text: a number of any length still compares (a shorter one is smaller).
+std::string iteration_number(const std::string& folder_name) {
   const std::string prefix = "iteration_";
   if (folder_name.compare(0, prefix.size(), prefix) != 0 || folder_name.size() == prefix.size() ||
-      folder_name.size() > prefix.size() + 18 ||
       folder_name.find_first_not_of("0123456789", prefix.size()) != std::string::npos)
-    return -1;
-  return std::stoll(folder_name.substr(prefix.size()));
+    return "";
+  const std::size_t first = folder_name.find_first_not_of('0', prefix.size());
+  return first == std::string::npos ? "0" : folder_name.substr(first);
+}
+
+bool iteration_before(const std::string& a, const std::string& b) {
+  return a.size() != b.size() ? a.size() < b.size() : a < b;
 }
 
 // <model>/point_cloud/iteration_<highest N>/point_cloud.ply, or empty when there is none.
 fs::path latest_training_iteration(const fs::path& model) {
   std::error_code error;
   fs::path best;
-  long long best_n = -1;
+  std::string best_n;
   for (fs::directory_iterator it(model / "point_cloud", error), end; !error && it != end; it.increment(error)) {
-    const long long n = iteration_number(it->path().filename().string());
-    if (n > best_n && something_at(it->path() / "point_cloud.ply")) {
+    const std::string n = iteration_number(it->path().filename().string());
+    if (!n.empty() && (best_n.empty() || iteration_before(best_n, n)) && something_at(it->path() / "point_cloud.ply")) {
       best_n = n;
       best = it->path() / "point_cloud.ply";
     }
@@ -51,7 +56,7 @@ std::string default_cameras_path(const std::string& ply_path) {
   const fs::path beside = folder / "cameras.json";
   if (something_at(beside)) return beside.string();
   const fs::path model = folder.parent_path().parent_path();
-  if (iteration_number(folder.filename().string()) >= 0 && folder.parent_path().filename() == "point_cloud" &&
+  if (!iteration_number(folder.filename().string()).empty() && folder.parent_path().filename() == "point_cloud" &&
       something_at(model / "cameras.json"))
     return (model / "cameras.json").string();
   return beside.string();

@@ -32,16 +32,22 @@ std::uint8_t component_to_byte(double c) {
 
 }  // namespace
 
-Scene parse_splat(const char* data, std::size_t size, const std::string& name, LoadReport& report,
-                  LoadProgress* progress) {
-  report = LoadReport{};
-  report.path = name;
+DeclaredScene declare_splat(std::uint64_t size, const std::string& name) {
   if (size == 0) throw Error(name + ": the .splat file is empty: there are no Gaussians");
   if (size % kRecordBytes != 0)
     throw Error(name + ": a .splat file is a sequence of 32-byte records, but its " + std::to_string(size) +
                 " bytes are not a multiple of 32 (" + std::to_string(size % kRecordBytes) +
                 " bytes left over): truncated, or not a .splat file");
-  const std::size_t count = size / kRecordBytes;
+  DeclaredScene declared;
+  declared.gaussians = size / kRecordBytes;
+  return declared;
+}
+
+Scene parse_splat(const char* data, std::size_t size, const std::string& name, LoadReport& report,
+                  LoadProgress* progress) {
+  report = LoadReport{};
+  report.path = name;
+  const std::size_t count = declare_splat(size, name).gaussians;
   report.vertices_in_file = count;
   Scene scene;
   scene.reserve(count);

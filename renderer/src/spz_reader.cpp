@@ -13,6 +13,7 @@
 #include "flashgs/error.h"
 #include "flashgs/file_access.h"
 #include "flashgs/frame_memory.h"
+#include "format_readers.h"
 #include "kernel_marks.h"
 #include "spz_axes.h"
 
@@ -278,14 +279,33 @@ Scene unpack(const Packed& packed, const Header& header, const std::string& name
 
 }  // namespace
 
+DeclaredScene declare_spz(const char* start, std::size_t start_size, const std::string& name) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(start);
+  std::vector<std::uint8_t> head;
+  if (start_size >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b)
+    head = gzip_peek(bytes, start_size, kGzipHeaderBytes);
+  else
+    head.assign(bytes, bytes + std::min(start_size, kV4HeaderBytes));
+  if (head.size() < kGzipHeaderBytes) return {};  // the reader says what is wrong
+  const Header header = parse_header(head.data(), name);
+  DeclaredScene declared;
+  declared.gaussians = header.count;
+  declared.sh_degree = std::min(header.sh_degree, 3);
+  declared.extra_bytes_per_gaussian = Layout(header).total();
+  return declared;
+}
+
 bool looks_like_spz(const char* data, std::size_t size) {
   const auto* bytes = reinterpret_cast<const unsigned char*>(data);
   if (size >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b) {
     // Any gzip file starts so: the SPZ magic must open the stream as well. Without zlib a
     // gzip file is taken for SPZ, whose reader then says zlib is missing.
     if (!have_gzip_support()) return true;
-    const std::vector<std::uint8_t> start = gzip_peek(bytes, size, 4);
-    return start.size() == 4 && read_u32(start.data()) == kSpzMagic;
+    // A corrupt stream is taken for SPZ too, so that its reader says "corrupt gzip" rather
+    // than the file being no scene at all.
+    bool corrupt = false;
+    const std::vector<std::uint8_t> start = gzip_peek(bytes, size, 4, &corrupt);
+    return corrupt || (start.size() == 4 && read_u32(start.data()) == kSpzMagic);
   }
   return size >= 8 && read_u32(bytes) == kSpzMagic;
 }

@@ -65,15 +65,19 @@ struct SogLodSet {
 // Whether `path` is a regular file that starts like a SOG lod-meta.json (64 KB are read).
 bool is_sog_lod_set(const std::string& path);
 // Reads lod-meta.json (`path`: the file, or the folder holding it) and each level's chunk
-// meta.json (for the SH degree); decodes no texture.
+// meta.json (for the count and SH degree); decodes no texture. Throws flashgs::Error unless
+// each level's leaves split its chunk files between them (ranges inside the file, disjoint,
+// covering it).
 SogLodSet describe_sog_lod(const std::string& path);
-// Decodes level `level` of the set (every leaf's range of that level, in tree order).
+// Decodes level `level` of the set (every leaf's range of that level, in tree order), after
+// the checks above and one of its memory against what is available.
 Scene read_sog_lod(const std::string& path, int level, LoadReport* report = nullptr,
                    LoadProgress* progress = nullptr);
 // Host memory that decoding and keeping level `level` takes (the scene and its textures).
 std::uint64_t sog_lod_level_bytes(const SogLodLevel& level);
 // The finest level whose bytes fit in half of `available_bytes` (the rest is left to the
-// renderer); the coarsest when none fits; the finest when `available_bytes` is 0 (unknown).
+// renderer); the finest when `available_bytes` is 0 (unknown). Throws flashgs::Error naming
+// the set and the figures when not even the coarsest fits.
 int choose_sog_lod_level(const SogLodSet& set, std::uint64_t available_bytes);
 
 }  // namespace flashgs

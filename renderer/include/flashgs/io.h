@@ -1,6 +1,7 @@
 // Scene and camera files: INRIA 3DGS PLY and the 3DGS training-output cameras.json.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -40,8 +41,12 @@ Scene load_ply(const std::string& path, LoadReport* report = nullptr, LoadProgre
 Scene parse_ply(const char* data, std::size_t size, const std::string& name,
                 LoadReport* report = nullptr, LoadProgress* progress = nullptr);
 // Writes the INRIA layout (binary little endian, logit opacity, log scales), whole or not at
-// all (write_file_atomically).
+// all (write_file_atomically). A negative scale has no log: its magnitude is written, which
+// gives the same covariance (see count_negative_scales).
 void save_ply(const Scene& scene, const std::string& path);
+// Gaussians with a negative scale (as a .splat file may hold): PLY's log scales cannot
+// represent the sign, so save_ply changes them, and a conversion says how many it touched.
+std::size_t count_negative_scales(const Scene& scene);
 
 // Reads cameras.json (at most 64 MB, a regular file). Throws flashgs::Error on a missing file,
 // bad JSON, a missing field, a value that is not a finite float, an absurd focal length or

@@ -49,6 +49,14 @@ LodSet read_lod_set(const std::string& path);
 // degree from its header alone, and its Gaussians.
 std::uint64_t lod_chunk_bytes(const std::string& path);
 int lod_chunk_sh_degree(const std::string& path);
+// A chunk's Gaussians by its header alone (SOG meta.json's count, a PLY's vertex count).
+std::uint64_t lod_chunk_gaussians(const std::string& path);
+
+// Throws flashgs::Error naming the set unless level `level`'s leaves split each chunk file they
+// name between them, as LOD writers make them: every range inside its file (by the chunk's
+// header: lod_chunk_gaussians, read once per file), no Gaussian in two leaves, none in no leaf.
+// So a tree that claims more Gaussians than its files hold costs no decoding.
+void check_lod_ranges(const LodSet& set, int level);
 Scene read_lod_chunk(const std::string& path, LoadReport* report = nullptr, LoadProgress* progress = nullptr);
 
 // The tree written into lod-meta.json: internal nodes split the leaves in two, as the builder's

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include "flashgs/load_progress.h"
@@ -42,6 +43,20 @@ const char* format_quantisation(SceneFormat format);
 // was set. `report` and `progress` may be null; `options` says what the file cannot.
 Scene load_scene_file(const std::string& path, LoadReport* report = nullptr, LoadProgress* progress = nullptr,
                       const SceneReadOptions& options = {});
+// What a scene file declares, from its start, before it is read whole (its header; a .splat
+// file's size): the Gaussians (0 when the format cannot say so cheaply, as SOG) and the memory
+// reading and decoding it takes (the file's bytes, the scene's and the decoder's). Throws
+// flashgs::Error naming the file when it is no scene file or its header contradicts its size;
+// load_scene_file does this first and refuses a file whose load_bytes exceed the memory available.
+struct SceneDeclaration {
+  SceneFormat format = SceneFormat::inria_ply;
+  std::uint64_t gaussians = 0;
+  int sh_degree = 0;
+  std::uint64_t file_bytes = 0;
+  std::uint64_t load_bytes = 0;
+};
+SceneDeclaration declare_scene_file(const std::string& path);
+
 // The same for a file's bytes already in memory (`name` is its path, used for messages and
 // for the extension); the fuzz tests drive this.
 Scene parse_scene_bytes(const char* data, std::size_t size, const std::string& name,
