@@ -7,6 +7,8 @@
 #include <fstream>
 #include <numeric>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "flashgs/demo_scene.h"
@@ -31,16 +33,25 @@ std::string fresh_folder(const std::string& name) {
 }
 
 // A set built once per process from the demo scene: 30,000 Gaussians in cells of about 2,048.
+// Each test runs in its own process, several at once: each builds its own copy.
+struct ProcessFolder {
+  std::string path;
+  ~ProcessFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
 const std::string& demo_set() {
-  static const std::string dir = [] {
-    const std::string out = fresh_folder("demo");
+  static const ProcessFolder folder = [] {
+    const std::string out = fresh_folder("demo_" + std::to_string(getpid()));
     LodBuildOptions options;
     options.leaf_gaussians = 2048;
     options.file_gaussians = 8192;
     build_lod_set(demo_scene_path(), out, options);
-    return out;
+    return ProcessFolder{out};
   }();
-  return dir;
+  return folder.path;
 }
 
 double opacity_mass(const Scene& s) {
@@ -276,7 +287,7 @@ TEST(LodStream, TheFramesWorkingMemoryIsInsideTheCap) {
 }
 
 TEST(LodStream, ACorruptChunkIsOneLineAndTheRestKeepsRendering) {
-  const std::string dir = fresh_folder("corrupt");
+  const std::string dir = fresh_folder("corrupt_" + std::to_string(getpid()));
   fs::copy(demo_set(), dir, fs::copy_options::recursive);
   LodSet set = read_lod_set(dir);
   const std::string broken = set.file_path(0);  // a level-0 chunk

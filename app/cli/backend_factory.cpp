@@ -25,6 +25,16 @@ std::unique_ptr<Renderer> create_backend(const std::string& which, int cpu_threa
   return make_cpu_renderer(cpu_threads, cpu_blend);
 }
 
+BackendKind backend_kind(const std::string& which) {
+#ifdef FLASHGS_HAVE_CUDA
+  std::string why;
+  if ((which == "cuda" || which == "auto") && cuda_available(&why)) return BackendKind::cuda;
+#else
+  (void)which;
+#endif
+  return BackendKind::cpu;
+}
+
 bool can_queue_frames(Renderer& renderer) {
 #ifdef FLASHGS_HAVE_CUDA
   return dynamic_cast<CudaRenderer*>(&renderer) != nullptr;

@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "flashgs/frame_memory.h"
 #include "flashgs/renderer.h"
 
 namespace flashgs::cli {
@@ -13,6 +14,10 @@ namespace flashgs::cli {
 // the CPU backend when it is the one chosen (0 threads: every core).
 std::unique_ptr<Renderer> create_backend(const std::string& which, int cpu_threads = 0,
                                          CpuBlend cpu_blend = CpuBlend::simd);
+
+// The kind of backend create_backend(which) makes, found without a word on stderr (estimates
+// made before the backend is).
+BackendKind backend_kind(const std::string& which);
 
 // Whether `renderer` can queue frames behind each other without the host waiting for each (the
 // CUDA backend: CudaRenderer::render_queued).

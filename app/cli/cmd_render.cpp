@@ -30,13 +30,11 @@ struct RenderCommand {
     check_output_image("--output", output);  // before the render, which may take long
     const std::string scene_path = scene.resolved_scene();
     const std::string size_option = camera.resolution.empty() ? "the camera's size" : "--resolution";
-    // The inputs' own errors first (a file that is no scene, then the camera), the backend's
-    // note after them; then what the file declares against memory, before it is read.
-    declare_scene_file(scene_path);
+    check_declared_scene(scene_path, size_option);
+    // The scene's errors, then the camera's, then the backend's note.
+    auto loaded = load_scene_verbose(scene_path, scene.lod, scene.read_options());
     const Camera cam = camera.select(scene.resolved_cameras());
     auto renderer = create_backend(render.backend);
-    check_declared_scene_fits(*renderer, cam, scene_path, size_option);
-    auto loaded = load_scene_verbose(scene_path, scene.lod, scene.read_options());
     check_frame_fits(*renderer, cam, loaded->size(), size_option);
     renderer->set_scene(loaded);
     const RenderOptions options = render.options(*loaded);
@@ -51,6 +49,18 @@ struct RenderCommand {
                                                         : kernel_summary(loaded->trained_kernel).c_str());
     std::printf("%s", format_stats(stats).c_str());
     std::printf("wrote %s\n", output.c_str());
+  }
+
+  // What the scene file declares, against loading it and one frame, before it is read. A
+  // camera that cannot be had skips this: its error comes after the scene's, as always.
+  void check_declared_scene(const std::string& scene_path, const std::string& size_option) const {
+    Camera cam;
+    try {
+      cam = camera.select(scene.resolved_cameras());
+    } catch (const Error&) {
+      return;
+    }
+    check_declared_scene_fits(backend_kind(render.backend), cam, scene_path, size_option);
   }
 
   // The path's frames, frame_00000.png on, at the path's size (or --resolution) and fps (or --fps).

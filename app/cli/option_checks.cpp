@@ -110,11 +110,10 @@ void check_frame_fits(const Renderer& renderer, const Camera& camera, std::size_
                  available.limited_by.empty() ? "unknown" : format_bytes(available.bytes).c_str());
 }
 
-void check_declared_scene_fits(const Renderer& renderer, const Camera& camera, const std::string& scene_path,
+void check_declared_scene_fits(BackendKind kind, const Camera& camera, const std::string& scene_path,
                                const std::string& option) {
   const SceneDeclaration declared = declare_scene_file(scene_path);
   if (declared.gaussians == 0) return;
-  const BackendKind kind = renderer.name().rfind("cpu", 0) == 0 ? BackendKind::cpu : BackendKind::cuda;
   const int threads = static_cast<int>(std::thread::hardware_concurrency());
   // One pair per Gaussian: the floor, as in check_frame_fits.
   const FrameMemory frame =

@@ -10,6 +10,7 @@
 
 #include "finite_option.h"
 #include "flashgs/camera.h"
+#include "flashgs/frame_memory.h"
 #include "flashgs/renderer.h"
 
 namespace flashgs::cli {
@@ -47,9 +48,9 @@ void check_frame_fits(const Renderer& renderer, const Camera& camera, std::size_
                       const std::string& option);
 
 // Refuses (flashgs::Error naming the scene file, with the figures) a scene whose file declares
-// more Gaussians than loading them and one frame of `camera` on `renderer` leave room for,
+// more Gaussians than loading them and one frame of `camera` on a `backend` leave room for,
 // before the file is read (declare_scene_file; formats that cannot say so cheaply pass).
-void check_declared_scene_fits(const Renderer& renderer, const Camera& camera, const std::string& scene_path,
+void check_declared_scene_fits(BackendKind backend, const Camera& camera, const std::string& scene_path,
                                const std::string& option);
 
 // Turns an explicit camera's --eye / --look-at / --up into an error naming them when they do
