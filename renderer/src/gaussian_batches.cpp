@@ -79,18 +79,8 @@ bool GaussianBatches::next(Scene& batch, std::size_t max_count) {
   const std::uint64_t n = std::min<std::uint64_t>(max_count, m_count - m_next);
   if (m_whole) {
     batch = Scene{};
-    batch.sh_degree = m_whole->sh_degree;
     batch.trained_kernel = m_whole->trained_kernel;
-    const int rest = m_whole->sh_rest_per_gaussian();
-    auto slice = [&](const std::vector<float>& from, std::size_t per, std::vector<float>& to) {
-      to.assign(from.begin() + m_next * per, from.begin() + (m_next + n) * per);
-    };
-    slice(m_whole->positions, 3, batch.positions);
-    slice(m_whole->scales, 3, batch.scales);
-    slice(m_whole->rotations, 4, batch.rotations);
-    slice(m_whole->opacities, 1, batch.opacities);
-    slice(m_whole->sh_dc, 3, batch.sh_dc);
-    slice(m_whole->sh_rest, static_cast<std::size_t>(rest), batch.sh_rest);
+    batch.append_range(*m_whole, m_next, n);
     m_next += n;
     return true;
   }

@@ -31,6 +31,17 @@ std::uint64_t bytes_per_gaussian(int sh_degree) {
   return sizeof(float) * (14 + 3 * static_cast<std::uint64_t>(sh_coefficient_count(sh_degree) - 1));
 }
 
+// The drawn ranges of the chunks in memory, copied one after another into one scene.
+std::shared_ptr<Scene> assemble(const std::vector<LodRange>& drawn, const std::vector<std::shared_ptr<const Scene>>& sources,
+                                std::uint64_t total) {
+  auto scene = std::make_shared<Scene>();
+  scene->sh_degree = sources.empty() ? 0 : sources.front()->sh_degree;
+  scene->trained_kernel = sources.empty() ? TrainedKernel{} : sources.front()->trained_kernel;
+  scene->reserve(total);
+  for (std::size_t i = 0; i < drawn.size(); ++i) scene->append_range(*sources[i], drawn[i].offset, drawn[i].count);
+  return scene;
+}
+
 }  // namespace
 
 void lod_frame_costs(BackendKind backend, int width, int height, int cpu_threads, LodFrameCost* host,
@@ -272,31 +283,13 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
                       return a.file == b.file && a.offset == b.offset && a.count == b.count;
                     });
   if (!same || !m_scene) {
-    auto scene = std::make_shared<Scene>();
-    scene->sh_degree = sources.empty() ? 0 : sources.front()->sh_degree;
-    scene->trained_kernel = sources.empty() ? TrainedKernel{} : sources.front()->trained_kernel;
     std::uint64_t total = 0;
     for (const LodRange& r : drawn) total += r.count;
     {
       std::lock_guard<std::mutex> lock(m_mutex);  // the next scene is held beside the one drawn now
       m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes + total * m_bytes_per_gaussian);
     }
-    scene->reserve(total);
-    for (std::size_t i = 0; i < drawn.size(); ++i) {
-      const Scene& from = *sources[i];
-      const LodRange& r = drawn[i];
-      const std::size_t rest = static_cast<std::size_t>(from.sh_rest_per_gaussian());
-      auto take = [&r](const std::vector<float>& v, std::size_t per, std::vector<float>& to) {
-        to.insert(to.end(), v.begin() + static_cast<std::ptrdiff_t>(r.offset * per),
-                  v.begin() + static_cast<std::ptrdiff_t>((r.offset + r.count) * per));
-      };
-      take(from.positions, 3, scene->positions);
-      take(from.scales, 3, scene->scales);
-      take(from.rotations, 4, scene->rotations);
-      take(from.opacities, 1, scene->opacities);
-      take(from.sh_dc, 3, scene->sh_dc);
-      if (rest) take(from.sh_rest, rest, scene->sh_rest);
-    }
+    std::shared_ptr<Scene> scene = assemble(drawn, sources, total);
     m_scene = std::move(scene);
     m_drawn = std::move(drawn);
     std::lock_guard<std::mutex> lock(m_mutex);

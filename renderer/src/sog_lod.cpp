@@ -130,18 +130,7 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
         if (r.offset > chunk.size() || r.count > chunk.size() - r.offset)  // a chunk that changed since its header was read
           fail(chunk_name, "holds " + std::to_string(chunk.size()) + " Gaussians once decoded, fewer than level " +
                                std::to_string(level) + "'s ranges take");
-        Scene part;
-        part.sh_degree = chunk.sh_degree;
-        const auto take = [&r](const std::vector<float>& from, std::size_t per, std::vector<float>& to) {
-          to.assign(from.begin() + r.offset * per, from.begin() + (r.offset + r.count) * per);
-        };
-        take(chunk.positions, 3, part.positions);
-        take(chunk.scales, 3, part.scales);
-        take(chunk.rotations, 4, part.rotations);
-        take(chunk.opacities, 1, part.opacities);
-        take(chunk.sh_dc, 3, part.sh_dc);
-        take(chunk.sh_rest, static_cast<std::size_t>(chunk.sh_rest_per_gaussian()), part.sh_rest);
-        scene.append(part);
+        scene.append_range(chunk, r.offset, r.count);
       }
     }
   } catch (const std::bad_alloc&) {  // the estimate above fell short of what decoding took

@@ -38,6 +38,8 @@ struct Scene {
   // Appends every Gaussian of `other` (same SH degree required; throws otherwise); the trained
   // kernel stays this scene's.
   void append(const Scene& other);
+  // Appends Gaussians [first, first + count) of `other` (the same rule for the SH degree).
+  void append_range(const Scene& other, std::size_t first, std::size_t count);
 };
 
 // What a loader dropped or repaired, reported by `flashgs info` and the viewer.
