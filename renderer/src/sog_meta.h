@@ -27,6 +27,8 @@ bool may_be_json_object(std::string_view start);
 constexpr std::size_t kMaxSogTextureBytes = std::size_t{1} << 30;
 // The most Gaussians one chunk may declare (a 16384 x 16384 texture).
 constexpr std::size_t kMaxSogCount = std::size_t{1} << 28;
+// Entries per row of the SH palette texture (the format's fixed layout).
+constexpr int kCentroidsPerRow = 64;
 
 struct SogMeta {
   int version = 2;  // 1: no "version" key, per-channel ranges instead of codebooks

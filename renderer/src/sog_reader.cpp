@@ -26,8 +26,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-// Each SH palette row holds this many entries (the format's fixed layout).
-constexpr int kCentroidsPerRow = 64;
 constexpr double kInvSqrt2 = 0.70710678118654752440;
 // Writers round textures up to a square of a multiple of 4 (a few spare rows); more spare
 // pixels than this many rows is not a SOG writer's slack but a size that would waste memory.

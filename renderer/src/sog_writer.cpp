@@ -15,6 +15,7 @@
 #include "format_writers.h"
 #include "kernel_marks.h"
 #include "kmeans.h"
+#include "sog_meta.h"
 #include "zip_archive.h"
 
 #ifdef FLASHGS_HAVE_WEBP
@@ -27,7 +28,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-constexpr int kCentroidsPerRow = 64;  // the format's SH palette layout
 constexpr std::size_t kCodebookSize = 256;
 constexpr std::size_t kMaxPalette = 65536;  // labels are 16 bits
 // Gaussians per palette entry: the palette stays a fraction of the scene, as SOG intends.
