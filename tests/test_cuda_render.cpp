@@ -1004,3 +1004,97 @@ TEST(CudaFp16, MatchesTheCpuAndTogglesLikeFreshRenderers) {
 
 }  // namespace
 }  // namespace flashgs
+
+namespace flashgs {
+namespace {
+
+// The tiled demo scene cut into parts of uneven lengths (none a multiple of the 256-Gaussian
+// page), as a streamed cut names ranges of its chunk files.
+std::vector<ScenePart> uneven_parts(std::shared_ptr<const Scene> scene) {
+  std::vector<ScenePart> parts;
+  std::mt19937 random(7);
+  std::uniform_int_distribution<std::size_t> length(1, 19000);
+  for (std::size_t first = 0; first < scene->size();) {
+    const std::size_t count = std::min(scene->size() - first, length(random));
+    parts.push_back(ScenePart{first, scene, first, count});  // the key: the first Gaussian
+    first += count;
+  }
+  return parts;
+}
+
+float max_difference(const Image& a, const Image& b) {
+  if (a.rgb.size() != b.rgb.size()) return INFINITY;
+  float worst = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) worst = std::max(worst, std::fabs(a.rgb[i] - b.rgb[i]));
+  return worst;
+}
+
+// Parts drawn from the GPU pool give the frame of the same parts assembled into one scene:
+// the same pairs and, but for the order of exactly equal depths, the same pixels, as the drawn
+// set changes (parts kept, dropped, reordered, evicted under a tiny cap, uploaded again).
+TEST(CudaSceneParts, DrawTheFrameOfTheAssembledScene) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = tiled_demo_scene();
+  const std::vector<ScenePart> all = uneven_parts(scene);
+  ASSERT_GT(all.size(), 20u);
+  std::vector<ScenePart> alternate, reversed;
+  for (std::size_t k = 0; k < all.size(); k += 2) alternate.push_back(all[k]);
+  reversed.assign(all.rbegin(), all.rend());
+  reversed.resize(reversed.size() / 2);
+  struct Step {
+    const char* name;
+    const std::vector<ScenePart>* parts;
+    std::uint64_t resident_bytes;
+  };
+  const Step steps[] = {{"all", &all, 0},
+                        {"every other", &alternate, 0},
+                        {"half, reversed", &reversed, 0},
+                        {"every other under a tiny cap", &alternate, 1},
+                        {"all again", &all, 1}};
+  auto pooled = make_cuda_renderer();
+  for (const Step& step : steps) {
+    pooled->set_scene_parts(*step.parts, step.resident_bytes);
+    auto whole = make_cuda_renderer();
+    whole->set_scene(assemble_scene_parts(*step.parts));
+    for (const Camera& camera : chunk_cull_cameras(*scene)) {
+      const std::string what = std::string(step.name) + " " + camera.name;
+      const Result a = render(*pooled, camera, RenderOptions{});
+      const Result b = render(*whole, camera, RenderOptions{});
+      EXPECT_EQ(a.stats.kv_pairs, b.stats.kv_pairs) << what;
+      EXPECT_EQ(a.stats.visible, b.stats.visible) << what;
+      // Every drawn Gaussian is counted once, and nothing else the pool holds.
+      EXPECT_EQ(a.stats.gaussians, scene_parts_size(*step.parts)) << what;
+      EXPECT_EQ(a.stats.visible + a.stats.culled_near + a.stats.culled_offscreen + a.stats.culled_low_opacity +
+                    a.stats.culled_degenerate,
+                a.stats.gaussians)
+          << what;
+      EXPECT_LE(max_difference(a.image, b.image), 1e-5f) << what;
+    }
+  }
+}
+
+// A pooled scene is drawn through its page list, which only flash with fused emission in full
+// precision reads: other configurations are refused with a line saying so, and a scene set
+// whole afterwards renders as in a fresh renderer.
+TEST(CudaSceneParts, RefuseTheBaselineAndGiveWayToAWholeScene) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = test::load_demo_scene();
+  const Camera camera = test::load_demo_cameras()[3].resized(333, 211);
+  auto gpu = make_cuda_renderer();
+  gpu->set_scene_parts(uneven_parts(scene), 0);
+  Image image;
+  try {
+    gpu->render(camera, RenderOptions::baseline(), image, nullptr);
+    ADD_FAILURE() << "the baseline drew a pooled scene";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not by the baseline"), std::string::npos) << e.what();
+  }
+  gpu->set_scene(scene);
+  auto fresh = make_cuda_renderer();
+  fresh->set_scene(scene);
+  for (const RenderOptions& o : {RenderOptions{}, RenderOptions::baseline()})
+    EXPECT_EQ(render(*gpu, camera, o).image.rgb, render(*fresh, camera, o).image.rgb) << o.label();
+}
+
+}  // namespace
+}  // namespace flashgs

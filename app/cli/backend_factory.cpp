@@ -56,4 +56,14 @@ void render_queued(Renderer& renderer, const Camera& camera, const RenderOptions
   throw Error("internal error: the " + renderer.name() + " backend cannot queue frames");
 }
 
+void finish_queued_frames(Renderer& renderer) {
+#ifdef FLASHGS_HAVE_CUDA
+  if (auto* cuda = dynamic_cast<CudaRenderer*>(&renderer)) {
+    cuda->finish();
+    return;
+  }
+#endif
+  throw Error("internal error: the " + renderer.name() + " backend cannot queue frames");
+}
+
 }  // namespace flashgs::cli

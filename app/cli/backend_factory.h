@@ -26,5 +26,7 @@ bool can_queue_frames(Renderer& renderer);
 // Queues a frame behind the last one without waiting for it, as the viewer renders; `stats`
 // gets this frame's counts and the previous frame's stage times. Only where can_queue_frames.
 void render_queued(Renderer& renderer, const Camera& camera, const RenderOptions& options, FrameStats* stats);
+// Waits until the frames render_queued queued have finished. Only where can_queue_frames.
+void finish_queued_frames(Renderer& renderer);
 
 }  // namespace flashgs::cli

@@ -146,6 +146,11 @@ void run_fly(const FlyArgs& args) {
   std::vector<double> frame_ms, psnrs;
   std::vector<std::uint64_t> drawn;
   std::shared_ptr<const Scene> shown;
+  // A GPU backend keeps the cut's parts in device memory and uploads only new ones
+  // (Renderer::set_scene_parts); its frames are queued and waited for, as the viewer shows them
+  // without a copy to the host. The CPU backend draws the assembled cut.
+  const bool gpu_parts = can_queue_frames(*renderer);
+  std::uint64_t gpu_high_water = 0;  // the drawn parts' pool and the frame's buffers
   // The first view waits for its chunks, as a viewer shows its load progress; later frames never wait.
   const auto open_start = Clock::now();
   streamer.update(path.front());
@@ -158,23 +163,42 @@ void run_fly(const FlyArgs& args) {
     std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
                                               std::chrono::duration<double>(static_cast<double>(i) / args.fps)));
     const auto t0 = Clock::now();
-    std::shared_ptr<const Scene> scene = streamer.update(path[i]);
-    if (scene != shown) {
-      renderer->set_scene(scene);
-      shown = scene;
-      ++swaps;
+    std::uint64_t drawn_now = 0;
+    if (gpu_parts) {
+      bool changed = false;
+      const std::vector<ScenePart>& parts = streamer.update_parts(path[i], &changed);
+      if (changed) {
+        renderer->set_scene_parts(parts, streamer.device_resident_bytes());
+        ++swaps;
+      }
+      drawn_now = scene_parts_size(parts);
+      if (drawn_now > 0) {
+        FrameStats frame_stats;
+        render_queued(*renderer, path[i], render_options, &frame_stats);
+        finish_queued_frames(*renderer);
+        gpu_high_water = std::max(gpu_high_water, frame_stats.scene_device_bytes + frame_stats.device_memory_bytes);
+      }
+    } else {
+      std::shared_ptr<const Scene> scene = streamer.update(path[i]);
+      if (scene != shown) {
+        renderer->set_scene(scene);
+        shown = scene;
+        ++swaps;
+      }
+      drawn_now = scene->size();
+      if (drawn_now > 0) renderer->render(path[i], render_options, image, nullptr);
     }
-    if (scene->size() > 0) renderer->render(path[i], render_options, image, nullptr);
     const auto t1 = Clock::now();
     const double ms = ms_between(t0, t1);
     frame_ms.push_back(ms);
-    drawn.push_back(scene->size());
+    drawn.push_back(drawn_now);
     if (ms_between(start, t0) < 1000.0) first_second_ms = std::max(first_second_ms, ms);
     else longest_after_first_second = std::max(longest_after_first_second, ms);
     const LodStreamStats s = streamer.stats();
     missing_frames += s.leaves_missing > 0;
     for (const std::string& line : streamer.take_errors()) std::fprintf(stderr, "warning: %s\n", line.c_str());
-    if (reference_renderer && scene->size() > 0 && i % static_cast<std::size_t>(args.psnr_every) == 0) {
+    if (reference_renderer && drawn_now > 0 && i % static_cast<std::size_t>(args.psnr_every) == 0) {
+      if (gpu_parts) renderer->render(path[i], render_options, image, nullptr);  // not timed: the image for the comparison
       reference_renderer->render(path[i], render_options, reference, nullptr);
       psnrs.push_back(compare_images(image, reference).psnr_db);
     }
@@ -194,6 +218,10 @@ void run_fly(const FlyArgs& args) {
               args.host_mb ? (std::to_string(args.host_mb) + " MiB").c_str() : "no",
               static_cast<double>(s.bytes_read) / 1e6, static_cast<double>(s.bytes_read) / 1e6 / seconds, s.files_resident,
               s.files_failed);
+  if (gpu_parts)
+    std::printf("GPU memory: high-water %.1f MiB (parts held and frame buffers) of a %s cap\n",
+                static_cast<double>(gpu_high_water) / (1 << 20),
+                args.gpu_mb ? (std::to_string(args.gpu_mb) + " MiB").c_str() : "no");
   if (!psnrs.empty()) {
     // Identical frames have an infinite PSNR: held at 999 dB so that the order statistics stay defined.
     for (double& p : psnrs) p = std::min(p, 999.0);

@@ -1,5 +1,5 @@
 // Chunk culling: the bounds of every chunk of 256 consecutive Gaussians (once per scene, on
-// the device), the per-frame constants of the test in chunk_cull.cuh, and the per-frame list
+// the device, or per page as a pooled scene's pages arrive), the per-frame constants of the test in chunk_cull.cuh, and the per-frame list
 // of the chunks that preprocess must read.
 #include <math.h>
 
@@ -31,14 +31,21 @@ struct Larger {
   __device__ float operator()(float a, float b) const { return fmaxf(a, b); }
 };
 
-__global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene scene, ChunkBound* bounds) {
+// A block per chunk: chunk b, or with `pages` (a pooled scene) chunk pages[b].x of pages[b].y members.
+__global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene scene, ChunkBound* bounds,
+                                                                  const uint2* pages) {
   using Reduce = cub::BlockReduce<float, kChunkSize>;
   __shared__ typename Reduce::TempStorage storage;
   __shared__ float centre[3];
   __shared__ float shared_radius, shared_scale, shared_min_opacity;
   __shared__ int all_bounded;
-  const std::size_t i = static_cast<std::size_t>(blockIdx.x) * kChunkSize + threadIdx.x;
-  const bool valid = i < scene.count;
+  const std::size_t chunk = pages ? pages[blockIdx.x].x : blockIdx.x;
+  const std::size_t first_index = chunk * kChunkSize;
+  const unsigned members = pages ? pages[blockIdx.x].y
+                                 : static_cast<unsigned>(scene.count - first_index < kChunkSize ? scene.count - first_index
+                                                                                                 : kChunkSize);
+  const std::size_t i = first_index + threadIdx.x;
+  const bool valid = threadIdx.x < members;
   GaussianShape g{{0, 0, 0}, 0, {1, 0, 0, 0}, {0, 0, 0}, 0};
   if (valid) g = load_shape(scene, i);
   const float* q = g.quaternion;
@@ -51,7 +58,7 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
   if (!ok) all_bounded = 0;
 
   // The box of the centres (an invalid thread repeats the chunk's first Gaussian).
-  const float4 first = load_position_opacity(scene, static_cast<std::size_t>(blockIdx.x) * kChunkSize);
+  const float4 first = load_position_opacity(scene, first_index);
   const float p[3] = {valid ? g.position[0] : first.x, valid ? g.position[1] : first.y,
                       valid ? g.position[2] : first.z};
   for (int a = 0; a < 3; ++a) {
@@ -89,17 +96,17 @@ __global__ void __launch_bounds__(kChunkSize) chunk_bounds_kernel(DeviceScene sc
     b.max_scale = shared_scale;
     b.min_opacity = shared_min_opacity;
     b.cullable = all_bounded != 0 && bounded(b.radius) ? 1u : 0u;
-    const std::size_t first = static_cast<std::size_t>(blockIdx.x) * kChunkSize;
-    b.members = static_cast<unsigned>(scene.count - first < kChunkSize ? scene.count - first : kChunkSize);
-    bounds[blockIdx.x] = b;
+    b.members = members;
+    bounds[chunk] = b;
   }
 }
 
 __global__ void __launch_bounds__(kChunkSize) chunk_list_kernel(DeviceScene scene, FrameBuffers buf,
                                                                 gm::CameraParams cam, gm::GeometryParams geo,
                                                                 ChunkCullFrame frame, unsigned chunks) {
-  const unsigned c = blockIdx.x * kChunkSize + threadIdx.x;
-  const bool real = c < chunks;
+  const unsigned t = blockIdx.x * kChunkSize + threadIdx.x;
+  const bool real = t < chunks;
+  const unsigned c = real && scene.draw_chunks ? scene.draw_chunks[t] : t;
   ChunkVerdict verdict = kChunkAllOffscreen;
   unsigned members = 0;
   if (real) {
@@ -158,7 +165,8 @@ ChunkCullFrame chunk_cull_frame(const gm::CameraParams& cam, const gm::GeometryP
 
 void launch_chunk_list(const DeviceScene& scene, const FrameBuffers& b, const PreprocessArgs& args,
                        cudaStream_t stream) {
-  const unsigned chunks = static_cast<unsigned>((scene.count + kChunkSize - 1) / kChunkSize);
+  const unsigned chunks = scene.draw_chunks ? scene.draw_chunk_count
+                                            : static_cast<unsigned>((scene.count + kChunkSize - 1) / kChunkSize);
   if (chunks == 0) return;
   chunk_list_kernel<<<(chunks + kChunkSize - 1) / kChunkSize, kChunkSize, 0, stream>>>(
       scene, b, args.camera, args.geometry, args.chunk_frame, chunks);
@@ -168,8 +176,14 @@ void launch_chunk_list(const DeviceScene& scene, const FrameBuffers& b, const Pr
 void launch_chunk_bounds(const DeviceScene& scene, ChunkBound* bounds, cudaStream_t stream) {
   if (scene.count == 0) return;
   const unsigned chunks = static_cast<unsigned>((scene.count + kChunkSize - 1) / kChunkSize);
-  chunk_bounds_kernel<<<chunks, kChunkSize, 0, stream>>>(scene, bounds);
+  chunk_bounds_kernel<<<chunks, kChunkSize, 0, stream>>>(scene, bounds, nullptr);
   check_cuda(cudaGetLastError(), "chunk bounds kernel launch");
+}
+
+void launch_page_bounds(const DeviceScene& scene, const uint2* pages, unsigned count, cudaStream_t stream) {
+  if (count == 0) return;
+  chunk_bounds_kernel<<<count, kChunkSize, 0, stream>>>(scene, scene.chunks, pages);
+  check_cuda(cudaGetLastError(), "page bounds kernel launch");
 }
 
 }  // namespace cuda

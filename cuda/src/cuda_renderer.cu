@@ -14,8 +14,10 @@
 #include "flashgs/error.h"
 #include "flashgs/frame_params.h"
 #include "flashgs/spatial_order.h"
+#include "device_buffer.h"
 #include "host_parallel.h"
 #include "pipeline.h"
+#include "scene_pool.h"
 #include "scene_upload.h"
 
 namespace flashgs {
@@ -54,6 +56,7 @@ bool cuda_available(std::string* why) {
 namespace {
 
 using cuda::check_cuda;
+using cuda::DeviceBuffer;
 using cuda::Clock;
 using cuda::seconds_since;
 
@@ -82,66 +85,6 @@ using PinnedHandle = CudaHandle<void*, cudaFreeHost>;
 struct HostReadback {
   cuda::FrameCounters counters;    // after the preprocess: pairs and culls of this frame
   cuda::TileTotals tile_totals[2] = {};  // FrameCounters::tile_totals, per event set
-};
-
-// One device allocation; grows (discarding its content) but never shrinks. The owner's byte
-// counters follow every change so FrameStats can report current and peak memory. Growing a
-// bound buffer first waits for its stream: a frame still in flight may be reading the old
-// allocation (cudaFree's implicit synchronisation is not something to rely on).
-class DeviceBuffer {
- public:
-  DeviceBuffer() = default;
-  DeviceBuffer(const DeviceBuffer&) = delete;
-  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
-  ~DeviceBuffer() { release(); }
-  void bind(std::uint64_t* current, std::uint64_t* peak, cudaStream_t stream) {
-    current_ = current;
-    peak_ = peak;
-    stream_ = stream;
-  }
-  // Ensures at least `bytes`; throws flashgs::Error when the device has no room.
-  void reserve(std::size_t bytes, const char* what) {
-    if (bytes <= bytes_) return;
-    if (ptr_ && stream_) check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation before a buffer grows");
-    release();
-    void* p = nullptr;
-    const cudaError_t status = cudaMalloc(&p, bytes);
-    if (status != cudaSuccess) {
-      cudaGetLastError();
-      std::size_t free_bytes = 0, total_bytes = 0;
-      cudaMemGetInfo(&free_bytes, &total_bytes);
-      throw Error(std::string("cuda renderer: out of GPU memory allocating ") + what + " (" +
-                  std::to_string(bytes >> 20) + " MiB; " + std::to_string(free_bytes >> 20) + " of " +
-                  std::to_string(total_bytes >> 20) + " MiB free)");
-    }
-    ptr_ = p;
-    bytes_ = bytes;
-    if (current_) {
-      *current_ += bytes;
-      *peak_ = std::max(*peak_, *current_);
-    }
-  }
-  void release() {
-    if (!ptr_) return;
-    cudaFree(ptr_);
-    if (current_) *current_ -= bytes_;
-    ptr_ = nullptr;
-    bytes_ = 0;
-  }
-  void swap(DeviceBuffer& other) {  // content and size; counters stay with each owner
-    std::swap(ptr_, other.ptr_);
-    std::swap(bytes_, other.bytes_);
-  }
-  template <typename T>
-  T* as() const { return static_cast<T*>(ptr_); }
-  std::size_t bytes() const { return bytes_; }
-
- private:
-  void* ptr_ = nullptr;
-  std::size_t bytes_ = 0;
-  std::uint64_t* current_ = nullptr;
-  std::uint64_t* peak_ = nullptr;
-  cudaStream_t stream_ = nullptr;
 };
 
 int bits_for(std::uint64_t values) {  // bits to hold 0 .. values - 1
@@ -259,7 +202,13 @@ class CudaRendererImpl final : public CudaRenderer {
   // new scene once. The bounds are the scene's, so a later re-pack keeps them.
   void set_scene(std::shared_ptr<const Scene> scene) override {
     if (!scene) throw Error("cuda renderer: null scene");
+    const bool was_pooled = pooled_;
+    if (pooled_) device_scene_ = cuda::DeviceScene{};  // the pool's layout is floats
     upload_scene(std::move(scene), device_scene_.sh_half, device_scene_.shape_half);
+    if (was_pooled) {
+      pool_.reset();
+      pooled_ = false;
+    }
     const auto bounds_start = Clock::now();
     compute_bounds(*scene_);
     if (print_upload_times_)
@@ -268,6 +217,27 @@ class CudaRendererImpl final : public CudaRenderer {
                    "waiting for copies %.3f s, bounds %.3f s\n",
                    scene_->size(), cuda::host_threads_for(scene_->size(), 1), upload_times_.order, upload_times_.allocation,
                    upload_times_.packing, upload_times_.waiting, seconds_since(bounds_start));
+  }
+
+  // The parts stay on the device in a pool of pages (scene_pool.h): only parts not held yet are
+  // uploaded, and a frame draws the listed pages. The regular scene's memory is given back.
+  void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) override {
+    if (!pool_) pool_ = std::make_unique<cuda::ScenePool>(stream_, &pool_bytes_, &pool_peak_bytes_);
+    if (!pooled_) {
+      check_cuda(cudaStreamSynchronize(stream_), "stream synchronisation");
+      for (DeviceBuffer* b : {&scene_pos_, &scene_rot_, &scene_scale_, &scene_dc_, &scene_rest_, &scene_chunks_, &scene_ids_})
+        b->release();
+      scene_.reset();
+    }
+    pooled_ = true;
+    device_scene_ = cuda::DeviceScene{};
+    pool_->set_parts(parts, resident_bytes);  // on failure the pool is empty: frames draw nothing
+    device_scene_ = pool_->scene();
+    const cuda::SceneBounds& bounds = pool_->bounds();
+    for (int a = 0; a < 3; ++a) bounds_centre_[a] = bounds.centre[a];
+    bounds_radius_ = bounds.radius;
+    max_opacity_ = bounds.max_opacity;
+    last_tiles_ = 0;
   }
 
   // The scene on the device in the layout of DeviceScene: its SH as floats or (`sh_half`,
@@ -415,6 +385,8 @@ class CudaRendererImpl final : public CudaRenderer {
     run_frame(camera, options, FrameTarget::device_image, nullptr, 0, stats);
   }
 
+  void finish() override { check_cuda(cudaStreamSynchronize(stream_), "frame"); }
+
   void download_tile_counts(std::vector<std::uint32_t>& counts) override {
     counts.resize(last_tiles_);
     std::vector<uint2> ranges(last_tiles_);
@@ -489,6 +461,19 @@ class CudaRendererImpl final : public CudaRenderer {
     bounds_radius_ = std::sqrt(radius2);
     // fp16_shape may round the largest opacity up (rounding keeps the order, so this is the max).
     max_opacity_ = std::max(max_opacity_, gm::round_to_half(max_opacity_));
+  }
+
+  // A pooled scene is drawn through its page list, which only fused emission reads, from its
+  // pages of floats.
+  static void check_pooled_options(const RenderOptions& options) {
+    const char* off = options.is_baseline() ? "the baseline"
+                      : !options.fused_emit ? "flash without fused emission"
+                      : options.fp16_sh     ? "fp16 SH"
+                      : options.fp16_shape  ? "fp16 shapes"
+                                            : nullptr;
+    if (off)
+      throw Error(std::string("cuda renderer: a streamed scene (scene parts) is drawn by flash with fused emission in "
+                              "full precision, not by ") + off);
   }
 
   double distance_to_bounds_centre(const gm::CameraParams& cam) const {
@@ -840,11 +825,12 @@ class CudaRendererImpl final : public CudaRenderer {
 
   void run_frame(const Camera& camera, const RenderOptions& options, FrameTarget target, Image* out,
                  std::uint64_t surface, FrameStats* stats_out) {
-    if (!scene_) throw Error("cuda renderer: no scene set");
+    if (!scene_ && !pooled_) throw Error("cuda renderer: no scene set");
     if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
     if (surface) check_surface(surface, camera);
+    if (pooled_) check_pooled_options(options);
     // A frame in another precision re-packs the scene from its host copy first.
-    if (options.fp16_sh != device_scene_.sh_half || options.fp16_shape != device_scene_.shape_half)
+    else if (options.fp16_sh != device_scene_.sh_half || options.fp16_shape != device_scene_.shape_half)
       upload_scene(scene_, options.fp16_sh, options.fp16_shape);
     const gm::CameraParams cam = make_camera_params(camera);
     // The emission kernels keep a box's tile range in 16 bits.
@@ -932,7 +918,8 @@ class CudaRendererImpl final : public CudaRenderer {
     args.sh_degree = std::max(0, std::min(device_scene_.sh_degree, options.sh_degree_cap));
     args.large_box_tiles = large_box_tiles_;
     args.item_chunks = item_chunks_;
-    args.chunk_cull = !baseline && (chunk_cull_ == kAlways || (chunk_cull_ == kAuto && n >= kChunkCullMinGaussians));
+    // A pooled scene is always drawn through the chunk list: it lists the drawn pages.
+    args.chunk_cull = !baseline && (pooled_ || chunk_cull_ == kAlways || (chunk_cull_ == kAuto && n >= kChunkCullMinGaussians));
     if (args.chunk_cull) args.chunk_frame = cuda::chunk_cull_frame(cam, args.geometry, max_opacity_);
     // Fused emission runs the chunk test as a pass of its own and preprocess over the chunks
     // it lists, so a chunk outside the view costs one thread rather than a block.
@@ -1024,7 +1011,7 @@ class CudaRendererImpl final : public CudaRenderer {
     stats.sorted_pairs = pairs;
     stats.tiles_x = cam.tiles_x;
     stats.tiles_y = cam.tiles_y;
-    stats.gaussians = n;
+    stats.gaussians = pooled_ ? pool_->drawn_gaussians() : n;  // a pool holds pages it does not draw
     stats.visible = c.by_reason[gm::kVisible];
     stats.culled_near = c.by_reason[gm::kCulledNear];
     stats.culled_offscreen = c.by_reason[gm::kCulledOffscreen];
@@ -1050,7 +1037,7 @@ class CudaRendererImpl final : public CudaRenderer {
     stats.device_memory_bytes = working_bytes_;
     stats.device_peak_bytes = peak_bytes_;
     stats.scene_device_bytes = scene_pos_.bytes() + scene_rot_.bytes() + scene_scale_.bytes() + scene_dc_.bytes() +
-                               scene_rest_.bytes() + scene_chunks_.bytes() + scene_ids_.bytes();
+                               scene_rest_.bytes() + scene_chunks_.bytes() + scene_ids_.bytes() + pool_bytes_;
     if (options.collect_tile_counts) download_tile_counts(stats.tile_pair_counts);
     *stats_out = std::move(stats);
   }
@@ -1138,6 +1125,10 @@ class CudaRendererImpl final : public CudaRenderer {
   float max_opacity_ = 1.0f;             // of the scene (sets the flash extent's largest threshold)
   // Scene (not counted as working memory).
   DeviceBuffer scene_pos_, scene_rot_, scene_scale_, scene_dc_, scene_rest_, scene_chunks_, scene_ids_;
+  // A streamed scene's parts (set_scene_parts) instead of the scene above while pooled_.
+  std::unique_ptr<cuda::ScenePool> pool_;
+  bool pooled_ = false;
+  std::uint64_t pool_bytes_ = 0, pool_peak_bytes_ = 0;
   // Working memory.
   DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_, bin_fill_,
       bin_ready_, dense_bins_, tile_order_, tile_places_, chunk_list_, image_,

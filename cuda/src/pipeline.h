@@ -87,7 +87,19 @@ struct DeviceScene {
   // [count] the scene index of device Gaussian i, where the upload put them in spatial order
   // (flashgs/spatial_order.h); null: i. Pairs of equal depth blend in scene index order.
   const std::uint32_t* scene_ids = nullptr;
+  // A pooled scene (ScenePool, a streamed cut): chunks are pages of the pool, partly filled
+  // (ChunkBound::members, the first lanes), and only the draw_chunk_count chunks listed in
+  // draw_chunks are drawn, through the chunk list (launch_chunk_list). Null: every chunk.
+  const std::uint32_t* draw_chunks = nullptr;
+  std::uint32_t draw_chunk_count = 0;
 };
+
+// Gaussians of chunk `chunk` (of a pooled scene: its page's members).
+__host__ __device__ inline unsigned chunk_members(const DeviceScene& scene, const ChunkBound* bounds, std::size_t chunk) {
+  if (scene.draw_chunks) return bounds[chunk].members;
+  const std::size_t first = chunk * kChunkSize;
+  return static_cast<unsigned>(scene.count - first < kChunkSize ? scene.count - first : kChunkSize);
+}
 
 // What the blend stage reads per Gaussian (48 bytes, three 16-byte loads): the whitened
 // footprint (gm::Footprint::whiten, q = (w0 dx + w1 dy)^2 + (w2 dx + w3 dy)^2, accurate far
@@ -244,6 +256,8 @@ struct PreprocessArgs {
 
 // Fills the scene's chunk bounds (once per scene).
 void launch_chunk_bounds(const DeviceScene& scene, ChunkBound* bounds, cudaStream_t stream);
+// The bounds of `count` pages of a pooled scene: pages[k] = (chunk, members) (a device array).
+void launch_page_bounds(const DeviceScene& scene, const uint2* pages, unsigned count, cudaStream_t stream);
 // The chunk test of every chunk, a thread each: chunks wholly culled are counted, the others
 // listed in buffers.chunk_list for preprocess, which then runs a grid over the list only.
 void launch_chunk_list(const DeviceScene& scene, const FrameBuffers& buffers, const PreprocessArgs& args,

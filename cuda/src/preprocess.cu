@@ -339,7 +339,7 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
 
   const unsigned i = chunk_index * kBlock + threadIdx.x;
   const unsigned lane = lane_id();
-  const bool valid = i < scene.count;
+  const bool valid = scene.draw_chunks ? threadIdx.x < scene.chunks[chunk_index].members : i < scene.count;
   const gm::CameraParams& cam = args.camera;
 
   if (chunk == kChunkClassify) {  // the whole block: only the centre and opacity are read
@@ -362,11 +362,9 @@ __device__ void preprocess_chunk(const DeviceScene& scene, const FrameBuffers& b
     __syncthreads();
     if (threadIdx.x < gm::kCullReasonCount && block_counts[threadIdx.x] > 0)
       atomicAdd(&buf.counters->by_reason[threadIdx.x], block_counts[threadIdx.x]);
-    if (threadIdx.x == 0) {
-      const std::size_t first = static_cast<std::size_t>(chunk_index) * kBlock;
-      const std::size_t members = scene.count - first < kBlock ? scene.count - first : kBlock;
-      atomicAdd(&buf.counters->chunk_culled, static_cast<unsigned long long>(members));
-    }
+    if (threadIdx.x == 0)
+      atomicAdd(&buf.counters->chunk_culled,
+                static_cast<unsigned long long>(chunk_members(scene, scene.chunks, chunk_index)));
     return;
   }
 
@@ -713,6 +711,8 @@ void launch_preprocess(const DeviceScene& scene, const FrameBuffers& buffers, co
   const bool counted = buffers.emitted_bin_counts != nullptr;
   if ((!fused && buffers.chunk_list) || (counted && (!fused || buffers.chunk_list)))
     throw Error("cuda renderer: internal error, a chunk list or pairs counted per bin where preprocess takes none");
+  if (scene.draw_chunks && (!fused || !buffers.chunk_list))
+    throw Error("cuda renderer: internal error, a pooled scene drawn without its chunk list");
   if (fused) {
     if (buffers.chunk_list) {
       launch_chunk_list(scene, buffers, args, stream);

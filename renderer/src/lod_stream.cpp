@@ -31,16 +31,6 @@ std::uint64_t bytes_per_gaussian(int sh_degree) {
   return sizeof(float) * (14 + 3 * static_cast<std::uint64_t>(sh_coefficient_count(sh_degree) - 1));
 }
 
-// The drawn ranges of the chunks in memory, copied one after another into one scene.
-std::shared_ptr<Scene> assemble(const std::vector<LodRange>& drawn, const std::vector<std::shared_ptr<const Scene>>& sources,
-                                std::uint64_t total) {
-  auto scene = std::make_shared<Scene>();
-  scene->sh_degree = sources.empty() ? 0 : sources.front()->sh_degree;
-  scene->trained_kernel = sources.empty() ? TrainedKernel{} : sources.front()->trained_kernel;
-  scene->reserve(total);
-  for (std::size_t i = 0; i < drawn.size(); ++i) scene->append_range(*sources[i], drawn[i].offset, drawn[i].count);
-  return scene;
-}
 
 }  // namespace
 
@@ -212,7 +202,7 @@ void LodStreamer::request(const std::vector<int>& files) {
   }
 }
 
-std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
+LodStreamer::Drawn LodStreamer::choose(const Camera& camera) {
   LodCutOptions cut_options = m_options.cut;
   cut_options.budget = m_budget == std::numeric_limits<std::uint64_t>::max() ? 0 : m_budget;
   LodCut cut = choose_lod_cut(m_set, camera, cut_options, &m_cut);
@@ -228,9 +218,11 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
   m_have_last_position = true;
 
   const int levels = m_set.level_count;
-  std::vector<LodRange> drawn;
-  std::vector<std::shared_ptr<const Scene>> sources;
-  LodStreamStats stats;
+  Drawn result;
+  std::vector<LodRange>& drawn = result.ranges;
+  std::vector<std::shared_ptr<const Scene>>& sources = result.sources;
+  LodStreamStats& stats = m_stats;
+  stats = LodStreamStats{};
   stats.budget = cut_options.budget;
   stats.drawn_per_level.assign(static_cast<std::size_t>(levels), 0);
   stats.worst_error_px = cut.worst_error_px;
@@ -277,28 +269,67 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
     if (!m_queue.empty()) m_wake.notify_all();
   }
   m_cut = std::move(cut);
+  return result;
+}
 
-  const bool same = drawn.size() == m_drawn.size() &&
-                    std::equal(drawn.begin(), drawn.end(), m_drawn.begin(), [](const LodRange& a, const LodRange& b) {
-                      return a.file == b.file && a.offset == b.offset && a.count == b.count;
-                    });
-  if (!same || !m_scene) {
-    std::uint64_t total = 0;
-    for (const LodRange& r : drawn) total += r.count;
+bool LodStreamer::same_as_drawn(const std::vector<LodRange>& drawn) const {
+  return drawn.size() == m_drawn.size() &&
+         std::equal(drawn.begin(), drawn.end(), m_drawn.begin(), [](const LodRange& a, const LodRange& b) {
+           return a.file == b.file && a.offset == b.offset && a.count == b.count;
+         });
+}
+
+std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
+  Drawn drawn = choose(camera);
+  if (!same_as_drawn(drawn.ranges) || !m_scene) {
+    const std::vector<ScenePart> parts = as_parts(drawn);
+    const std::uint64_t total = scene_parts_size(parts);
     {
       std::lock_guard<std::mutex> lock(m_mutex);  // the next scene is held beside the one drawn now
       m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes + total * m_bytes_per_gaussian);
     }
-    std::shared_ptr<Scene> scene = assemble(drawn, sources, total);
-    m_scene = std::move(scene);
-    m_drawn = std::move(drawn);
+    m_scene = assemble_scene_parts(parts);
+    m_drawn = std::move(drawn.ranges);
     std::lock_guard<std::mutex> lock(m_mutex);
     // The scene drawn now and the frame that renders it.
     m_drawn_bytes = m_scene->size() * (m_bytes_per_gaussian + m_options.host_frame.per_gaussian) + m_options.host_frame.fixed;
   }
-  stats.drawn_gaussians = m_scene->size();
-  m_stats = stats;
+  m_stats.drawn_gaussians = m_scene->size();
   return m_scene;
+}
+
+const std::vector<ScenePart>& LodStreamer::update_parts(const Camera& camera, bool* changed) {
+  Drawn drawn = choose(camera);
+  const bool differ = !same_as_drawn(drawn.ranges) || m_parts.empty();
+  if (differ) {
+    m_parts = as_parts(drawn);
+    m_drawn = std::move(drawn.ranges);
+    m_scene.reset();  // the renderer holds the parts: no drawn scene on the host
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_drawn_bytes = scene_parts_size(m_parts) * m_options.host_frame.per_gaussian + m_options.host_frame.fixed;
+    m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
+  }
+  m_stats.drawn_gaussians = scene_parts_size(m_parts);
+  if (changed) *changed = differ;
+  return m_parts;
+}
+
+std::vector<ScenePart> LodStreamer::as_parts(const Drawn& drawn) {
+  std::vector<ScenePart> parts;
+  parts.reserve(drawn.ranges.size());
+  for (std::size_t i = 0; i < drawn.ranges.size(); ++i) {
+    const LodRange& r = drawn.ranges[i];
+    // A range of a chunk file never changes: the file and offset name it.
+    parts.push_back(ScenePart{static_cast<std::uint64_t>(r.file) << 40 | r.offset, drawn.sources[i], r.offset, r.count});
+  }
+  return parts;
+}
+
+std::uint64_t LodStreamer::device_resident_bytes() const {
+  if (!m_options.device_bytes) return 0;
+  const std::uint64_t drawn_budget = m_budget == std::numeric_limits<std::uint64_t>::max() ? 0 : m_budget;
+  const std::uint64_t frame = m_options.device_frame.fixed + drawn_budget * m_options.device_frame.per_gaussian;
+  return m_options.device_bytes > frame ? m_options.device_bytes - frame : 1;
 }
 
 LodStreamStats LodStreamer::stats() const {

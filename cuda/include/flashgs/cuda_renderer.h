@@ -29,6 +29,8 @@ class CudaRenderer : public Renderer {
   // the host's launches for the next frame overlap this one's GPU work (`flashgs bench` times
   // these). `stats` as render_to_surface; a later render() waits for every queued frame.
   virtual void render_queued(const Camera& camera, const RenderOptions& options, FrameStats* stats) = 0;
+  // Returns once every queued frame has finished on the GPU.
+  virtual void finish() = 0;
   // Per-tile pair counts of the last frame (row-major tiles_y x tiles_x), copied from the
   // device only when this is called.
   virtual void download_tile_counts(std::vector<std::uint32_t>& counts) = 0;

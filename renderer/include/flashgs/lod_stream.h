@@ -16,6 +16,7 @@
 #include "flashgs/lod_cut.h"
 #include "flashgs/lod_set.h"
 #include "flashgs/scene.h"
+#include "flashgs/scene_parts.h"
 
 namespace flashgs {
 
@@ -64,6 +65,13 @@ class LodStreamer {
   // Chooses the cut for `camera`, asks for the chunks it lacks and returns the scene to draw:
   // the same pointer as before while nothing drawn changed. Never waits for a chunk.
   std::shared_ptr<const Scene> update(const Camera& camera);
+  // The same cut as parts of the chunks in memory (ScenePart::key: the chunk file and offset)
+  // for a renderer that keeps parts on the GPU (Renderer::set_scene_parts); the host then
+  // holds no drawn scene. `changed`: whether they differ from the last call's.
+  const std::vector<ScenePart>& update_parts(const Camera& camera, bool* changed);
+  // What Renderer::set_scene_parts may keep on the GPU under the device cap: the cap less the
+  // frame's memory at the budget (0: no cap).
+  std::uint64_t device_resident_bytes() const;
   LodStreamStats stats() const;
   // Blocks until no chunk is queued or loading (tests; a benchmark's warm start).
   void wait_until_idle();
@@ -73,6 +81,15 @@ class LodStreamer {
 
  private:
   struct Chunk;
+  // The ranges a cut draws and the chunk scenes they are in.
+  struct Drawn {
+    std::vector<LodRange> ranges;
+    std::vector<std::shared_ptr<const Scene>> sources;
+  };
+  // Chooses the cut, asks for the chunks it lacks and fills m_stats but its drawn count.
+  Drawn choose(const Camera& camera);
+  bool same_as_drawn(const std::vector<LodRange>& drawn) const;
+  static std::vector<ScenePart> as_parts(const Drawn& drawn);
   void load_loop();
   std::uint64_t chunk_estimate(int file) const;
   bool make_room(std::uint64_t bytes, std::unique_lock<std::mutex>& lock);
@@ -97,7 +114,8 @@ class LodStreamer {
 
   LodCut m_cut;
   std::vector<LodRange> m_drawn;  // what m_scene holds, in leaf order
-  std::shared_ptr<const Scene> m_scene;
+  std::shared_ptr<const Scene> m_scene;  // update()'s
+  std::vector<ScenePart> m_parts;        // update_parts()'s
   LodStreamStats m_stats;
   bool m_have_last_position = false;
   float m_last_position[3] = {0, 0, 0};

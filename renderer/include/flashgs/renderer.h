@@ -2,13 +2,16 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "flashgs/camera.h"
 #include "flashgs/image.h"
 #include "flashgs/options.h"
 #include "flashgs/scene.h"
+#include "flashgs/scene_parts.h"
 #include "flashgs/stats.h"
 
 namespace flashgs {
@@ -21,6 +24,11 @@ class Renderer {
   // Throws flashgs::Error when the scene cannot be held (e.g. out of GPU memory); the
   // previous scene then stays.
   virtual void set_scene(std::shared_ptr<const Scene> scene) = 0;
+  // Makes the parts, one after another, the scene rendered from now on (a streamed LOD cut).
+  // A backend that holds its scene on the GPU uploads only the parts whose keys it does not
+  // hold, and keeps parts no longer drawn while they fit in `resident_bytes` (0: no limit) for
+  // a later cut. By default the parts are assembled into one scene for set_scene.
+  virtual void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes);
   // Renders one frame. `stats` may be null.
   virtual void render(const Camera& camera, const RenderOptions& options, Image& out,
                       FrameStats* stats) = 0;

@@ -1,0 +1,28 @@
+// Assembling a scene from parts, which is what Renderer::set_scene_parts does by default.
+#include "flashgs/scene_parts.h"
+
+#include "flashgs/renderer.h"
+
+namespace flashgs {
+
+std::uint64_t scene_parts_size(const std::vector<ScenePart>& parts) {
+  std::uint64_t total = 0;
+  for (const ScenePart& p : parts) total += p.count;
+  return total;
+}
+
+std::shared_ptr<Scene> assemble_scene_parts(const std::vector<ScenePart>& parts) {
+  auto scene = std::make_shared<Scene>();
+  if (parts.empty()) return scene;
+  scene->sh_degree = parts.front().source->sh_degree;
+  scene->trained_kernel = parts.front().source->trained_kernel;
+  scene->reserve(scene_parts_size(parts));
+  for (const ScenePart& p : parts) scene->append_range(*p.source, p.first, p.count);  // checks the degree
+  return scene;
+}
+
+void Renderer::set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t) {
+  set_scene(assemble_scene_parts(parts));
+}
+
+}  // namespace flashgs
