@@ -15,7 +15,9 @@ namespace flashgs {
 namespace cuda {
 namespace {
 
-constexpr std::size_t kStagingHalfBytes = std::size_t{16} << 20;
+// Each half of the upload staging: 16 MiB, less under a small cap (a 32nd of it, at least 1 MiB).
+constexpr std::size_t kStagingHalfMaxBytes = std::size_t{16} << 20;
+constexpr std::size_t kStagingHalfMinBytes = std::size_t{1} << 20;
 constexpr unsigned kScatterBlock = 256;
 // A staged Gaussian: position and opacity, rotation, scale and DC red, DC green and blue, then
 // its higher SH bands as DeviceScene::sh_rest holds them.
@@ -42,6 +44,20 @@ __global__ void pool_scatter_kernel(const float4* __restrict__ staged, unsigned 
   }
 }
 
+// ids[page * kChunkSize + lane] = bases[k] + lane for the k-th drawn page: each drawn Gaussian's
+// place in the parts' order, so that pairs of equal depth blend in the order of the assembled
+// scene whatever pages the parts landed in.
+__global__ void pool_ids_kernel(const std::uint32_t* __restrict__ pages, const std::uint32_t* __restrict__ bases,
+                                unsigned page_count, std::uint32_t* __restrict__ ids) {
+  const std::size_t total = static_cast<std::size_t>(page_count) * kChunkSize;
+  for (std::size_t t = blockIdx.x * static_cast<std::size_t>(blockDim.x) + threadIdx.x; t < total;
+       t += static_cast<std::size_t>(gridDim.x) * blockDim.x) {
+    const std::size_t k = t / kChunkSize;
+    const unsigned lane = static_cast<unsigned>(t % kChunkSize);
+    ids[static_cast<std::size_t>(pages[k]) * kChunkSize + lane] = bases[k] + lane;
+  }
+}
+
 // Grows `buffer` to `bytes`, keeping its first `keep` bytes (queued on `stream`).
 void grow_keeping(DeviceBuffer& buffer, std::size_t bytes, std::size_t keep, std::uint64_t* current, std::uint64_t* peak,
                   cudaStream_t stream, const char* what) {
@@ -59,10 +75,9 @@ void grow_keeping(DeviceBuffer& buffer, std::size_t bytes, std::size_t keep, std
 
 ScenePool::ScenePool(cudaStream_t stream, std::uint64_t* current, std::uint64_t* peak)
     : m_stream(stream), m_current(current), m_peak(peak) {
-  for (DeviceBuffer* b : {&m_position, &m_rotation, &m_scale, &m_dc, &m_rest, &m_chunks, &m_draw_chunks,
-                          &m_device_staging, &m_device_pages})
+  for (DeviceBuffer* b : {&m_position, &m_rotation, &m_scale, &m_dc, &m_rest, &m_chunks, &m_ids, &m_draw_chunks,
+                          &m_draw_bases, &m_device_staging, &m_device_pages})
     b->bind(current, peak, stream);
-  check_cuda(cudaMallocHost(&m_staging, 2 * kStagingHalfBytes), "pinned pool staging allocation");
   for (int k = 0; k < 2; ++k) {
     check_cuda(cudaEventCreateWithFlags(&m_staging_free[k], cudaEventDisableTiming), "event creation");
     check_cuda(cudaEventCreateWithFlags(&m_draw_list_free[k], cudaEventDisableTiming), "event creation");
@@ -75,27 +90,60 @@ ScenePool::~ScenePool() {
     if (m_staging_free[k]) cudaEventDestroy(m_staging_free[k]);
     if (m_draw_list_free[k]) cudaEventDestroy(m_draw_list_free[k]);
     if (m_draw_list[k]) cudaFreeHost(m_draw_list[k]);
+    if (m_draw_bases_host[k]) cudaFreeHost(m_draw_bases_host[k]);
   }
+  release_staging();
+}
+
+void ScenePool::release_staging() {
+  if (m_stream) cudaStreamSynchronize(m_stream);
   if (m_staged_pages) cudaFreeHost(m_staged_pages);
   if (m_staging) cudaFreeHost(m_staging);
+  m_staged_pages = nullptr;
+  m_staging = nullptr;
+  m_device_staging.release();
+  m_device_pages.release();
+  m_staging_half_bytes = 0;
+  m_staging_page_capacity = 0;
+}
+
+void ScenePool::size_staging(std::uint64_t resident_bytes) {
+  const std::size_t half = resident_bytes ? std::min(kStagingHalfMaxBytes, std::max<std::size_t>(kStagingHalfMinBytes, resident_bytes / 32))
+                                          : kStagingHalfMaxBytes;
+  if (half == m_staging_half_bytes) return;
+  release_staging();
+  const std::size_t record_bytes = (kShapeVec4 + m_rest_stride_vec4) * sizeof(float4);
+  m_staging_page_capacity = std::max<std::size_t>(1, half / (kChunkSize * record_bytes));
+  m_staging_half_bytes = m_staging_page_capacity * kChunkSize * record_bytes;
+  check_cuda(cudaMallocHost(&m_staging, 2 * m_staging_half_bytes), "pinned pool staging allocation");
+  check_cuda(cudaMallocHost(&m_staged_pages, 2 * m_staging_page_capacity * sizeof(uint2)), "pinned pool page table");
+  m_device_staging.reserve(2 * m_staging_half_bytes, "pool staging");
+  m_device_pages.reserve(2 * m_staging_page_capacity * sizeof(uint2), "pool page table");
+}
+
+std::size_t ScenePool::staging_bytes() const {
+  return m_device_staging.bytes() + m_device_pages.bytes();
 }
 
 std::size_t ScenePool::page_bytes() const {
-  const std::size_t per_gaussian = 3 * sizeof(float4) + sizeof(float2) + m_rest_stride_vec4 * sizeof(float4);
-  return kChunkSize * per_gaussian + sizeof(ChunkBound) + sizeof(std::uint32_t);
+  // The shape, colour, SH bands and id of each Gaussian; the page's bounds and draw-list entry.
+  const std::size_t per_gaussian = 3 * sizeof(float4) + sizeof(float2) + m_rest_stride_vec4 * sizeof(float4) +
+                                   sizeof(std::uint32_t);
+  return kChunkSize * per_gaussian + sizeof(ChunkBound) + 2 * sizeof(std::uint32_t);
 }
 
 std::uint64_t ScenePool::bytes() const {
   std::uint64_t total = 0;
-  for (const DeviceBuffer* b : {&m_position, &m_rotation, &m_scale, &m_dc, &m_rest, &m_chunks, &m_draw_chunks,
-                                &m_device_staging, &m_device_pages})
+  for (const DeviceBuffer* b : {&m_position, &m_rotation, &m_scale, &m_dc, &m_rest, &m_chunks, &m_ids, &m_draw_chunks,
+                                &m_draw_bases, &m_device_staging, &m_device_pages})
     total += b->bytes();
   return total;
 }
 
 void ScenePool::clear() {
   if (m_stream) cudaStreamSynchronize(m_stream);
-  for (DeviceBuffer* b : {&m_position, &m_rotation, &m_scale, &m_dc, &m_rest, &m_chunks, &m_draw_chunks}) b->release();
+  for (DeviceBuffer* b : {&m_position, &m_rotation, &m_scale, &m_dc, &m_rest, &m_chunks, &m_ids, &m_draw_chunks, &m_draw_bases})
+    b->release();
   m_free_pages.clear();
   m_parts.clear();
   m_capacity_pages = 0;
@@ -109,13 +157,7 @@ void ScenePool::reset_layout(int sh_degree) {
   m_sh_degree = sh_degree;
   const int rest_floats = 3 * (sh_coefficient_count(sh_degree) - 1);
   m_rest_stride_vec4 = (rest_floats + 3) / 4;
-  const std::size_t record_bytes = (kShapeVec4 + m_rest_stride_vec4) * sizeof(float4);
-  m_staging_page_capacity = kStagingHalfBytes / (kChunkSize * record_bytes);
-  if (m_staged_pages) cudaFreeHost(m_staged_pages);
-  m_staged_pages = nullptr;
-  check_cuda(cudaMallocHost(&m_staged_pages, 2 * m_staging_page_capacity * sizeof(uint2)), "pinned pool page table");
-  m_device_staging.reserve(2 * kStagingHalfBytes, "pool staging");
-  m_device_pages.reserve(2 * m_staging_page_capacity * sizeof(uint2), "pool page table");
+  release_staging();  // its records are of the new layout
 }
 
 void ScenePool::grow(std::size_t pages) {
@@ -130,7 +172,9 @@ void ScenePool::grow(std::size_t pages) {
                  m_peak, m_stream, "pool SH bands");
   grow_keeping(m_chunks, pages * sizeof(ChunkBound), m_capacity_pages * sizeof(ChunkBound), m_current, m_peak, m_stream,
                "pool page bounds");
+  m_ids.reserve(now * sizeof(std::uint32_t), "pool Gaussian ids");  // rewritten for every cut
   m_draw_chunks.reserve(pages * sizeof(std::uint32_t), "pool draw list");
+  m_draw_bases.reserve(pages * sizeof(std::uint32_t), "pool draw list");
   // Highest pages last, so that the lowest free page is used first.
   for (std::size_t p = pages; p-- > m_capacity_pages;) m_free_pages.push_back(static_cast<std::uint32_t>(p));
   m_capacity_pages = pages;
@@ -172,8 +216,11 @@ void ScenePool::set_parts(const std::vector<ScenePart>& parts, std::uint64_t res
       missing.push_back(&part);
       needed += pages_for(part.count);
     }
-    const std::size_t limit_pages =
-        resident_bytes ? std::max<std::size_t>(1, resident_bytes / page_bytes()) : std::numeric_limits<std::size_t>::max();
+    size_staging(resident_bytes);
+    const std::size_t limit_pages = resident_bytes ? std::max<std::size_t>(1, (resident_bytes - std::min<std::uint64_t>(
+                                                                                     resident_bytes, staging_bytes())) /
+                                                                                     page_bytes())
+                                                   : std::numeric_limits<std::size_t>::max();
     const auto used = [&] { return m_capacity_pages - m_free_pages.size(); };
     while ((m_free_pages.size() < needed || used() + needed > limit_pages) && evict_least_recent()) {
     }
@@ -225,7 +272,7 @@ void ScenePool::upload(const std::vector<const ScenePart*>& parts) {
   for (std::size_t begin = 0; begin < jobs.size(); begin += m_staging_page_capacity) {
     const std::size_t end = std::min(jobs.size(), begin + m_staging_page_capacity);
     check_cuda(cudaEventSynchronize(m_staging_free[m_half]), "pool upload");  // the half's last copy landed
-    float4* staged = reinterpret_cast<float4*>(static_cast<char*>(m_staging) + m_half * kStagingHalfBytes);
+    float4* staged = reinterpret_cast<float4*>(static_cast<char*>(m_staging) + m_half * m_staging_half_bytes);
     uint2* table = m_staged_pages + m_half * m_staging_page_capacity;
     for_each_host_range(end - begin, host_threads_for((end - begin) * kChunkSize, 4096),
                         [&](unsigned, std::size_t lo, std::size_t hi) {
@@ -255,7 +302,7 @@ void ScenePool::upload(const std::vector<const ScenePart*>& parts) {
       }
     });
     const std::size_t count = end - begin;
-    char* device_staging = m_device_staging.as<char>() + m_half * kStagingHalfBytes;
+    char* device_staging = m_device_staging.as<char>() + m_half * m_staging_half_bytes;
     uint2* device_pages = m_device_pages.as<uint2>() + m_half * m_staging_page_capacity;
     check_cuda(cudaMemcpyAsync(device_staging, staged, count * kChunkSize * record_vec4 * sizeof(float4),
                                cudaMemcpyHostToDevice, m_stream),
@@ -288,23 +335,30 @@ void ScenePool::write_draw_list(const std::vector<ScenePart>& parts) {
     check_cuda(cudaStreamSynchronize(m_stream), "pool draw list");  // both copies are done
     for (int k = 0; k < 2; ++k) {
       if (m_draw_list[k]) cudaFreeHost(m_draw_list[k]);
-      m_draw_list[k] = nullptr;
+      if (m_draw_bases_host[k]) cudaFreeHost(m_draw_bases_host[k]);
+      m_draw_list[k] = m_draw_bases_host[k] = nullptr;
     }
     m_draw_list_capacity = 0;
     const std::size_t capacity = std::max<std::size_t>(pages + pages / 4, 1024);
-    for (int k = 0; k < 2; ++k)
+    for (int k = 0; k < 2; ++k) {
       check_cuda(cudaMallocHost(&m_draw_list[k], capacity * sizeof(std::uint32_t)), "pinned pool draw list");
+      check_cuda(cudaMallocHost(&m_draw_bases_host[k], capacity * sizeof(std::uint32_t)), "pinned pool draw list");
+    }
     m_draw_list_capacity = capacity;
   }
   check_cuda(cudaEventSynchronize(m_draw_list_free[m_draw_half]), "pool draw list");
   std::uint32_t* list = m_draw_list[m_draw_half];
+  std::uint32_t* bases = m_draw_bases_host[m_draw_half];
   std::size_t n = 0;
   SceneBounds bounds;
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   m_drawn_gaussians = 0;
   for (const ScenePart& part : parts) {
     const Resident& resident = m_parts.at(part.key);
-    for (std::uint32_t page : resident.pages) list[n++] = page;
+    for (std::size_t k = 0; k < resident.pages.size(); ++k) {
+      list[n] = resident.pages[k];
+      bases[n++] = static_cast<std::uint32_t>(m_drawn_gaussians + k * kChunkSize);
+    }
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], double(resident.lo[a]));
       hi[a] = std::max(hi[a], double(resident.hi[a]));
@@ -319,9 +373,18 @@ void ScenePool::write_draw_list(const std::vector<ScenePart>& parts) {
   }
   bounds.radius = std::sqrt(radius2);
   m_bounds = bounds;
-  if (n > 0)
+  if (m_drawn_gaussians >= (std::uint64_t{1} << 32))
+    throw Error("cuda renderer: " + std::to_string(m_drawn_gaussians) + " Gaussians drawn exceed the 32-bit Gaussian index");
+  if (n > 0) {
     check_cuda(cudaMemcpyAsync(m_draw_chunks.as<void>(), list, n * sizeof(std::uint32_t), cudaMemcpyHostToDevice, m_stream),
                "pool draw list");
+    check_cuda(cudaMemcpyAsync(m_draw_bases.as<void>(), bases, n * sizeof(std::uint32_t), cudaMemcpyHostToDevice, m_stream),
+               "pool draw list");
+    const unsigned blocks = static_cast<unsigned>(std::min<std::size_t>(4096, (n * kChunkSize + kScatterBlock - 1) / kScatterBlock));
+    pool_ids_kernel<<<blocks, kScatterBlock, 0, m_stream>>>(m_draw_chunks.as<std::uint32_t>(), m_draw_bases.as<std::uint32_t>(),
+                                                          static_cast<unsigned>(n), m_ids.as<std::uint32_t>());
+    check_cuda(cudaGetLastError(), "pool ids kernel launch");
+  }
   check_cuda(cudaEventRecord(m_draw_list_free[m_draw_half], m_stream), "event record");
   m_draw_half ^= 1;
 
@@ -335,6 +398,7 @@ void ScenePool::write_draw_list(const std::vector<ScenePart>& parts) {
   m_scene.dc_gb = m_dc.as<float2>();
   m_scene.sh_rest = m_rest_stride_vec4 > 0 ? m_rest.as<float4>() : nullptr;
   m_scene.chunks = m_chunks.as<ChunkBound>();
+  m_scene.scene_ids = m_ids.as<std::uint32_t>();
   m_scene.draw_chunks = m_draw_chunks.as<std::uint32_t>();
   m_scene.draw_chunk_count = static_cast<std::uint32_t>(n);
 }

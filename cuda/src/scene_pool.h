@@ -57,6 +57,9 @@ class ScenePool {
   };
   void clear();
   void reset_layout(int sh_degree);
+  void release_staging();
+  void size_staging(std::uint64_t resident_bytes);
+  std::size_t staging_bytes() const;
   void grow(std::size_t pages);
   void evict(const std::unordered_map<std::uint64_t, Resident>::iterator& victim);
   bool evict_least_recent();
@@ -71,7 +74,9 @@ class ScenePool {
   int m_sh_degree = -1;
   int m_rest_stride_vec4 = 0;
   std::size_t m_capacity_pages = 0;
-  DeviceBuffer m_position, m_rotation, m_scale, m_dc, m_rest, m_chunks, m_draw_chunks;
+  DeviceBuffer m_position, m_rotation, m_scale, m_dc, m_rest, m_chunks;
+  DeviceBuffer m_ids;                        // per slot: its place in the cut's order (DeviceScene::scene_ids)
+  DeviceBuffer m_draw_chunks, m_draw_bases;  // per drawn page: the page, and the id of its first Gaussian
   std::vector<std::uint32_t> m_free_pages;
   std::unordered_map<std::uint64_t, Resident> m_parts;
   std::uint64_t m_generation = 0;
@@ -87,9 +92,11 @@ class ScenePool {
   DeviceBuffer m_device_staging, m_device_pages;
   cudaEvent_t m_staging_free[2] = {nullptr, nullptr};
   int m_half = 0;
+  std::size_t m_staging_half_bytes = 0;
   std::size_t m_staging_page_capacity = 0;  // pages per half
   // The draw list's pinned copies, used in turn (a copy may still be in flight).
   std::uint32_t* m_draw_list[2] = {nullptr, nullptr};
+  std::uint32_t* m_draw_bases_host[2] = {nullptr, nullptr};
   std::size_t m_draw_list_capacity = 0;
   cudaEvent_t m_draw_list_free[2] = {nullptr, nullptr};
   int m_draw_half = 0;
