@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/backend_tuning.h"
 #include "flashgs/cuda_renderer.h"
 #include "flashgs/error.h"
 #include "flashgs/frame_params.h"
@@ -176,9 +177,15 @@ cuda::KeyFormat compact_key_format(std::uint64_t tiles, double min_depth, double
   return k;
 }
 
+// The bin sort holds at most kBinSortSharedPairsMax pairs of a bin in shared memory.
+static_assert(tuning_knob("bin_sort_shared_pairs").max == cuda::kBinSortSharedPairsMax,
+              "the bin_sort_shared_pairs knob's range is the bin sort's shared-memory limit");
+// A deferred work item is one warp's: at most a chunk per lane.
+static_assert(tuning_knob("deferred_item_chunks").max == cuda::kWarp, "the deferred_item_chunks knob's range");
+
 class CudaRendererImpl final : public CudaRenderer {
  public:
-  CudaRendererImpl() {
+  explicit CudaRendererImpl(const BackendTuning& tuning) {
     check_cuda(cudaGetDevice(&device_), "cudaGetDevice");
     cudaDeviceProp prop{};
     check_cuda(cudaGetDeviceProperties(&prop, device_), "cudaGetDeviceProperties");
@@ -186,54 +193,27 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaStreamCreateWithFlags(stream_handle_.out(), cudaStreamNonBlocking), "stream creation");
     stream_ = stream_handle_.get();
     check_cuda(cudaStreamCreateWithFlags(copy_stream_handle_.out(), cudaStreamNonBlocking), "stream creation");
-    // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
-    if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
-    // FLASHGS_BLEND_STOP_BOUND=0 runs the blend's stop rule on every staged Gaussian: the same
-    // image, slower (the tests compare the two).
-    if (const char* bound = std::getenv("FLASHGS_BLEND_STOP_BOUND")) stop_bound_ = std::atoi(bound) != 0;
-    // And the box size (in tiles, bins with macro bins) above which warps emit a Gaussian's
-    // pairs after preprocess, in work items of how many 32-bin chunks.
-    if (const char* tiles = std::getenv("FLASHGS_LARGE_BOX_TILES"))
-      large_box_tiles_ = std::max(1, std::min(kMaxBoxThreshold, std::atoi(tiles)));
-    if (const char* chunks = std::getenv("FLASHGS_DEFERRED_ITEM_CHUNKS"))
-      item_chunks_ = std::max(1, std::min(cuda::kWarp, std::atoi(chunks)));
-    // FLASHGS_CHUNK_CULL=0 projects every Gaussian, =1 culls chunks in any scene (unset: scenes
-    // of kChunkCullMinGaussians and more).
-    if (const char* cull = std::getenv("FLASHGS_CHUNK_CULL")) chunk_cull_ = std::atoi(cull) != 0 ? kAlways : kNever;
-    // FLASHGS_SPATIAL_ORDER=1 uploads every scene in spatial order, =0 none (unset: scenes whose
-    // stored order is not spatially coherent, see flashgs/spatial_order.h).
-    if (const char* order = std::getenv("FLASHGS_SPATIAL_ORDER")) spatial_order_ = std::atoi(order) != 0 ? kAlways : kNever;
-    // FLASHGS_UPLOAD_TIMES=1 prints where each set_scene's time went (stderr).
-    if (const char* times = std::getenv("FLASHGS_UPLOAD_TIMES")) print_upload_times_ = std::atoi(times) != 0;
-    // FLASHGS_DENSE_TILES_FIRST=1 orders the tiles on every frame, =0 never (unset: when the
-    // last frame's fullest tile outlasted a wave of the blend, see dense_order_pays).
-    if (const char* dense = std::getenv("FLASHGS_DENSE_TILES_FIRST"))
-      dense_tiles_mode_ = std::atoi(dense) != 0 ? kAlways : kNever;
-    // FLASHGS_SORT_KEY_BITS: the compact key's length (tile and depth bin), 16 to 32.
-    if (const char* bits = std::getenv("FLASHGS_SORT_KEY_BITS")) sort_key_bits_ = std::max(16, std::min(32, std::atoi(bits)));
-    // FLASHGS_BIN_SORT=1 sorts every binned frame per bin, =0 none (CUB's radix sort over the
-    // whole frame, the path of 64-bit keys and of tile keys; unset: where it pays, see
-    // bin_sort_pays); FLASHGS_BIN_SORT_SHARED_PAIRS (0 to kBinSortSharedPairsMax) is the
-    // largest bin sorted in shared memory.
-    if (const char* bin_sort = std::getenv("FLASHGS_BIN_SORT")) bin_sort_ = std::atoi(bin_sort) != 0 ? kAlways : kNever;
-    if (const char* shared = std::getenv("FLASHGS_BIN_SORT_SHARED_PAIRS"))
-      bin_sort_shared_pairs_ = static_cast<unsigned>(
-          std::max(0, std::min(static_cast<int>(cuda::kBinSortSharedPairsMax), std::atoi(shared))));
+    // The knobs of flashgs/backend_tuning.h; each mode's auto is decided per scene or frame
+    // (upload_scene, bin_sort_pays, emit_bin_counts_pays, dense_order_pays, run_frame).
+    region_width_ = static_cast<int>(tuning.blend_region_width);
+    stop_bound_ = tuning.blend_stop_bound != 0;
+    large_box_tiles_ = static_cast<int>(tuning.large_box_tiles);
+    item_chunks_ = static_cast<int>(tuning.deferred_item_chunks);
+    chunk_cull_ = mode_of(tuning.chunk_cull);
+    spatial_order_ = mode_of(tuning.spatial_order);
+    print_upload_times_ = tuning.upload_times != 0;
+    dense_tiles_mode_ = mode_of(tuning.dense_tiles_first);
+    sort_key_bits_ = static_cast<int>(tuning.sort_key_bits);
+    bin_sort_ = mode_of(tuning.bin_sort);
+    bin_sort_shared_pairs_ = static_cast<unsigned>(tuning.bin_sort_shared_pairs);
+    emit_bin_counts_ = mode_of(tuning.emit_bin_counts);
+    initial_records_ = static_cast<std::uint64_t>(tuning.initial_records);
     // The blend starts beside the bin blocks where the device can launch a kernel early (sm_90
-    // and later); FLASHGS_BIN_OVERLAP=0 runs it after them.
+    // and later) unless the knob turns it off.
     int device = 0, major = 0;
     check_cuda(cudaGetDevice(&device), "device query");
     check_cuda(cudaDeviceGetAttribute(&major, cudaDevAttrComputeCapabilityMajor, device), "device query");
-    bin_overlap_ = major >= 9;
-    if (const char* overlap = std::getenv("FLASHGS_BIN_OVERLAP")) bin_overlap_ = bin_overlap_ && std::atoi(overlap) != 0;
-    // FLASHGS_EMIT_BIN_COUNTS=1 has every bin-sort frame count its pairs per bin as it emits
-    // them (FrameBuffers::emitted_bin_counts) unless it orders its bins or culls by chunk list,
-    // =0 none (the counting pass counts; unset: where it pays, see emit_bin_counts_pays).
-    if (const char* counts = std::getenv("FLASHGS_EMIT_BIN_COUNTS"))
-      emit_bin_counts_ = std::atoi(counts) != 0 ? kAlways : kNever;
-    // FLASHGS_INITIAL_RECORDS: the blend records a first frame starts with (tests of growth).
-    if (const char* records = std::getenv("FLASHGS_INITIAL_RECORDS"))
-      initial_records_ = std::max<long long>(1, std::atoll(records));
+    bin_overlap_ = major >= 9 && tuning.bin_overlap != 0;
     blend_resident_blocks_ = cuda::blend_resident_blocks();
     for (int set = 0; set < 2; ++set)
       for (int e = 0; e < kEventCount; ++e) {
@@ -1081,13 +1061,12 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;
   std::uint64_t pair_capacity_ = 0;
   std::size_t last_tiles_ = 0;
-  int region_width_ = 8;
+  int region_width_ = 0;  // the tuning's (constructor), as the knobs below
   bool stop_bound_ = true;
   std::size_t cub_sized_for_gaussians_ = ~std::size_t{0};  // sizes cub_temp_ was last checked for
   std::uint64_t cub_sized_for_pairs_ = 0;
-  static constexpr int kMaxBoxThreshold = 1 << 20;  // large_box_tiles_ at most: a 16384x16384 frame's tiles
-  int large_box_tiles_ = cuda::kLargeBoxTiles;
-  int item_chunks_ = cuda::kDeferredItemChunks;
+  int large_box_tiles_ = 0;
+  int item_chunks_ = 0;
   // Chunk culling pays off in large scenes (the 3.5M tiled scene's project stage fell 9%, the
   // 100M one's 2.8x on an H200) and costs a test per 256 Gaussians that cannot pay off when
   // the whole of a small scene is in view (pc_biker's and pc_playbot's orbit views).
@@ -1097,12 +1076,13 @@ class CudaRendererImpl final : public CudaRenderer {
   // cull working again). Below, it gathers a small grid's heavy Gaussians into a few blocks
   // (v3dg_donut, 45k: 3% / 2% longer on the H200, docs/PERFORMANCE.md).
   static constexpr std::size_t kSpatialOrderMinGaussians = std::size_t{1} << 18;
-  // Compact records a scene's first frame starts with (100 MB): a view of more Gaussians grows
-  // them once and runs again.
-  std::uint64_t initial_records_ = std::uint64_t{1} << 21;
-  int sort_key_bits_ = 32;  // of a compact key (compact_key_format)
-  unsigned bin_sort_shared_pairs_ = cuda::kBinSortSharedPairsMax;
+  // Compact records a scene's first frame starts with: a view of more Gaussians grows them once
+  // and runs again.
+  std::uint64_t initial_records_ = 0;
+  int sort_key_bits_ = 0;  // of a compact key (compact_key_format)
+  unsigned bin_sort_shared_pairs_ = 0;
   enum Mode { kAuto, kAlways, kNever };
+  static Mode mode_of(long long knob) { return knob == kTuningAuto ? kAuto : (knob != 0 ? kAlways : kNever); }
   Mode chunk_cull_ = kAuto;
   Mode spatial_order_ = kAuto;  // the scene's device layout in spatial order (upload_scene)
   // Where the last upload's wall-clock seconds went, printed by set_scene where asked for.
@@ -1146,6 +1126,8 @@ class CudaRendererImpl final : public CudaRenderer {
 
 }  // namespace
 
-std::unique_ptr<CudaRenderer> make_cuda_renderer() { return std::make_unique<CudaRendererImpl>(); }
+std::unique_ptr<CudaRenderer> make_cuda_renderer(const BackendTuning& tuning) {
+  return std::make_unique<CudaRendererImpl>(tuning);
+}
 
 }  // namespace flashgs
