@@ -818,6 +818,8 @@ class CudaRendererImpl final : public CudaRenderer {
     }
   }
 
+  // Renders one frame: its path planned, its buffers sized, its preprocess queued and its
+  // counts read back, then the rest of its work queued; its statistics where asked for.
   void run_frame(const Camera& camera, const RenderOptions& options, FrameTarget target, Image* out,
                  std::uint64_t surface, FrameStats* stats_out) {
     if (!scene_) throw Error("cuda renderer: no scene set");
@@ -826,6 +828,50 @@ class CudaRendererImpl final : public CudaRenderer {
     // A frame in another precision re-packs the scene from its host copy first.
     if (options.fp16_sh != device_scene_.sh_half || options.fp16_shape != device_scene_.shape_half)
       upload_scene(scene_, options.fp16_sh, options.fp16_shape);
+    const FramePath path = plan_frame_path(camera, options, target);
+    size_frame_buffers(path, options);
+    const cuda::PreprocessArgs args = preprocess_args(path, options);
+    // Event sets alternate between frames, so that a surface frame's statistics can report
+    // the previous frame's stage times without waiting for its own.
+    const int previous_set = event_set_;
+    const bool previous_complete = last_frame_complete_;  // all its events recorded
+    last_frame_complete_ = false;
+    event_set_ ^= 1;
+    frame_tiles_[event_set_] = path.tiles;
+    // The bin sort reads the pair count on the device, so a frame of fused emission queues
+    // the rest of its work before the host waits for the count: the GPU then runs on instead
+    // of idling while the host reads the count and launches the sort (8-16 us a frame).
+    // Nothing it queues waits for the last frame's end (dense_order_pays reads a finished
+    // frame's statistics), so frames queued back to back follow each other without a gap.
+    const bool queue_before_count = bin_sort_frame_ && path.fused;
+    // Such a frame that goes to the host (whose end the host waits for anyway) reads its counts
+    // back at its end, after the blend: a copy between preprocess and sort kept the GPU idle
+    // for 15-25 us on the H200 machine. A surface frame reads them back at once, so that
+    // the host can go on while the GPU blends.
+    const bool count_at_end = queue_before_count && out;
+    separate_emit_[event_set_] = !path.fused;
+    const FramePlan frame{&camera,    &path.cam,  &options,    &args,         out,        surface,     path.float_image,
+                          path.tiles, path.bins, path.pixels, path.baseline, path.fused, path.binned, count_at_end};
+    const std::uint64_t pairs =
+        queue_preprocess_and_read_back(frame, queue_before_count, count_at_end, previous_set, previous_complete);
+    if (!queue_before_count) queue_after_count(frame, pairs);
+    finish_frame(frame, pairs);
+    if (stats_out) *stats_out = frame_stats(frame, pairs, previous_set, previous_complete);
+  }
+
+  // What plan_frame_path decides of a frame before any of its work is queued.
+  struct FramePath {
+    gm::CameraParams cam;
+    std::uint64_t tiles, pixels, bins;
+    std::size_t n;  // the scene's Gaussians
+    bool baseline, fused, binned;
+    bool float_image;  // the blend writes the device image (a host or a queued frame)
+  };
+
+  // The frame's path: its tiles and bins (macro bins where the scene allows them), its key
+  // format (compact keys over the depths the view can hold) and its sort (per bin where that
+  // pays, bin_sort_frame_).
+  FramePath plan_frame_path(const Camera& camera, const RenderOptions& options, FrameTarget target) {
     const gm::CameraParams cam = make_camera_params(camera);
     // The emission kernels keep a box's tile range in 16 bits.
     if (cam.tiles_x > 0xffff || cam.tiles_y > 0xffff)
@@ -862,6 +908,15 @@ class CudaRendererImpl final : public CudaRenderer {
 
     // The bin sort needs the depth bins of compact keys (depth_bits > 0) in 32-bit keys.
     bin_sort_frame_ = binned && key_format_.depth_bits > 0 && bin_sort_pays(bins);
+    return FramePath{cam, tiles, pixels, bins, n, baseline, fused, binned, target != FrameTarget::surface};
+  }
+
+  // The buffers the frame's path needs, grown (never shrunk) to its bins, tiles, image and
+  // records.
+  void size_frame_buffers(const FramePath& path, const RenderOptions& options) {
+    const std::uint64_t tiles = path.tiles, bins = path.bins, pixels = path.pixels;
+    const std::size_t n = path.n;
+    const bool baseline = path.baseline, fused = path.fused, binned = path.binned;
     if (bin_sort_frame_) {
       const std::size_t fill_bytes = bin_fill_.bytes();
       // Each bin's fill, then its count when emission counts (FrameBuffers::emitted_bin_counts).
@@ -879,8 +934,7 @@ class CudaRendererImpl final : public CudaRenderer {
       tile_lists_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile lists");
       dense_bins_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "dense bin list");
     }
-    const bool float_image = target != FrameTarget::surface;
-    if (float_image) image_.reserve(pixels * 3 * sizeof(float), "frame image");
+    if (path.float_image) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     // Fused emission keeps a blend record per projected Gaussian (FrameBuffers::blend), the
     // separate path one per Gaussian.
     compact_records_ = fused;
@@ -902,7 +956,13 @@ class CudaRendererImpl final : public CudaRenderer {
       pair_offsets_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair offsets");
     }
     grow_cub_temp();  // allocates only when the scene or pairs grew
+  }
 
+  // The preprocess kernel's arguments; the chunk list sized where preprocess walks one.
+  cuda::PreprocessArgs preprocess_args(const FramePath& path, const RenderOptions& options) {
+    const gm::CameraParams& cam = path.cam;
+    const std::size_t n = path.n;
+    const bool baseline = path.baseline, fused = path.fused;
     cuda::PreprocessArgs args{};
     args.camera = cam;
     args.geometry = make_geometry_params(options);
@@ -920,31 +980,21 @@ class CudaRendererImpl final : public CudaRenderer {
     if (list_chunks_)
       chunk_list_.reserve(
           std::max<std::size_t>((n + cuda::kChunkSize - 1) / cuda::kChunkSize, 1) * sizeof(std::uint32_t), "chunk list");
+    return args;
+  }
 
-    // project (+ fused emit), then the frame's one read back: the pair and record counts.
-    // Fused emission that overflowed wrote nothing past the capacities; grow and run it again.
-    // Event sets alternate between frames, so that a surface frame's statistics can report
-    // the previous frame's stage times without waiting for its own.
-    const int previous_set = event_set_;
-    const bool previous_complete = last_frame_complete_;  // all its events recorded
-    last_frame_complete_ = false;
-    event_set_ ^= 1;
-    frame_tiles_[event_set_] = tiles;
+  // Queues project (+ fused emit), then the frame's one read back: the pair and record counts,
+  // which it waits for; returns the pairs. Fused emission that overflowed wrote nothing past
+  // the capacities; grow and run it again. A frame queued before its count
+  // (queue_before_count) queues the rest of its work here too.
+  std::uint64_t queue_preprocess_and_read_back(const FramePlan& frame, bool queue_before_count, bool count_at_end,
+                                               int previous_set, bool previous_complete) {
+    const RenderOptions& options = *frame.options;
+    const cuda::PreprocessArgs& args = *frame.args;
+    const std::uint64_t tiles = frame.tiles, bins = frame.bins;
+    const std::size_t n = device_scene_.count;
+    const bool baseline = frame.baseline, fused = frame.fused;
     cudaEvent_t* events = events_[event_set_];
-    // The bin sort reads the pair count on the device, so a frame of fused emission queues
-    // the rest of its work before the host waits for the count: the GPU then runs on instead
-    // of idling while the host reads the count and launches the sort (8-16 us a frame).
-    // Nothing it queues waits for the last frame's end (dense_order_pays reads a finished
-    // frame's statistics), so frames queued back to back follow each other without a gap.
-    const bool queue_before_count = bin_sort_frame_ && fused;
-    // Such a frame that goes to the host (whose end the host waits for anyway) reads its counts
-    // back at its end, after the blend: a copy between preprocess and sort kept the GPU idle
-    // for 15-25 us on the H200 machine. A surface frame reads them back at once, so that
-    // the host can go on while the GPU blends.
-    const bool count_at_end = queue_before_count && out;
-    separate_emit_[event_set_] = !fused;
-    const FramePlan frame{&camera, &cam, &options, &args, out, surface,
-                          float_image, tiles, bins, pixels, baseline, fused, binned, count_at_end};
     std::uint64_t pairs = 0;
     for (int attempt = 0;; ++attempt) {
       // Emission counts the pairs per bin where it pays, each preprocess block takes its own
@@ -985,7 +1035,16 @@ class CudaRendererImpl final : public CudaRenderer {
       if (!fused) break;  // nothing was written yet
       if (attempt > 0) throw Error("cuda renderer: internal error, pair count changed between identical runs");
     }
-    if (!queue_before_count) queue_after_count(frame, pairs);
+    return pairs;
+  }
+
+  // What the next frames judge by (this frame's tiles, pairs and records; the deferred list
+  // grown to what it wanted), and a frame for the host waited for.
+  void finish_frame(const FramePlan& frame, std::uint64_t pairs) {
+    const cuda::PreprocessArgs& args = *frame.args;
+    const std::uint64_t tiles = frame.tiles;
+    const bool fused = frame.fused, binned = frame.binned;
+    Image* out = frame.out;
     if (args.warp_cooperative && fused)
       grow_deferred(readback_->counters.deferred, readback_->counters.deferred_items);
     last_tiles_ = tiles;
@@ -997,8 +1056,15 @@ class CudaRendererImpl final : public CudaRenderer {
       settle(event_set_);
     }
     last_frame_complete_ = true;
-    if (!stats_out) return;
+  }
 
+  // The frame's counts, stage times and memory (a surface frame: the previous frame's times).
+  FrameStats frame_stats(const FramePlan& frame, std::uint64_t pairs, int previous_set, bool previous_complete) {
+    const gm::CameraParams& cam = *frame.cam;
+    const RenderOptions& options = *frame.options;
+    const std::size_t n = device_scene_.count;
+    const bool binned = frame.binned;
+    Image* out = frame.out;
     FrameStats stats;
     const cuda::FrameCounters& c = readback_->counters;
     stats.sorted_pairs = pairs;
@@ -1032,7 +1098,7 @@ class CudaRendererImpl final : public CudaRenderer {
     stats.scene_device_bytes = scene_pos_.bytes() + scene_rot_.bytes() + scene_scale_.bytes() + scene_dc_.bytes() +
                                scene_rest_.bytes() + scene_chunks_.bytes() + scene_ids_.bytes();
     if (options.collect_tile_counts) download_tile_counts(stats.tile_pair_counts);
-    *stats_out = std::move(stats);
+    return stats;
   }
 
   int device_ = 0;
