@@ -744,8 +744,10 @@ TEST(CliTuning, ListTuningNamesEveryKnob) {
 
 TEST(CliTuning, BenchSweepsAKnobAndRecordsTheValuesUsed) {
   const std::string dir = scratch_dir("bench_tuning");
+  // The scene after --set stays the scene: each --set takes one value.
   const CliResult r = run_cli("bench --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 "
-                              "--set sort_key_bits=24 --tuning blend_stop_bound=0,1 --json " + dir + "/b.json");
+                              "--set sort_key_bits=24 " + demo_scene_path() + " --tuning blend_stop_bound=0,1 --json " +
+                              dir + "/b.json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("tuning (changed from the defaults): sort_key_bits=24\n"), std::string::npos) << r.output;
   for (const char* row : {"baseline blend_stop_bound=0", "baseline blend_stop_bound=1", "flash blend_stop_bound=0",

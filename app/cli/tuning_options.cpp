@@ -30,10 +30,12 @@ std::vector<std::string> split_values(const std::string& text) {
 void TuningOptions::add_to(CLI::App* command) {
   command->add_option("--set", settings,
                       "NAME=VALUE: a backend tuning knob for every run (" + knob_names() +
-                          "; see --list-tuning; the environment's FLASHGS_<NAME> is the default)")
-      ->take_all();
-  command->add_option("--tuning", sweeps, "NAME=V1,V2,...: run every configuration once per value of the knob")
-      ->take_all();
+                          "; see --list-tuning; the environment's FLASHGS_<NAME> is the default); may be repeated")
+      ->allow_extra_args(false);  // one value each: a scene path after it stays the scene
+  command->add_option("--tuning", sweeps,
+                      "NAME=V1,V2,...: run every configuration once per value of the knob; may be repeated "
+                      "(every combination)")
+      ->allow_extra_args(false);
   command->add_flag_callback(
       "--list-tuning",
       [] {
