@@ -15,11 +15,13 @@
 #include <fstream>
 #include <random>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
 
+#include "flashgs/backend_tuning.h"
 #include "flashgs/demo_scene.h"
 #include "flashgs/generators.h"
 #include "flashgs/image.h"
@@ -725,6 +727,87 @@ TEST(CliOutputs, AWriteThatFailsIsAnErrorAndLeavesNoFile) {
     }
   }
   EXPECT_EQ(names_in(dir), (std::vector<std::string>{"report", "scene"})) << "a file or a temporary was left";
+}
+
+// The backend tuning knobs (flashgs/backend_tuning.h) on the command line: listed by
+// --list-tuning, set by --set, swept by --tuning, and recorded in what a run writes.
+TEST(CliTuning, ListTuningNamesEveryKnob) {
+  for (const char* command : {"bench", "report"}) {
+    const CliResult r = run_cli(std::string(command) + " --list-tuning");
+    ASSERT_EQ(r.exit_code, 0) << command << "\n" << r.output;
+    for (const TuningKnob& knob : kTuningKnobs)
+      EXPECT_NE(r.output.find(std::string(knob.name) + " ("), std::string::npos) << command << " " << knob.name;
+    const CliResult help = run_cli(std::string(command) + " --help");
+    EXPECT_NE(help.output.find("sort_key_bits"), std::string::npos) << command << "\n" << help.output;
+  }
+}
+
+TEST(CliTuning, BenchSweepsAKnobAndRecordsTheValuesUsed) {
+  const std::string dir = scratch_dir("bench_tuning");
+  // The scene after --set stays the scene: each --set takes one value.
+  const CliResult r = run_cli("bench --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 "
+                              "--set sort_key_bits=24 " + demo_scene_path() + " --tuning blend_stop_bound=0,1 --json " +
+                              dir + "/b.json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("tuning (changed from the defaults): sort_key_bits=24\n"), std::string::npos) << r.output;
+  for (const char* row : {"baseline blend_stop_bound=0", "baseline blend_stop_bound=1", "flash blend_stop_bound=0",
+                          "flash blend_stop_bound=1"})
+    EXPECT_NE(r.output.find(std::string("\n32x18      ") + row + " "), std::string::npos) << row << "\n" << r.output;
+  std::ifstream in(dir + "/b.json");
+  std::stringstream json;
+  json << in.rdbuf();
+  const std::string text = json.str();
+  // The run's values (before the sweep) and each row's.
+  auto count = [&](const std::string& fragment) {
+    std::size_t n = 0;
+    for (std::size_t at = text.find(fragment); at != std::string::npos; at = text.find(fragment, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("\"sort_key_bits\": \"24\""), 5u) << text;
+  EXPECT_EQ(count("\"blend_stop_bound\": \"0\""), 2u) << text;
+  EXPECT_EQ(count("\"blend_stop_bound\": \"1\""), 3u) << text;
+  EXPECT_EQ(count("\"bin_sort\": \"auto\""), 5u) << text;
+}
+
+TEST(CliTuning, BadSettingsAreOneLineBeforeAnyWork) {
+  const std::string dir = scratch_dir("bench_tuning_bad");
+  const std::string quick = " --backend cpu -r 32x18 --camera-list 0 --configs flash --warmup 0 --repeat 1 ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--set sort_key_bits=40", "--set: sort_key_bits=\"40\": expected 16-32"},
+      {"--set nothing=1", "--set \"nothing=1\": expected NAME=VALUE"},
+      {"--set bin_sort", "--set \"bin_sort\": expected NAME=VALUE"},
+      {"--tuning bin_sort=0,,1", "--tuning: bin_sort=\"\": expected auto, 0 or 1"},
+      {"--tuning blend_region_width=8,12", "--tuning: blend_region_width=\"12\": expected 8 or 16"},
+      {"--tuning nothing=1,2", "--tuning \"nothing=1,2\": expected NAME=V1,V2,..."},
+  };
+  for (const auto& [options, fragment] : cases) {
+    expect_one_line_error(run_cli("bench" + quick + options + " --json " + dir + "/b.json"), fragment, "bench " + options);
+    expect_one_line_error(run_cli("report" + quick.substr(0, quick.find(" --configs")) + " --repeat 1 " + options +
+                                  " -o " + dir + "/report"),
+                          fragment, "report " + options);
+  }
+  EXPECT_FALSE(fs::exists(dir + "/b.json"));
+  EXPECT_FALSE(fs::exists(dir + "/report"));
+}
+
+TEST(CliTuning, ReportSweepsAKnobAndRecordsTheValuesUsed) {
+  const std::string dir = scratch_dir("report_tuning");
+  const CliResult r = run_cli("report --backend cpu -r 32x18 --camera-list 0 --repeat 1 --ref-window 8 --ref-cameras 1 "
+                              "--set chunk_cull=0 --tuning sort_key_bits=20,28 -o " + dir);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::set<std::string> configs;
+  for (const auto& row : read_csv(dir + "/report.csv"))
+    if (row.size() > 1) configs.insert(row[1]);
+  for (const char* config : {"baseline sort_key_bits=20", "baseline sort_key_bits=28", "flash sort_key_bits=20",
+                             "flash sort_key_bits=28"})
+    EXPECT_TRUE(configs.count(config)) << config << "\n" << r.output;
+  EXPECT_FALSE(configs.count("flash")) << "a row without the swept knob";
+  std::ifstream in(dir + "/report.md");
+  std::stringstream md;
+  md << in.rdbuf();
+  EXPECT_NE(md.str().find("- tuning (docs/TUNING.md): bin_sort=auto "), std::string::npos) << md.str();
+  EXPECT_NE(md.str().find(" chunk_cull=0 "), std::string::npos) << md.str();
+  EXPECT_NE(md.str().find("settings of --tuning"), std::string::npos) << md.str();
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <numeric>
 #include <random>
 
+#include "flashgs/backend_tuning.h"
 #include "flashgs/cuda_renderer.h"
 #include "flashgs/error.h"
 #include "flashgs/generators.h"
@@ -202,6 +203,39 @@ TEST(CudaRecords, GrowingFromOneRecordChangesNoByte) {
         expect_same_counts(what, a.stats, b.stats);
       }
   }
+}
+
+// A tuning set in code (make_cuda_renderer(tuning), as `flashgs bench --set` makes renderers)
+// reaches the backend as the same values through the environment do: every byte and count
+// the same, and chunks culled in a scene below the size that culls by default.
+TEST(CudaTuning, SetInCodeAsThroughTheEnvironment) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = tiled_demo_scene();
+  const std::vector<std::string> settings = {"chunk_cull=1", "initial_records=1", "bin_sort=1", "sort_key_bits=24",
+                                             "dense_tiles_first=1", "blend_stop_bound=0"};
+  BackendTuning tuning;
+  for (const std::string& setting : settings) apply_tuning_setting(tuning, setting, "test");
+  auto in_code = make_cuda_renderer(tuning);
+  for (const std::string& setting : settings) {
+    const TuningKnob& knob = *find_tuning_knob(setting.substr(0, setting.find('=')));
+    setenv(tuning_variable(knob).c_str(), setting.substr(setting.find('=') + 1).c_str(), 1);
+  }
+  auto from_environment = make_cuda_renderer();
+  for (const TuningKnob& knob : kTuningKnobs) unsetenv(tuning_variable(knob).c_str());
+  in_code->set_scene(scene);
+  from_environment->set_scene(scene);
+  std::uint64_t culled = 0;
+  for (const Camera& camera : chunk_cull_cameras(*scene))
+    for (const RenderOptions& o : all_configs()) {
+      const std::string what = camera.name + " " + o.label();
+      const Result a = render(*from_environment, camera, o);
+      const Result b = render(*in_code, camera, o);
+      EXPECT_TRUE(a.image.rgb == b.image.rgb) << what;
+      expect_same_counts(what, a.stats, b.stats);
+      EXPECT_EQ(a.stats.culled_by_chunk, b.stats.culled_by_chunk) << what;
+      culled += b.stats.culled_by_chunk;
+    }
+  EXPECT_GT(culled, 0u) << "no chunk was culled: chunk_cull=1 did not reach the backend";
 }
 
 // The flash path's working memory follows the projected Gaussians: the tiled scene's first

@@ -11,18 +11,19 @@
 
 namespace flashgs::cli {
 
-std::unique_ptr<Renderer> create_backend(const std::string& which, int cpu_threads, CpuBlend cpu_blend) {
+std::unique_ptr<Renderer> create_backend(const std::string& which, int cpu_threads, CpuBlend cpu_blend,
+                                         const BackendTuning& tuning) {
 #ifdef FLASHGS_HAVE_CUDA
   if (which == "cuda" || which == "auto") {
     std::string why;
-    if (cuda_available(&why)) return make_cuda_renderer();
+    if (cuda_available(&why)) return make_cuda_renderer(tuning);
     if (which == "cuda") throw Error("the CUDA backend is unavailable: " + why);
     std::fprintf(stderr, "note: no usable CUDA device (%s); rendering on the CPU\n", why.c_str());
   }
 #else
   if (which == "cuda") throw Error("this build has no CUDA backend (configure with -DFLASHGS_WITH_CUDA=ON)");
 #endif
-  return make_cpu_renderer(cpu_threads, cpu_blend);
+  return make_cpu_renderer(cpu_threads, cpu_blend, tuning);
 }
 
 BackendKind backend_kind(const std::string& which) {

@@ -11,9 +11,10 @@ namespace flashgs::cli {
 
 // "cpu", "cuda" (throws flashgs::Error when unavailable) or "auto" (CUDA if a device works).
 // Prints which backend was chosen, and why, to stderr. `cpu_threads` and `cpu_blend` configure
-// the CPU backend when it is the one chosen (0 threads: every core).
+// the CPU backend when it is the one chosen (0 threads: every core); `tuning` either backend.
 std::unique_ptr<Renderer> create_backend(const std::string& which, int cpu_threads = 0,
-                                         CpuBlend cpu_blend = CpuBlend::simd);
+                                         CpuBlend cpu_blend = CpuBlend::simd,
+                                         const BackendTuning& tuning = tuning_from_environment());
 
 // The kind of backend create_backend(which) makes, found without a word on stderr (estimates
 // made before the backend is).

@@ -21,6 +21,7 @@
 #include "flashgs/percentile.h"
 #include "option_checks.h"
 #include "scene_source.h"
+#include "tuning_options.h"
 
 namespace flashgs::cli {
 namespace {
@@ -44,6 +45,7 @@ struct BenchArgs {
   int copies = 1;  // --tile: the scene copied on a grid in memory (scale benchmarks)
   std::string json_path = "bench.json";
   KernelOption kernel;  // applied to every configuration
+  TuningOptions tuning;  // every configuration runs once per tuning variant
 };
 
 double ms_since(std::chrono::steady_clock::time_point start) {
@@ -116,6 +118,7 @@ double stage_ms(const StageTimes& t, int s) {
 struct ConfigRun {
   std::string name;
   RenderOptions options;
+  BackendTuning tuning;
   std::unique_ptr<Renderer> renderer;
   std::vector<double> stage[6];  // per camera
   std::vector<double> kv, sorted, visible, psnr, max_abs;
@@ -160,10 +163,10 @@ struct BenchBackend {
 
 // The backend, probed once: every resolution's first frame must fit in memory.
 BenchBackend probe_backend(const BenchArgs& args, const std::vector<Resolution>& resolutions, const Camera& first_camera,
-                           std::size_t gaussians) {
+                           std::size_t gaussians, const BackendTuning& tuning) {
   BenchBackend b;
   b.cpu_blend = args.cpu_blend == "scalar" ? CpuBlend::scalar : CpuBlend::simd;
-  auto probe = create_backend(args.backend, args.threads, b.cpu_blend);
+  auto probe = create_backend(args.backend, args.threads, b.cpu_blend, tuning);
   for (const Resolution& size : resolutions)
     check_frame_fits(*probe, first_camera.resized(size.width, size.height), gaussians, "--resolutions");
   b.cpu = probe->name().rfind("cpu", 0) == 0;
@@ -172,14 +175,31 @@ BenchBackend probe_backend(const BenchArgs& args, const std::vector<Resolution>&
   return b;
 }
 
-// The configurations in run order: the baselines first (each row is judged against the baseline
-// of its kernel), every one without a kernel of its own drawn with the scene's (or --kernel's).
-std::vector<std::pair<std::string, RenderOptions>> run_configs(const BenchArgs& args, bool cpu, const SplatKernel& kernel) {
-  auto configs = select_configs(args.configs, cpu);
-  for (auto& config : configs)
-    if (config.second.kernel == SplatKernel::classic()) config.second.kernel = kernel;
-  std::stable_partition(configs.begin(), configs.end(), [](const auto& c) { return c.second.is_baseline(); });
+// One row of the run: a configuration and the tuning it runs with.
+struct RunConfig {
+  std::string name;
+  RenderOptions options;
+  BackendTuning tuning;
+};
+
+// The configurations in run order, each once per tuning variant: the baselines first (each row
+// is judged against the baseline of its kernel), every one without a kernel of its own drawn
+// with the scene's (or --kernel's).
+std::vector<RunConfig> run_configs(const BenchArgs& args, bool cpu, const SplatKernel& kernel,
+                                   const std::vector<TuningVariant>& variants) {
+  std::vector<RunConfig> configs;
+  for (auto [name, options] : select_configs(args.configs, cpu)) {
+    if (options.kernel == SplatKernel::classic()) options.kernel = kernel;
+    for (const TuningVariant& variant : variants) configs.push_back({with_tuning_label(name, variant), options, variant.tuning});
+  }
+  std::stable_partition(configs.begin(), configs.end(), [](const RunConfig& c) { return c.options.is_baseline(); });
   return configs;
+}
+
+nlohmann::json tuning_json(const BackendTuning& tuning) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const TuningKnob& knob : kTuningKnobs) j[knob.name] = tuning_value_text(tuning, knob);
+  return j;
 }
 
 // One camera's frames of one config: the first frame (timed apart), warm-up and timed frames,
@@ -256,6 +276,7 @@ void summarise(const ConfigRun& r, const std::string& resolution, nlohmann::json
   j["resolution"] = resolution;
   j["config"] = r.name;
   j["label"] = r.options.label();
+  j["tuning"] = tuning_json(r.tuning);
   for (int s = 0; s < 6; ++s)
     j["ms"][kStages[s]] = {{"median", median(r.stage[s])}, {"p95", percentile(r.stage[s], kTailPercentile)}};
   j["kv_pairs"] = {{"median", median(r.kv)}, {"max", *std::max_element(r.kv.begin(), r.kv.end())}};
@@ -301,6 +322,8 @@ void summarise(const ConfigRun& r, const std::string& resolution, nlohmann::json
 void run(const BenchArgs& args) {
   // Everything that can be wrong with the arguments is found before the first frame.
   check_output_file("--json", args.json_path);
+  const std::vector<TuningVariant> variants = args.tuning.variants();
+  const BackendTuning base_tuning = args.tuning.base();
   std::vector<Resolution> resolutions;
   for (const std::string& text : args.resolutions) resolutions.push_back(parse_resolution(text));
   const std::string scene_path = args.scene.resolved_scene();
@@ -308,9 +331,10 @@ void run(const BenchArgs& args) {
   const std::string cameras_path = args.scene.resolved_cameras();
   const std::vector<Camera> all_cameras = load_cameras(cameras_path);
   const std::vector<int> camera_ids = bench_camera_ids(args, all_cameras.size(), cameras_path);
-  const BenchBackend backend = probe_backend(args, resolutions, all_cameras[camera_ids.front()], scene->size());
+  const BenchBackend backend =
+      probe_backend(args, resolutions, all_cameras[camera_ids.front()], scene->size(), base_tuning);
   const SplatKernel kernel = args.kernel.resolve(*scene);
-  const auto configs = run_configs(args, backend.cpu, kernel);
+  const std::vector<RunConfig> configs = run_configs(args, backend.cpu, kernel, variants);
 
   nlohmann::json out;
   out["scene"] = scene_path;
@@ -326,6 +350,7 @@ void run(const BenchArgs& args) {
   out["frames"] = backend.queued ? "queued" : "waited";
   out["warmup"] = args.warmup;
   out["repeat"] = args.repeat;
+  out["tuning"] = tuning_json(base_tuning);  // before --tuning's sweep; each result has its own
   out["results"] = nlohmann::json::array();
 
   std::printf("%s: %zu Gaussians (SH degree %d, %s kernel) on %s; cameras", scene_path.c_str(), scene->size(),
@@ -334,17 +359,20 @@ void run(const BenchArgs& args) {
   std::printf("; %d warm-up + %d timed frames each, %s; per-camera medians, then median (p95) over cameras\n",
               args.warmup, args.repeat,
               backend.queued ? "queued back to back as the viewer renders them" : "each downloaded and waited for");
+  const std::string changed = tuning_changes(base_tuning);
+  if (!changed.empty()) std::printf("tuning (changed from the defaults): %s\n", changed.c_str());
 
   std::string table, uploads;
   for (std::size_t k = 0; k < resolutions.size(); ++k) {
     const std::string& resolution = args.resolutions[k];
     // One renderer per config, so each one's memory is its own high-water mark.
     std::vector<ConfigRun> runs;
-    for (const auto& [name, options] : configs) {
+    for (const RunConfig& config : configs) {
       ConfigRun r;
-      r.name = name;
-      r.options = options;
-      r.renderer = create_backend(args.backend, args.threads, backend.cpu_blend);
+      r.name = config.name;
+      r.options = config.options;
+      r.tuning = config.tuning;
+      r.renderer = create_backend(args.backend, args.threads, backend.cpu_blend, config.tuning);
       const auto upload_start = std::chrono::steady_clock::now();
       r.renderer->set_scene(scene);
       r.upload_ms = ms_since(upload_start);
@@ -390,6 +418,7 @@ void register_bench(CLI::App& app) {
       ->check(whole_number())->check(CLI::Range(1, 4096));
   sub->add_option("--json,-o", args->json_path, "JSON output file");
   args->kernel.add_to(sub);
+  args->tuning.add_to(sub);
   sub->callback([args] { run(*args); });
 }
 

@@ -26,6 +26,7 @@
 #include "report_plot.h"
 #include "report_sweep.h"
 #include "scene_source.h"
+#include "tuning_options.h"
 
 namespace flashgs::cli {
 namespace {
@@ -45,6 +46,7 @@ struct ReportArgs {
   std::string replot;    // re-plot this report.csv instead of measuring
   std::string subtitle;  // for --replot
   KernelOption kernel;   // the kernel every configuration but the kernel group's draws with
+  TuningOptions tuning;  // every configuration runs once per tuning variant
 };
 
 std::string cpu_model() {
@@ -148,12 +150,12 @@ std::vector<int> report_camera_ids(const ReportArgs& args, std::size_t camera_co
 using NamedBackends = std::vector<std::pair<std::string, std::unique_ptr<Renderer>>>;
 
 // The backends --backend asks for (all: every one present, a missing one noted).
-NamedBackends report_backends(const ReportArgs& args) {
+NamedBackends report_backends(const ReportArgs& args, const BackendTuning& tuning) {
   NamedBackends backends;
   for (const char* name : {"cpu", "cuda"}) {
     if (args.backend != "all" && args.backend != name) continue;
     try {
-      backends.emplace_back(name, create_backend(name));
+      backends.emplace_back(name, create_backend(name, 0, CpuBlend::simd, tuning));
     } catch (const Error& e) {
       if (args.backend == name) throw;
       std::fprintf(stderr, "note: backend %s not measured: %s\n", name, e.what());
@@ -186,9 +188,11 @@ double add_reference(const Scene& scene, const SplatKernel& kernel, int side, st
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - ref_start).count();
 }
 
-// Every configuration of the sweep on every backend, each on a fresh renderer.
+// Every configuration of the sweep on every backend, once per tuning variant, each on a fresh
+// renderer.
 std::vector<SweepResult> sweep(NamedBackends& backends, const std::shared_ptr<const Scene>& scene, const SplatKernel& kernel,
-                               SweepFrames& frames, int repeat, std::vector<std::string>& backend_names) {
+                               const std::vector<TuningVariant>& variants, SweepFrames& frames, int repeat,
+                               std::vector<std::string>& backend_names) {
   std::vector<SweepResult> results;
   for (auto& [name, renderer] : backends) {
     renderer->set_scene(scene);
@@ -196,17 +200,21 @@ std::vector<SweepResult> sweep(NamedBackends& backends, const std::shared_ptr<co
     const bool gpu = name == "cuda";
     for (const SweepConfig& config : sweep_configs(kernel)) {
       if (config.gpu_only && !gpu) continue;  // the CPU ignores these switches
-      const auto start = std::chrono::steady_clock::now();
-      // A fresh backend per configuration: its buffers only grow, so the peak memory of one
-      // that rendered the baseline first would be the baseline's for every configuration.
-      std::unique_ptr<Renderer> fresh = create_backend(name);
-      fresh->set_scene(scene);
-      SweepResult r = measure_config(*fresh, name, config, frames, repeat);
-      std::fprintf(stderr, "%-5s %-22s median %9.3f ms  p95 %9.3f ms  kv %11.0f  vs baseline %6s dB  vs fp64 %6s dB (%.0f s)\n",
-                   name.c_str(), config.name.c_str(), r.median_ms, r.p95_ms, r.kv_pairs,
-                   psnr_text(r.vs_baseline.psnr_db).c_str(), psnr_text(r.vs_reference.psnr_db).c_str(),
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-      results.push_back(std::move(r));
+      for (const TuningVariant& variant : variants) {
+        const auto start = std::chrono::steady_clock::now();
+        // A fresh backend per configuration: its buffers only grow, so the peak memory of one
+        // that rendered the baseline first would be the baseline's for every configuration.
+        std::unique_ptr<Renderer> fresh = create_backend(name, 0, CpuBlend::simd, variant.tuning);
+        fresh->set_scene(scene);
+        SweepConfig named = config;
+        named.name = with_tuning_label(config.name, variant);
+        SweepResult r = measure_config(*fresh, name, named, frames, repeat);
+        std::fprintf(stderr, "%-5s %-22s median %9.3f ms  p95 %9.3f ms  kv %11.0f  vs baseline %6s dB  vs fp64 %6s dB (%.0f s)\n",
+                     name.c_str(), named.name.c_str(), r.median_ms, r.p95_ms, r.kv_pairs,
+                     psnr_text(r.vs_baseline.psnr_db).c_str(), psnr_text(r.vs_reference.psnr_db).c_str(),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        results.push_back(std::move(r));
+      }
     }
   }
   return results;
@@ -258,6 +266,7 @@ struct ReportContext {
   std::size_t windows = 0, ref_cameras = 0;
   double ref_seconds = 0;
   std::vector<std::string> backend_names;
+  std::string tuning;  // the values every run used (before --tuning's sweep)
 };
 
 // report.md and one plot per backend, report_<backend>.svg.
@@ -272,6 +281,7 @@ void write_markdown_and_plots(const ReportArgs& args, const ReportContext& c, co
      << args.repeat << " timed frames; time is the backend's FrameStats total (CPU: wall time of the stages)\n";
   md << "- host: " << cpu_model() << ", " << std::thread::hardware_concurrency() << " hardware threads\n";
   for (const std::string& b : c.backend_names) md << "- backend " << b << "\n";
+  md << "- tuning (docs/TUNING.md): " << c.tuning << "\n";
   md << "- error vs baseline: whole frames against the same backend's baseline render; error vs fp64: the fp64 "
         "brute-force reference (cost pixels x Gaussians) on "
      << c.windows << " windows of " << c.window_side << "x" << c.window_side
@@ -320,6 +330,10 @@ void measure(const ReportArgs& args) {
   for (const char* name : kReportFiles) check_output_file("--output-dir", args.output_dir + "/" + name);
   const Resolution size = args.resolution.empty() ? Resolution{} : parse_resolution(args.resolution);
   ReportContext context;
+  const std::vector<TuningVariant> variants = args.tuning.variants();
+  context.tuning = tuning_summary(args.tuning.base());
+  if (variants.size() > 1) context.tuning += "; each configuration also with " + std::to_string(variants.size()) +
+                                             " settings of --tuning (named in its row)";
   context.scene_path = args.scene.resolved_scene();
   auto scene = load_scene_verbose(context.scene_path, args.scene.lod, args.scene.read_options());
   context.scene = scene.get();
@@ -332,7 +346,7 @@ void measure(const ReportArgs& args) {
     if (!args.resolution.empty()) c = c.resized(size.width, size.height);
     frames.cameras.push_back(c);
   }
-  NamedBackends backends = report_backends(args);
+  NamedBackends backends = report_backends(args, args.tuning.base());
   for (auto& [name, renderer] : backends)
     check_frame_fits(*renderer, frames.cameras.front(), scene->size(),
                      args.resolution.empty() ? "the cameras' size" : "--resolution");
@@ -346,7 +360,8 @@ void measure(const ReportArgs& args) {
   std::fprintf(stderr, "fp64 reference: %zu cameras x %zu windows of %dx%d in %.1f s\n", context.ref_cameras,
                context.windows, context.window_side, context.window_side, context.ref_seconds);
 
-  const std::vector<SweepResult> results = sweep(backends, scene, context.kernel, frames, args.repeat, context.backend_names);
+  const std::vector<SweepResult> results =
+      sweep(backends, scene, context.kernel, variants, frames, args.repeat, context.backend_names);
   const std::string stem = args.output_dir + "/report";
   write_csv(results, stem + ".csv");
   context.title = args.title.empty() ? std::filesystem::path(context.scene_path).parent_path().filename().string()
@@ -393,6 +408,7 @@ void register_report(CLI::App& app) {
   sub->add_option("--replot", args->replot, "only redraw the SVG plot(s) from this report.csv (beside it)");
   sub->add_option("--subtitle", args->subtitle, "with --replot: the plot's second line");
   args->kernel.add_to(sub);
+  args->tuning.add_to(sub);
   sub->callback([args] { run(*args); });
 }
 

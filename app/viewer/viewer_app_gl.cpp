@@ -252,6 +252,11 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
 
   // ImGui runs with the panels hidden too (legend, help): its windows still take the input.
   const bool mouse_free = !(m_ui && m_ui->wants_mouse());
+  read_keys(nav, actions);
+  read_mouse(nav, actions, x, y, dx, dy, scroll, mouse_free);
+}
+
+void ViewerApp::read_keys(NavigationInput& nav, UiActions& actions) {
   // After Enter in the path field the typing goes on there (the field takes the focus back a
   // frame or two later): until a click, letters are text, not shortcuts.
   if (m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT) || m_window->mouse_down(GLFW_MOUSE_BUTTON_RIGHT))
@@ -323,6 +328,10 @@ void ViewerApp::gather_input(NavigationInput& nav, UiActions& actions) {
     m_settings.options.kernel = next_trainer_kernel(m_settings.options.kernel);
     std::fprintf(stderr, "flashgs-viewer: kernel: %s (K)\n", m_settings.options.kernel.description().c_str());
   }
+}
+
+void ViewerApp::read_mouse(NavigationInput& nav, UiActions& actions, double x, double y, float dx, float dy,
+                           float scroll, bool mouse_free) {
   const bool left_down = m_window->mouse_down(GLFW_MOUSE_BUTTON_LEFT);
   if (mouse_free) actions.snap_camera = frustum_under_click(left_down, x, y);
   if (mouse_free || m_divider.dragging()) handle_divider_drag(left_down, x);
@@ -941,6 +950,29 @@ void ViewerApp::apply_script_step(NavigationInput& nav) {
 
 void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   m_ui->begin_frame();  // every frame: the legend, help and hint show with the panels hidden too
+  const UiModel model = panel_model(fb_w, fb_h);
+  const ViewerSettings before = m_settings;
+  // A screenshot with the overlay: this frame draws the legend's labels alone over the image
+  // (no panels, no help, no status line), and the picture is taken once it is drawn.
+  m_overlay_shot_frame = !m_pending_overlay_shot.empty();
+  if (m_overlay_shot_frame) {
+    draw_legend_labels(model, m_settings);
+  } else {
+    if (m_settings.show_ui)
+      draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer, m_keys, m_key_fields);
+    draw_overlays(model, m_settings);
+    if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
+  }
+  keep_settings_valid(m_settings, before);
+  if (const std::string chosen = m_dialog.take_choice(); !chosen.empty()) actions.open_path = chosen;
+  if (!model.loading.empty() && !m_logged_load_progress) {
+    m_logged_load_progress = true;
+    std::fprintf(stderr, "flashgs-viewer: load progress shown %.0f ms after the load started, %.0f ms after start (%s)\n",
+                 model.load.elapsed_s * 1000.0, ms_since_start(), model.loading.c_str());
+  }
+}
+
+UiModel ViewerApp::panel_model(int fb_w, int fb_h) {
   UiModel model;
   model.frame_path = m_path->name();
   model.frame_path_note = m_path_note;
@@ -999,25 +1031,7 @@ void ViewerApp::build_panels(int fb_w, int fb_h, UiActions& actions) {
   model.ui_scale = m_ui_scale;
   const glm::vec3 up = m_controller.world_up(), pos = m_controller.pose().position;
   for (int k = 0; k < 3; ++k) model.world_up[k] = up[k], model.position[k] = pos[k];
-  const ViewerSettings before = m_settings;
-  // A screenshot with the overlay: this frame draws the legend's labels alone over the image
-  // (no panels, no help, no status line), and the picture is taken once it is drawn.
-  m_overlay_shot_frame = !m_pending_overlay_shot.empty();
-  if (m_overlay_shot_frame) {
-    draw_legend_labels(model, m_settings);
-  } else {
-    if (m_settings.show_ui)
-      draw_panels(model, m_settings, actions, m_path_buffer, m_export_buffer, m_keys, m_key_fields);
-    draw_overlays(model, m_settings);
-    if (const std::string chosen = m_browser.draw(m_ui_scale); !chosen.empty()) actions.open_path = chosen;
-  }
-  keep_settings_valid(m_settings, before);
-  if (const std::string chosen = m_dialog.take_choice(); !chosen.empty()) actions.open_path = chosen;
-  if (!model.loading.empty() && !m_logged_load_progress) {
-    m_logged_load_progress = true;
-    std::fprintf(stderr, "flashgs-viewer: load progress shown %.0f ms after the load started, %.0f ms after start (%s)\n",
-                 model.load.elapsed_s * 1000.0, ms_since_start(), model.loading.c_str());
-  }
+  return model;
 }
 
 bool ViewerApp::advance_camera(const NavigationInput& nav, float dt) {
@@ -1069,41 +1083,60 @@ int ViewerApp::run() {
   select_frame_path();
   if (!start_first_scene()) return 2;
   m_window->cursor(&m_last_cursor_x, &m_last_cursor_y);
+  m_last_swap = Clock::now();
+  while (!m_window->should_close()) run_one_frame();
+  shut_down();
+  return m_exit_code;
+}
 
-  auto last_swap = Clock::now();
-  while (!m_window->should_close()) {
-    int fb_w = 0, fb_h = 0;
-    float dt = 0;
-    if (!begin_frame(&fb_w, &fb_h, &dt)) continue;
-    // A background frame or comparison in flight as this frame starts.
-    const bool rendering = background_busy();
-    UiActions actions;
-    NavigationInput nav;
-    gather_input(nav, actions);
-    apply_script_step(nav);
-    build_panels(fb_w, fb_h, actions);
-    if (m_args.log_input) {
-      log_held_input();
-      log_popup_changes();
-    }
-    apply_actions(actions);
-    log_option_changes();
-    finish_pending_load();
-    if ((m_export.active() || m_export_job.busy()) && !m_scripted) export_step();  // polls the export's job
-    m_moving = advance_camera(nav, dt);
-    if (m_moving) m_last_motion = Clock::now();
-    m_before_render_ms = ms_since(m_frame_start);
-    request_frame(fb_w, fb_h, m_moving || ms_since(m_last_motion) < kSettleMs);
-    collect_frame();
-    const auto t_compare = Clock::now();
-    finish_comparison(/*at_once=*/false);
-    m_compare_show_ms = ms_since(t_compare);
-    draw_and_present(fb_w, fb_h);
-    const auto swapped = Clock::now();
-    const double frame_ms = std::chrono::duration<double, std::milli>(swapped - last_swap).count();
-    last_swap = swapped;
-    record_frame_times(frame_ms, ms_since(m_frame_start), rendering);
+void ViewerApp::run_one_frame() {
+  int fb_w = 0, fb_h = 0;
+  float dt = 0;
+  if (!begin_frame(&fb_w, &fb_h, &dt)) return;
+  // A background frame or comparison in flight as this frame starts.
+  const bool rendering = background_busy();
+  const NavigationInput nav = take_input(fb_w, fb_h);
+  advance_state(nav, dt);
+  render_and_present(fb_w, fb_h);
+  const auto swapped = Clock::now();
+  const double frame_ms = std::chrono::duration<double, std::milli>(swapped - m_last_swap).count();
+  m_last_swap = swapped;
+  record_frame_times(frame_ms, ms_since(m_frame_start), rendering);
+}
+
+NavigationInput ViewerApp::take_input(int fb_w, int fb_h) {
+  UiActions actions;
+  NavigationInput nav;
+  gather_input(nav, actions);
+  apply_script_step(nav);
+  build_panels(fb_w, fb_h, actions);
+  if (m_args.log_input) {
+    log_held_input();
+    log_popup_changes();
   }
+  apply_actions(actions);
+  log_option_changes();
+  return nav;
+}
+
+void ViewerApp::advance_state(const NavigationInput& nav, float dt) {
+  finish_pending_load();
+  if ((m_export.active() || m_export_job.busy()) && !m_scripted) export_step();  // polls the export's job
+  m_moving = advance_camera(nav, dt);
+  if (m_moving) m_last_motion = Clock::now();
+}
+
+void ViewerApp::render_and_present(int fb_w, int fb_h) {
+  m_before_render_ms = ms_since(m_frame_start);
+  request_frame(fb_w, fb_h, m_moving || ms_since(m_last_motion) < kSettleMs);
+  collect_frame();
+  const auto t_compare = Clock::now();
+  finish_comparison(/*at_once=*/false);
+  m_compare_show_ms = ms_since(t_compare);
+  draw_and_present(fb_w, fb_h);
+}
+
+void ViewerApp::shut_down() {
   save_settings();
   if (m_compare_task.busy()) {  // quitting stops it: its renders end at their next check, before the path goes
     m_compare_task.cancel();
@@ -1115,7 +1148,6 @@ int ViewerApp::run() {
                  m_ui_frames_while_rendering, m_worst_ui_ms_while_rendering);
   if (m_loader.busy())  // its thread may be blocked in open(): closing does not wait for it
     std::fprintf(stderr, "flashgs-viewer: closing without waiting for the load of %s\n", m_loader.path().c_str());
-  return m_exit_code;
 }
 
 }  // namespace flashgs::viewer

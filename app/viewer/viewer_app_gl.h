@@ -73,18 +73,32 @@ class ViewerApp {
   void apply_up_choice();
   void snap_to_camera(int index);
 
-  // The steps of one frame, in order.
+  // One frame of the loop (run_one_frame): its steps, in order, and the steps they take.
+  void run_one_frame();
   bool begin_frame(int* fb_w, int* fb_h, float* dt);  // events, sizes; false: nothing to draw into
+  // The input (window or key script) and the panels, their actions applied; returns the navigation.
+  NavigationInput take_input(int fb_w, int fb_h);
   void gather_input(NavigationInput& nav, UiActions& actions);
+  // The keyboard's shortcuts and movement keys, where the panels leave the keyboard free.
+  void read_keys(NavigationInput& nav, UiActions& actions);
+  // The mouse's drags, clicks and wheel; `mouse_free`: the panels do not hold the mouse.
+  void read_mouse(NavigationInput& nav, UiActions& actions, double x, double y, float dx, float dy, float scroll,
+                  bool mouse_free);
   void apply_script_step(NavigationInput& nav);
   void build_panels(int fb_w, int fb_h, UiActions& actions);
+  UiModel panel_model(int fb_w, int fb_h);  // what the panels show this frame
   void apply_actions(const UiActions& actions);
+  // A finished load installed, the export's next frame, the camera moved.
+  void advance_state(const NavigationInput& nav, float dt);
   bool advance_camera(const NavigationInput& nav, float dt);  // true: the view moves this frame
+  // The frame requested or collected, a comparison's textures, the window drawn and swapped.
+  void render_and_present(int fb_w, int fb_h);
   void request_frame(int fb_w, int fb_h, bool moving);
   void collect_frame();  // a finished frame: shown, its statistics kept
   void draw_and_present(int fb_w, int fb_h);
   // `rendering`: a background frame was in flight as this frame began (its UI time is tracked).
   void record_frame_times(double frame_ms, double ui_ms, bool rendering);
+  void shut_down();  // after the loop: settings saved, a comparison stopped, the UI frames logged
 
   // The render size for this frame: `wanted`, or where it does not fit (memory, texture
   // limit) the last size that rendered, with one message logged and shown.
@@ -172,6 +186,7 @@ class ViewerApp {
   bool m_moving = false;     // the view moved in the last loop iteration
   std::chrono::steady_clock::time_point m_last_motion;  // when it last moved
   std::chrono::steady_clock::time_point m_frame_start, m_last_frame_start;
+  std::chrono::steady_clock::time_point m_last_swap;  // the last frame's buffer swap
   FrameStats m_stats;
   StatsHistory m_history;
   std::vector<std::uint32_t> m_tile_counts;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/backend_tuning.h"
 #include "flashgs/cuda_renderer.h"
 #include "flashgs/error.h"
 #include "flashgs/frame_params.h"
@@ -119,9 +120,15 @@ cuda::KeyFormat compact_key_format(std::uint64_t tiles, double min_depth, double
   return k;
 }
 
+// The bin sort holds at most kBinSortSharedPairsMax pairs of a bin in shared memory.
+static_assert(tuning_knob("bin_sort_shared_pairs").max == cuda::kBinSortSharedPairsMax,
+              "the bin_sort_shared_pairs knob's range is the bin sort's shared-memory limit");
+// A deferred work item is one warp's: at most a chunk per lane.
+static_assert(tuning_knob("deferred_item_chunks").max == cuda::kWarp, "the deferred_item_chunks knob's range");
+
 class CudaRendererImpl final : public CudaRenderer {
  public:
-  CudaRendererImpl() {
+  explicit CudaRendererImpl(const BackendTuning& tuning) {
     check_cuda(cudaGetDevice(&device_), "cudaGetDevice");
     cudaDeviceProp prop{};
     check_cuda(cudaGetDeviceProperties(&prop, device_), "cudaGetDeviceProperties");
@@ -129,54 +136,27 @@ class CudaRendererImpl final : public CudaRenderer {
     check_cuda(cudaStreamCreateWithFlags(stream_handle_.out(), cudaStreamNonBlocking), "stream creation");
     stream_ = stream_handle_.get();
     check_cuda(cudaStreamCreateWithFlags(copy_stream_handle_.out(), cudaStreamNonBlocking), "stream creation");
-    // Tuning knob for the benchmark script: the warp blend's region, 16 x 4 or 8 x 8 pixels.
-    if (const char* width = std::getenv("FLASHGS_BLEND_REGION_WIDTH")) region_width_ = std::atoi(width) == 16 ? 16 : 8;
-    // FLASHGS_BLEND_STOP_BOUND=0 runs the blend's stop rule on every staged Gaussian: the same
-    // image, slower (the tests compare the two).
-    if (const char* bound = std::getenv("FLASHGS_BLEND_STOP_BOUND")) stop_bound_ = std::atoi(bound) != 0;
-    // And the box size (in tiles, bins with macro bins) above which warps emit a Gaussian's
-    // pairs after preprocess, in work items of how many 32-bin chunks.
-    if (const char* tiles = std::getenv("FLASHGS_LARGE_BOX_TILES"))
-      large_box_tiles_ = std::max(1, std::min(kMaxBoxThreshold, std::atoi(tiles)));
-    if (const char* chunks = std::getenv("FLASHGS_DEFERRED_ITEM_CHUNKS"))
-      item_chunks_ = std::max(1, std::min(cuda::kWarp, std::atoi(chunks)));
-    // FLASHGS_CHUNK_CULL=0 projects every Gaussian, =1 culls chunks in any scene (unset: scenes
-    // of kChunkCullMinGaussians and more).
-    if (const char* cull = std::getenv("FLASHGS_CHUNK_CULL")) chunk_cull_ = std::atoi(cull) != 0 ? kAlways : kNever;
-    // FLASHGS_SPATIAL_ORDER=1 uploads every scene in spatial order, =0 none (unset: scenes whose
-    // stored order is not spatially coherent, see flashgs/spatial_order.h).
-    if (const char* order = std::getenv("FLASHGS_SPATIAL_ORDER")) spatial_order_ = std::atoi(order) != 0 ? kAlways : kNever;
-    // FLASHGS_UPLOAD_TIMES=1 prints where each set_scene's time went (stderr).
-    if (const char* times = std::getenv("FLASHGS_UPLOAD_TIMES")) print_upload_times_ = std::atoi(times) != 0;
-    // FLASHGS_DENSE_TILES_FIRST=1 orders the tiles on every frame, =0 never (unset: when the
-    // last frame's fullest tile outlasted a wave of the blend, see dense_order_pays).
-    if (const char* dense = std::getenv("FLASHGS_DENSE_TILES_FIRST"))
-      dense_tiles_mode_ = std::atoi(dense) != 0 ? kAlways : kNever;
-    // FLASHGS_SORT_KEY_BITS: the compact key's length (tile and depth bin), 16 to 32.
-    if (const char* bits = std::getenv("FLASHGS_SORT_KEY_BITS")) sort_key_bits_ = std::max(16, std::min(32, std::atoi(bits)));
-    // FLASHGS_BIN_SORT=1 sorts every binned frame per bin, =0 none (CUB's radix sort over the
-    // whole frame, the path of 64-bit keys and of tile keys; unset: where it pays, see
-    // bin_sort_pays); FLASHGS_BIN_SORT_SHARED_PAIRS (0 to kBinSortSharedPairsMax) is the
-    // largest bin sorted in shared memory.
-    if (const char* bin_sort = std::getenv("FLASHGS_BIN_SORT")) bin_sort_ = std::atoi(bin_sort) != 0 ? kAlways : kNever;
-    if (const char* shared = std::getenv("FLASHGS_BIN_SORT_SHARED_PAIRS"))
-      bin_sort_shared_pairs_ = static_cast<unsigned>(
-          std::max(0, std::min(static_cast<int>(cuda::kBinSortSharedPairsMax), std::atoi(shared))));
+    // The knobs of flashgs/backend_tuning.h; each mode's auto is decided per scene or frame
+    // (upload_scene, bin_sort_pays, emit_bin_counts_pays, dense_order_pays, run_frame).
+    region_width_ = static_cast<int>(tuning.blend_region_width);
+    stop_bound_ = tuning.blend_stop_bound != 0;
+    large_box_tiles_ = static_cast<int>(tuning.large_box_tiles);
+    item_chunks_ = static_cast<int>(tuning.deferred_item_chunks);
+    chunk_cull_ = mode_of(tuning.chunk_cull);
+    spatial_order_ = mode_of(tuning.spatial_order);
+    print_upload_times_ = tuning.upload_times != 0;
+    dense_tiles_mode_ = mode_of(tuning.dense_tiles_first);
+    sort_key_bits_ = static_cast<int>(tuning.sort_key_bits);
+    bin_sort_ = mode_of(tuning.bin_sort);
+    bin_sort_shared_pairs_ = static_cast<unsigned>(tuning.bin_sort_shared_pairs);
+    emit_bin_counts_ = mode_of(tuning.emit_bin_counts);
+    initial_records_ = static_cast<std::uint64_t>(tuning.initial_records);
     // The blend starts beside the bin blocks where the device can launch a kernel early (sm_90
-    // and later); FLASHGS_BIN_OVERLAP=0 runs it after them.
+    // and later) unless the knob turns it off.
     int device = 0, major = 0;
     check_cuda(cudaGetDevice(&device), "device query");
     check_cuda(cudaDeviceGetAttribute(&major, cudaDevAttrComputeCapabilityMajor, device), "device query");
-    bin_overlap_ = major >= 9;
-    if (const char* overlap = std::getenv("FLASHGS_BIN_OVERLAP")) bin_overlap_ = bin_overlap_ && std::atoi(overlap) != 0;
-    // FLASHGS_EMIT_BIN_COUNTS=1 has every bin-sort frame count its pairs per bin as it emits
-    // them (FrameBuffers::emitted_bin_counts) unless it orders its bins or culls by chunk list,
-    // =0 none (the counting pass counts; unset: where it pays, see emit_bin_counts_pays).
-    if (const char* counts = std::getenv("FLASHGS_EMIT_BIN_COUNTS"))
-      emit_bin_counts_ = std::atoi(counts) != 0 ? kAlways : kNever;
-    // FLASHGS_INITIAL_RECORDS: the blend records a first frame starts with (tests of growth).
-    if (const char* records = std::getenv("FLASHGS_INITIAL_RECORDS"))
-      initial_records_ = std::max<long long>(1, std::atoll(records));
+    bin_overlap_ = major >= 9 && tuning.bin_overlap != 0;
     blend_resident_blocks_ = cuda::blend_resident_blocks();
     for (int set = 0; set < 2; ++set)
       for (int e = 0; e < kEventCount; ++e) {
@@ -823,6 +803,8 @@ class CudaRendererImpl final : public CudaRenderer {
     }
   }
 
+  // Renders one frame: its path planned, its buffers sized, its preprocess queued and its
+  // counts read back, then the rest of its work queued; its statistics where asked for.
   void run_frame(const Camera& camera, const RenderOptions& options, FrameTarget target, Image* out,
                  std::uint64_t surface, FrameStats* stats_out) {
     if (!scene_ && !pooled_) throw Error("cuda renderer: no scene set");
@@ -832,6 +814,50 @@ class CudaRendererImpl final : public CudaRenderer {
     // A frame in another precision re-packs the scene from its host copy first.
     else if (options.fp16_sh != device_scene_.sh_half || options.fp16_shape != device_scene_.shape_half)
       upload_scene(scene_, options.fp16_sh, options.fp16_shape);
+    const FramePath path = plan_frame_path(camera, options, target);
+    size_frame_buffers(path, options);
+    const cuda::PreprocessArgs args = preprocess_args(path, options);
+    // Event sets alternate between frames, so that a surface frame's statistics can report
+    // the previous frame's stage times without waiting for its own.
+    const int previous_set = event_set_;
+    const bool previous_complete = last_frame_complete_;  // all its events recorded
+    last_frame_complete_ = false;
+    event_set_ ^= 1;
+    frame_tiles_[event_set_] = path.tiles;
+    // The bin sort reads the pair count on the device, so a frame of fused emission queues
+    // the rest of its work before the host waits for the count: the GPU then runs on instead
+    // of idling while the host reads the count and launches the sort (8-16 us a frame).
+    // Nothing it queues waits for the last frame's end (dense_order_pays reads a finished
+    // frame's statistics), so frames queued back to back follow each other without a gap.
+    const bool queue_before_count = bin_sort_frame_ && path.fused;
+    // Such a frame that goes to the host (whose end the host waits for anyway) reads its counts
+    // back at its end, after the blend: a copy between preprocess and sort kept the GPU idle
+    // for 15-25 us on the H200 machine. A surface frame reads them back at once, so that
+    // the host can go on while the GPU blends.
+    const bool count_at_end = queue_before_count && out;
+    separate_emit_[event_set_] = !path.fused;
+    const FramePlan frame{&camera,    &path.cam,  &options,    &args,         out,        surface,     path.float_image,
+                          path.tiles, path.bins, path.pixels, path.baseline, path.fused, path.binned, count_at_end};
+    const std::uint64_t pairs =
+        queue_preprocess_and_read_back(frame, queue_before_count, count_at_end, previous_set, previous_complete);
+    if (!queue_before_count) queue_after_count(frame, pairs);
+    finish_frame(frame, pairs);
+    if (stats_out) *stats_out = frame_stats(frame, pairs, previous_set, previous_complete);
+  }
+
+  // What plan_frame_path decides of a frame before any of its work is queued.
+  struct FramePath {
+    gm::CameraParams cam;
+    std::uint64_t tiles, pixels, bins;
+    std::size_t n;  // the scene's Gaussians
+    bool baseline, fused, binned;
+    bool float_image;  // the blend writes the device image (a host or a queued frame)
+  };
+
+  // The frame's path: its tiles and bins (macro bins where the scene allows them), its key
+  // format (compact keys over the depths the view can hold) and its sort (per bin where that
+  // pays, bin_sort_frame_).
+  FramePath plan_frame_path(const Camera& camera, const RenderOptions& options, FrameTarget target) {
     const gm::CameraParams cam = make_camera_params(camera);
     // The emission kernels keep a box's tile range in 16 bits.
     if (cam.tiles_x > 0xffff || cam.tiles_y > 0xffff)
@@ -868,6 +894,15 @@ class CudaRendererImpl final : public CudaRenderer {
 
     // The bin sort needs the depth bins of compact keys (depth_bits > 0) in 32-bit keys.
     bin_sort_frame_ = binned && key_format_.depth_bits > 0 && bin_sort_pays(bins);
+    return FramePath{cam, tiles, pixels, bins, n, baseline, fused, binned, target != FrameTarget::surface};
+  }
+
+  // The buffers the frame's path needs, grown (never shrunk) to its bins, tiles, image and
+  // records.
+  void size_frame_buffers(const FramePath& path, const RenderOptions& options) {
+    const std::uint64_t tiles = path.tiles, bins = path.bins, pixels = path.pixels;
+    const std::size_t n = path.n;
+    const bool baseline = path.baseline, fused = path.fused, binned = path.binned;
     if (bin_sort_frame_) {
       const std::size_t fill_bytes = bin_fill_.bytes();
       // Each bin's fill, then its count when emission counts (FrameBuffers::emitted_bin_counts).
@@ -885,8 +920,7 @@ class CudaRendererImpl final : public CudaRenderer {
       tile_lists_.reserve(std::max<std::uint64_t>(tiles, 1) * sizeof(uint2), "tile lists");
       dense_bins_.reserve(std::max<std::uint64_t>(bins, 1) * sizeof(std::uint32_t), "dense bin list");
     }
-    const bool float_image = target != FrameTarget::surface;
-    if (float_image) image_.reserve(pixels * 3 * sizeof(float), "frame image");
+    if (path.float_image) image_.reserve(pixels * 3 * sizeof(float), "frame image");
     // Fused emission keeps a blend record per projected Gaussian (FrameBuffers::blend), the
     // separate path one per Gaussian.
     compact_records_ = fused;
@@ -908,7 +942,13 @@ class CudaRendererImpl final : public CudaRenderer {
       pair_offsets_.reserve(std::max<std::size_t>(n, 1) * sizeof(std::uint32_t), "per-Gaussian pair offsets");
     }
     grow_cub_temp();  // allocates only when the scene or pairs grew
+  }
 
+  // The preprocess kernel's arguments; the chunk list sized where preprocess walks one.
+  cuda::PreprocessArgs preprocess_args(const FramePath& path, const RenderOptions& options) {
+    const gm::CameraParams& cam = path.cam;
+    const std::size_t n = path.n;
+    const bool baseline = path.baseline, fused = path.fused;
     cuda::PreprocessArgs args{};
     args.camera = cam;
     args.geometry = make_geometry_params(options);
@@ -927,31 +967,21 @@ class CudaRendererImpl final : public CudaRenderer {
     if (list_chunks_)
       chunk_list_.reserve(
           std::max<std::size_t>((n + cuda::kChunkSize - 1) / cuda::kChunkSize, 1) * sizeof(std::uint32_t), "chunk list");
+    return args;
+  }
 
-    // project (+ fused emit), then the frame's one read back: the pair and record counts.
-    // Fused emission that overflowed wrote nothing past the capacities; grow and run it again.
-    // Event sets alternate between frames, so that a surface frame's statistics can report
-    // the previous frame's stage times without waiting for its own.
-    const int previous_set = event_set_;
-    const bool previous_complete = last_frame_complete_;  // all its events recorded
-    last_frame_complete_ = false;
-    event_set_ ^= 1;
-    frame_tiles_[event_set_] = tiles;
+  // Queues project (+ fused emit), then the frame's one read back: the pair and record counts,
+  // which it waits for; returns the pairs. Fused emission that overflowed wrote nothing past
+  // the capacities; grow and run it again. A frame queued before its count
+  // (queue_before_count) queues the rest of its work here too.
+  std::uint64_t queue_preprocess_and_read_back(const FramePlan& frame, bool queue_before_count, bool count_at_end,
+                                               int previous_set, bool previous_complete) {
+    const RenderOptions& options = *frame.options;
+    const cuda::PreprocessArgs& args = *frame.args;
+    const std::uint64_t tiles = frame.tiles, bins = frame.bins;
+    const std::size_t n = device_scene_.count;
+    const bool baseline = frame.baseline, fused = frame.fused;
     cudaEvent_t* events = events_[event_set_];
-    // The bin sort reads the pair count on the device, so a frame of fused emission queues
-    // the rest of its work before the host waits for the count: the GPU then runs on instead
-    // of idling while the host reads the count and launches the sort (8-16 us a frame).
-    // Nothing it queues waits for the last frame's end (dense_order_pays reads a finished
-    // frame's statistics), so frames queued back to back follow each other without a gap.
-    const bool queue_before_count = bin_sort_frame_ && fused;
-    // Such a frame that goes to the host (whose end the host waits for anyway) reads its counts
-    // back at its end, after the blend: a copy between preprocess and sort kept the GPU idle
-    // for 15-25 us on the H200 machine. A surface frame reads them back at once, so that
-    // the host can go on while the GPU blends.
-    const bool count_at_end = queue_before_count && out;
-    separate_emit_[event_set_] = !fused;
-    const FramePlan frame{&camera, &cam, &options, &args, out, surface,
-                          float_image, tiles, bins, pixels, baseline, fused, binned, count_at_end};
     std::uint64_t pairs = 0;
     for (int attempt = 0;; ++attempt) {
       // Emission counts the pairs per bin where it pays, each preprocess block takes its own
@@ -992,7 +1022,16 @@ class CudaRendererImpl final : public CudaRenderer {
       if (!fused) break;  // nothing was written yet
       if (attempt > 0) throw Error("cuda renderer: internal error, pair count changed between identical runs");
     }
-    if (!queue_before_count) queue_after_count(frame, pairs);
+    return pairs;
+  }
+
+  // What the next frames judge by (this frame's tiles, pairs and records; the deferred list
+  // grown to what it wanted), and a frame for the host waited for.
+  void finish_frame(const FramePlan& frame, std::uint64_t pairs) {
+    const cuda::PreprocessArgs& args = *frame.args;
+    const std::uint64_t tiles = frame.tiles;
+    const bool fused = frame.fused, binned = frame.binned;
+    Image* out = frame.out;
     if (args.warp_cooperative && fused)
       grow_deferred(readback_->counters.deferred, readback_->counters.deferred_items);
     last_tiles_ = tiles;
@@ -1004,8 +1043,15 @@ class CudaRendererImpl final : public CudaRenderer {
       settle(event_set_);
     }
     last_frame_complete_ = true;
-    if (!stats_out) return;
+  }
 
+  // The frame's counts, stage times and memory (a surface frame: the previous frame's times).
+  FrameStats frame_stats(const FramePlan& frame, std::uint64_t pairs, int previous_set, bool previous_complete) {
+    const gm::CameraParams& cam = *frame.cam;
+    const RenderOptions& options = *frame.options;
+    const std::size_t n = device_scene_.count;
+    const bool binned = frame.binned;
+    Image* out = frame.out;
     FrameStats stats;
     const cuda::FrameCounters& c = readback_->counters;
     stats.sorted_pairs = pairs;
@@ -1039,7 +1085,7 @@ class CudaRendererImpl final : public CudaRenderer {
     stats.scene_device_bytes = scene_pos_.bytes() + scene_rot_.bytes() + scene_scale_.bytes() + scene_dc_.bytes() +
                                scene_rest_.bytes() + scene_chunks_.bytes() + scene_ids_.bytes() + pool_bytes_;
     if (options.collect_tile_counts) download_tile_counts(stats.tile_pair_counts);
-    *stats_out = std::move(stats);
+    return stats;
   }
 
   int device_ = 0;
@@ -1068,13 +1114,12 @@ class CudaRendererImpl final : public CudaRenderer {
   std::uint64_t working_bytes_ = 0, peak_bytes_ = 0;
   std::uint64_t pair_capacity_ = 0;
   std::size_t last_tiles_ = 0;
-  int region_width_ = 8;
+  int region_width_ = 0;  // the tuning's (constructor), as the knobs below
   bool stop_bound_ = true;
   std::size_t cub_sized_for_gaussians_ = ~std::size_t{0};  // sizes cub_temp_ was last checked for
   std::uint64_t cub_sized_for_pairs_ = 0;
-  static constexpr int kMaxBoxThreshold = 1 << 20;  // large_box_tiles_ at most: a 16384x16384 frame's tiles
-  int large_box_tiles_ = cuda::kLargeBoxTiles;
-  int item_chunks_ = cuda::kDeferredItemChunks;
+  int large_box_tiles_ = 0;
+  int item_chunks_ = 0;
   // Chunk culling pays off in large scenes (the 3.5M tiled scene's project stage fell 9%, the
   // 100M one's 2.8x on an H200) and costs a test per 256 Gaussians that cannot pay off when
   // the whole of a small scene is in view (pc_biker's and pc_playbot's orbit views).
@@ -1084,12 +1129,13 @@ class CudaRendererImpl final : public CudaRenderer {
   // cull working again). Below, it gathers a small grid's heavy Gaussians into a few blocks
   // (v3dg_donut, 45k: 3% / 2% longer on the H200, docs/PERFORMANCE.md).
   static constexpr std::size_t kSpatialOrderMinGaussians = std::size_t{1} << 18;
-  // Compact records a scene's first frame starts with (100 MB): a view of more Gaussians grows
-  // them once and runs again.
-  std::uint64_t initial_records_ = std::uint64_t{1} << 21;
-  int sort_key_bits_ = 32;  // of a compact key (compact_key_format)
-  unsigned bin_sort_shared_pairs_ = cuda::kBinSortSharedPairsMax;
+  // Compact records a scene's first frame starts with: a view of more Gaussians grows them once
+  // and runs again.
+  std::uint64_t initial_records_ = 0;
+  int sort_key_bits_ = 0;  // of a compact key (compact_key_format)
+  unsigned bin_sort_shared_pairs_ = 0;
   enum Mode { kAuto, kAlways, kNever };
+  static Mode mode_of(long long knob) { return knob == kTuningAuto ? kAuto : (knob != 0 ? kAlways : kNever); }
   Mode chunk_cull_ = kAuto;
   Mode spatial_order_ = kAuto;  // the scene's device layout in spatial order (upload_scene)
   // Where the last upload's wall-clock seconds went, printed by set_scene where asked for.
@@ -1137,6 +1183,8 @@ class CudaRendererImpl final : public CudaRenderer {
 
 }  // namespace
 
-std::unique_ptr<CudaRenderer> make_cuda_renderer() { return std::make_unique<CudaRendererImpl>(); }
+std::unique_ptr<CudaRenderer> make_cuda_renderer(const BackendTuning& tuning) {
+  return std::make_unique<CudaRendererImpl>(tuning);
+}
 
 }  // namespace flashgs

@@ -435,15 +435,14 @@ void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::si
 
 std::string simd_target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
 
-void apply_simd_target_limit() {
+void apply_simd_target_limit(const std::string& wanted) {
   hwy::DisableTargets(0);  // what the CPU supports, whatever an earlier renderer chose
-  const char* wanted = std::getenv("FLASHGS_CPU_SIMD");
-  if (!wanted || !*wanted) return;
+  if (wanted.empty()) return;
   std::int64_t chosen = 0;
   std::string names;
   for (const std::int64_t target : hwy::SupportedAndGeneratedTargets()) {
     names += std::string(names.empty() ? "" : ", ") + hwy::TargetName(target);
-    if (strcasecmp(hwy::TargetName(target), wanted) == 0) chosen = target;
+    if (strcasecmp(hwy::TargetName(target), wanted.c_str()) == 0) chosen = target;
   }
   if (chosen == 0) {
     // Once per value: a process makes several renderers.
@@ -451,8 +450,10 @@ void apply_simd_target_limit() {
     static std::string said;
     const std::lock_guard<std::mutex> lock(said_mutex);
     if (said != wanted)
-      std::fprintf(stderr, "FLASHGS_CPU_SIMD=%s: not a SIMD target this build has and this CPU runs (%s); using the best\n",
-                   wanted, names.c_str());
+      std::fprintf(stderr,
+                   "cpu_simd=%s (FLASHGS_CPU_SIMD): not a SIMD target this build has and this CPU runs (%s); using the "
+                   "best\n",
+                   wanted.c_str(), names.c_str());
     said = wanted;
     return;
   }
@@ -478,10 +479,10 @@ void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::si
 
 std::string simd_target_name() { return "scalar"; }
 
-void apply_simd_target_limit() {
-  const char* wanted = std::getenv("FLASHGS_CPU_SIMD");
-  if (wanted && *wanted)
-    std::fprintf(stderr, "FLASHGS_CPU_SIMD=%s: this build has no SIMD kernels (built without Highway)\n", wanted);
+void apply_simd_target_limit(const std::string& wanted) {
+  if (!wanted.empty())
+    std::fprintf(stderr, "cpu_simd=%s (FLASHGS_CPU_SIMD): this build has no SIMD kernels (built without Highway)\n",
+                 wanted.c_str());
 }
 
 }  // namespace cpu

@@ -200,10 +200,11 @@ void simd_alpha(const float* q, const float* log2_opacity, float* alpha, std::si
 constexpr double kSimdAlphaMaxRelError = 4e-6;
 // The SIMD target blend_tile_simd runs on this CPU ("AVX2", "AVX3", ...; "scalar" without Highway).
 std::string simd_target_name();
-// The environment's FLASHGS_CPU_SIMD names the best target the SIMD kernels may use (e.g. AVX2
-// on an AVX-512 host, to measure what most desktops run); unset, the CPU's best. A name this
-// build or CPU lacks gets one line on stderr and the best target. Applies to the whole process.
-void apply_simd_target_limit();
+// `wanted` (the cpu_simd knob, BackendTuning) names the best target the SIMD kernels may use
+// (e.g. AVX2 on an AVX-512 host, to measure what most desktops run); empty, the CPU's best. A
+// name this build or CPU lacks gets one line on stderr and the best target. Applies to the
+// whole process.
+void apply_simd_target_limit(const std::string& wanted);
 
 }  // namespace cpu
 }  // namespace flashgs

@@ -18,17 +18,17 @@ namespace flashgs {
 
 namespace {
 
-// The blend kernel's name, after FLASHGS_CPU_SIMD has picked the SIMD target.
-std::string blend_kernel_name(CpuBlend blend) {
-  cpu::apply_simd_target_limit();
+// The blend kernel's name, after the cpu_simd knob has picked the SIMD target.
+std::string blend_kernel_name(CpuBlend blend, const std::string& simd_limit) {
+  cpu::apply_simd_target_limit(simd_limit);
   return blend == CpuBlend::scalar ? "scalar" : cpu::simd_target_name();
 }
 
 class CpuRenderer final : public Renderer {
  public:
-  CpuRenderer(int threads, CpuBlend blend)
+  CpuRenderer(int threads, CpuBlend blend, const BackendTuning& tuning)
       : kernel_(blend == CpuBlend::scalar ? cpu::BlendKernel::scalar : cpu::BlendKernel::simd),
-        kernel_name_(blend_kernel_name(blend)) {
+        kernel_name_(blend_kernel_name(blend, tuning.cpu_simd)) {
 #ifdef _OPENMP
     frame_.threads = threads > 0 ? threads : omp_get_max_threads();
 #else
@@ -129,8 +129,8 @@ class CpuRenderer final : public Renderer {
 
 }  // namespace
 
-std::unique_ptr<Renderer> make_cpu_renderer(int threads, CpuBlend blend) {
-  return std::make_unique<CpuRenderer>(threads, blend);
+std::unique_ptr<Renderer> make_cpu_renderer(int threads, CpuBlend blend, const BackendTuning& tuning) {
+  return std::make_unique<CpuRenderer>(threads, blend, tuning);
 }
 
 }  // namespace flashgs

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/backend_tuning.h"
 #include "flashgs/renderer.h"
 
 namespace flashgs {
@@ -38,6 +39,7 @@ class CudaRenderer : public Renderer {
   virtual void* stream() const = 0;
 };
 
-std::unique_ptr<CudaRenderer> make_cuda_renderer();
+// `tuning`: how it makes frames (by default, as the environment sets it).
+std::unique_ptr<CudaRenderer> make_cuda_renderer(const BackendTuning& tuning = tuning_from_environment());
 
 }  // namespace flashgs

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/backend_tuning.h"
 #include "flashgs/camera.h"
 #include "flashgs/image.h"
 #include "flashgs/options.h"
@@ -54,7 +55,9 @@ class Renderer {
 // run time) or the scalar reference kernel the SIMD one is tested against.
 enum class CpuBlend { simd, scalar };
 
-// The multi-threaded CPU backend; `threads` = 0 uses every core.
-std::unique_ptr<Renderer> make_cpu_renderer(int threads = 0, CpuBlend blend = CpuBlend::simd);
+// The multi-threaded CPU backend; `threads` = 0 uses every core. Of `tuning` it reads cpu_simd
+// (by default, as the environment sets it).
+std::unique_ptr<Renderer> make_cpu_renderer(int threads = 0, CpuBlend blend = CpuBlend::simd,
+                                            const BackendTuning& tuning = tuning_from_environment());
 
 }  // namespace flashgs
