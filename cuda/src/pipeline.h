@@ -14,14 +14,6 @@ namespace flashgs {
 namespace cuda {
 
 constexpr int kWarp = 32;
-// By default, a Gaussian whose tile box holds more than this many tiles is emitted by a whole
-// warp (FlashGS section 4.3): below it one thread's loop is shorter than the warp's
-// bookkeeping (PreprocessArgs::large_box_tiles; FLASHGS_LARGE_BOX_TILES overrides it).
-constexpr int kLargeBoxTiles = 32;
-// A deferred box is emitted in work items of up to this many 32-bin chunks, a warp each, so
-// that a box of the whole frame is spread over many warps instead of setting the kernel's
-// length (PreprocessArgs::item_chunks; FLASHGS_DEFERRED_ITEM_CHUNKS overrides it, 1 to 32).
-constexpr int kDeferredItemChunks = 4;
 
 // Preprocess takes the Gaussians in chunks of this many (one block each) and skips the
 // projection of a chunk whose bounds lie outside the view (chunk_cull.cuh).
