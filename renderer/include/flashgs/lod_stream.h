@@ -15,6 +15,7 @@
 #include "flashgs/frame_memory.h"
 #include "flashgs/lod_cut.h"
 #include "flashgs/lod_set.h"
+#include "flashgs/lod_tint.h"
 #include "flashgs/scene.h"
 
 namespace flashgs {
@@ -65,6 +66,8 @@ class LodStreamer {
   // the same pointer as before while nothing drawn changed. Never waits for a chunk.
   std::shared_ptr<const Scene> update(const Camera& camera);
   LodStreamStats stats() const;
+  // The levels of the scene update() last returned, run by run in its order (the level overlay).
+  const std::vector<LodLevelRun>& drawn_levels() const { return m_level_runs; }
   // Blocks until no chunk is queued or loading (tests; a benchmark's warm start).
   void wait_until_idle();
   // One line per chunk that could not be read since the last call (the rest keeps rendering).
@@ -98,6 +101,7 @@ class LodStreamer {
   LodCut m_cut;
   std::vector<LodRange> m_drawn;  // what m_scene holds, in leaf order
   std::shared_ptr<const Scene> m_scene;
+  std::vector<LodLevelRun> m_level_runs;  // m_scene's levels
   LodStreamStats m_stats;
   bool m_have_last_position = false;
   float m_last_position[3] = {0, 0, 0};
