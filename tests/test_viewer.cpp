@@ -1359,6 +1359,31 @@ TEST(Viewer, StreamingASceneFileBuildsItsLodSetOnceAndThenOpensTheCachedSet) {
     EXPECT_EQ(e.path().filename().string().find("broken.ply.lod-"), std::string::npos) << e.path();
 }
 
+// The Scene panel's "level colours" box turns the overlay on while the set streams (a real
+// click, XTEST), and off again.
+TEST(Viewer, TheLevelColoursBoxTurnsTheOverlayOnAndOffLive) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string set = out_dir() + "/live_overlay_set";
+  std::filesystem::remove_all(set);
+  flashgs::LodBuildOptions options;
+  options.leaf_gaussians = 2048;
+  flashgs::build_lod_set(flashgs::demo_scene_path(), set, options);
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { wait_for \"stream settled\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { click \"level colours\" && wait_for \"level overlay on\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { click \"level colours\" && wait_for \"level overlay off\" || status=14; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "live_overlay",
+                                      "--backend cpu --size 1280x800 --log-input --stream --max-error-px 8 '" + set + "'", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 stream, 12 overlay on, 13 crash, 14 overlay off, 15 close)\n" << r.output;
+#endif
+}
+
 // Frames and scenes too large for this machine are refused with their figures, before any
 // allocation (no std::bad_alloc, no abort).
 TEST(Viewer, ARenderSizeBeyondMemoryOrTextureLimitIsRefused) {

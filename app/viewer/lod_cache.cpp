@@ -44,7 +44,7 @@ bool holds_set(const std::string& folder) {
 
 // Builds into `folder` through a temporary sibling; false when that cannot be created (the
 // caller tries the next place); throws when the build itself fails.
-bool build_into(const std::string& scene_file, const std::string& folder, const LodCacheOptions& options,
+bool build_into(const std::string& scene_file, const std::string& folder, const LodBuildOptions& options,
                 LoadProgress* progress) {
   std::error_code error;
   const fs::path target(folder), partial = target.string() + ".partial-" + std::to_string(::getpid());
@@ -52,10 +52,7 @@ bool build_into(const std::string& scene_file, const std::string& folder, const 
   if (error || ::access(target.parent_path().c_str(), W_OK) != 0) return false;
   fs::remove_all(partial, error);
   if (!fs::create_directory(partial, error) || error) return false;
-  LodBuildOptions build;
-  build.leaf_gaussians = options.leaf_gaussians;
-  build.file_gaussians = options.file_gaussians;
-  build.memory_bytes = options.memory_bytes;
+  LodBuildOptions build = options;
   if (progress) {
     // Three passes over the scene: the load bar runs once over all of them.
     build.progress = [progress, &scene_file](const char* stage, std::uint64_t done, std::uint64_t total) {
@@ -84,7 +81,7 @@ bool build_into(const std::string& scene_file, const std::string& folder, const 
 
 }  // namespace
 
-LodCacheFolders lod_cache_folders(const std::string& scene_file, const LodCacheOptions& options) {
+LodCacheFolders lod_cache_folders(const std::string& scene_file, const LodBuildOptions& options) {
   std::error_code error;
   const fs::path file = fs::absolute(scene_file, error);
   const std::uintmax_t size = fs::file_size(file, error);
@@ -98,7 +95,7 @@ LodCacheFolders lod_cache_folders(const std::string& scene_file, const LodCacheO
   return {(file.parent_path() / (name + ".lod-" + key)).string(), user_cache_root() + "/flashgs/lod/" + name + "-" + key};
 }
 
-CachedLodSet open_or_build_lod_cache(const std::string& scene_file, const LodCacheOptions& options, LoadProgress* progress) {
+CachedLodSet open_or_build_lod_cache(const std::string& scene_file, const LodBuildOptions& options, LoadProgress* progress) {
   const LodCacheFolders folders = lod_cache_folders(scene_file, options);
   CachedLodSet out;
   for (const std::string& folder : {folders.beside, folders.user})
@@ -120,7 +117,7 @@ CachedLodSet open_or_build_lod_cache(const std::string& scene_file, const LodCac
 }
 
 LoadedScene load_streamed_scene(const std::string& path, const std::string& cameras_path, LoadProgress* progress,
-                                const LodCacheOptions& options) {
+                                const LodBuildOptions& options) {
   const SceneLocation location = locate_scene(path);
   if (is_sog_lod_set(location.ply)) return load_scene(path, cameras_path, progress, kCoarsestLodLevel);
   const CachedLodSet set = open_or_build_lod_cache(location.ply, options, progress);

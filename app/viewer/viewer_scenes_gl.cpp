@@ -21,8 +21,8 @@
 namespace flashgs::viewer {
 namespace {
 
-LodCacheOptions lod_cache_options(const ViewerArgs& args) {
-  LodCacheOptions options;
+LodBuildOptions lod_cache_options(const ViewerArgs& args) {
+  LodBuildOptions options;
   options.leaf_gaussians = args.lod_leaf_size;
   options.file_gaussians = args.lod_file_size;
   return options;
