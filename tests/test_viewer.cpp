@@ -1359,6 +1359,32 @@ TEST(Viewer, StreamingASceneFileBuildsItsLodSetOnceAndThenOpensTheCachedSet) {
     EXPECT_EQ(e.path().filename().string().find("broken.ply.lod-"), std::string::npos) << e.path();
 }
 
+// Interactive, the build of a scene file's LOD set is the scene's load beside the window: its
+// progress shows, and the set streams once it is built.
+TEST(Viewer, AStreamedSceneFilesBuildShowsAsTheLoadsProgress) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string dir = out_dir() + "/stream_cache_live";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(flashgs::demo_scene_path(), dir + "/demo.ply");
+  const std::string steps = "wait_for \"load progress shown\" || status=11\n"
+                            "[ $status -eq 0 ] && { open_load_gate; wait_for \"built the LOD set of\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"stream settled\" || status=14; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "stream_cache_live",
+                                      "--backend cpu --size 1280x800 --stream --lod-leaf-size 2048 '" + dir + "/demo.ply'" +
+                                          load_gate_args("stream_cache_live"),
+                                      steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (11 progress, 12 build, 13 crash, 14 stream, 15 close)\n" << r.output;
+  EXPECT_NE(r.output.find("streaming " + dir + "/demo.ply.lod-"), std::string::npos) << r.output;
+#endif
+}
+
 // The Scene panel's "level colours" box turns the overlay on while the set streams (a real
 // click, XTEST), and off again.
 TEST(Viewer, TheLevelColoursBoxTurnsTheOverlayOnAndOffLive) {

@@ -1,6 +1,7 @@
 // The viewer's LOD set cache: where a scene file's set lives, and building it when absent.
 #include "lod_cache.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -54,13 +55,13 @@ bool build_into(const std::string& scene_file, const std::string& folder, const 
   if (!fs::create_directory(partial, error) || error) return false;
   LodBuildOptions build = options;
   if (progress) {
-    // Three passes over the scene: the load bar runs once over all of them.
+    // Three passes over the scene: the load bar runs once over all of them (a third each).
     build.progress = [progress, &scene_file](const char* stage, std::uint64_t done, std::uint64_t total) {
       if (progress->cancel_requested) throw LoadCancelled(scene_file);
       const std::string s = stage;
       const std::uint64_t pass = s == "sampling" ? 0 : s == "sorting" ? 1 : 2;
-      progress->gaussians_total = 3 * total;
-      progress->gaussians_done = pass * total + done;
+      progress->gaussians_total = total;
+      progress->gaussians_done = (pass * total + std::min(done, total)) / 3;
     };
   }
   std::fprintf(stderr, "flashgs-viewer: building the LOD set of %s into %s (once: later opens read it from there)\n",

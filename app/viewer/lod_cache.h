@@ -28,7 +28,7 @@ struct CachedLodSet {
 };
 // The set for `scene_file`: a cached one, else built now (into a temporary folder renamed once
 // complete; beside the file when its folder is writable, else in the user's cache). `progress`
-// (may be null) shows the build's passes as Gaussians done of three times the scene's; its
+// (may be null) shows the build's three passes as one run over the scene's Gaussians; its
 // cancel flag stops the build (flashgs::LoadCancelled). Throws flashgs::Error naming the file.
 CachedLodSet open_or_build_lod_cache(const std::string& scene_file, const LodBuildOptions& options, LoadProgress* progress);
 
