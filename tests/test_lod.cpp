@@ -374,6 +374,27 @@ TEST(LodTint, EachGaussianTakesItsLevelsColourAndTheGeometryStays) {
   EXPECT_THROW(tint_by_level(with_sh, {{0, 7}}), Error);
 }
 
+// A drawn scene's ranges become runs of levels by the chunk file each range is in.
+TEST(LodTint, RangesBecomeRunsByTheirFilesLevel) {
+  LodSet set;
+  set.meta_path = "set/lod-meta.json";
+  set.level_count = 2;
+  set.files = {"0_0.ply", "1_0.ply", "0_1.ply"};
+  set.leaves.resize(2);
+  set.leaves[0].levels = {LodRange{0, 0, 10}, LodRange{1, 0, 5}};
+  set.leaves[1].levels = {LodRange{2, 0, 8}, LodRange{1, 5, 4}};
+  const std::vector<LodLevelRun> runs =
+      lod_level_runs(set, {LodRange{0, 0, 10}, LodRange{2, 0, 8}, LodRange{1, 5, 4}, LodRange{1, 0, 5}});
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0].level, 0);
+  EXPECT_EQ(runs[0].count, 18u);
+  EXPECT_EQ(runs[1].level, 1);
+  EXPECT_EQ(runs[1].count, 9u);
+  EXPECT_THROW(lod_level_runs(set, {LodRange{3, 0, 1}}), Error);
+  set.leaves[1].levels[1].file = 0;  // a file of two levels
+  EXPECT_THROW(lod_level_runs(set, {LodRange{0, 0, 10}}), Error);
+}
+
 // The streamer says which level each drawn Gaussian came from: the runs cover the drawn scene
 // and add up to its per-level counts; the overlay colours each run by its level.
 TEST(LodStream, TheLevelRunsFollowTheDrawnScene) {
@@ -385,7 +406,7 @@ TEST(LodStream, TheLevelRunsFollowTheDrawnScene) {
   streamer.update(camera);
   streamer.wait_until_idle();
   const std::shared_ptr<const Scene> scene = streamer.update(camera);
-  const std::vector<LodLevelRun>& runs = streamer.drawn_levels();
+  const std::vector<LodLevelRun> runs = lod_level_runs(set, streamer.drawn_ranges());
   std::vector<std::uint64_t> per_level(static_cast<std::size_t>(set.level_count), 0);
   std::uint64_t total = 0;
   for (const LodLevelRun& r : runs) {

@@ -51,7 +51,7 @@ std::shared_ptr<const Scene> LodStreamView::update(const Camera& camera, bool se
     return scene;
   }
   if (scene != m_tinted_from) {  // a copy of what is drawn, the levels' colours in place of the scene's
-    m_tinted = std::make_shared<const Scene>(tint_by_level(*scene, m_streamer->drawn_levels()));
+    m_tinted = std::make_shared<const Scene>(tint_by_level(*scene, lod_level_runs(m_streamer->set(), m_streamer->drawn_ranges())));
     m_tinted_from = scene;
   }
   return m_tinted;

@@ -229,7 +229,6 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
 
   const int levels = m_set.level_count;
   std::vector<LodRange> drawn;
-  std::vector<int> drawn_levels;  // the level of each drawn range
   std::vector<std::shared_ptr<const Scene>> sources;
   LodStreamStats stats;
   stats.budget = cut_options.budget;
@@ -266,7 +265,6 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
       Chunk& chunk = m_chunks[static_cast<std::size_t>(range.file)];
       chunk.last_used = m_frame;
       drawn.push_back(range);
-      drawn_levels.push_back(draw);
       sources.push_back(chunk.scene);
       stats.drawn_per_level[static_cast<std::size_t>(draw)] += range.count;
     }
@@ -294,11 +292,6 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
     std::shared_ptr<Scene> scene = assemble(drawn, sources, total);
     m_scene = std::move(scene);
     m_drawn = std::move(drawn);
-    m_level_runs.clear();
-    for (std::size_t i = 0; i < m_drawn.size(); ++i) {
-      if (m_level_runs.empty() || m_level_runs.back().level != drawn_levels[i]) m_level_runs.push_back({drawn_levels[i], 0});
-      m_level_runs.back().count += m_drawn[i].count;
-    }
     std::lock_guard<std::mutex> lock(m_mutex);
     // The scene drawn now and the frame that renders it.
     m_drawn_bytes = m_scene->size() * (m_bytes_per_gaussian + m_options.host_frame.per_gaussian) + m_options.host_frame.fixed;

@@ -28,6 +28,31 @@ std::array<float, 3> lod_level_colour(int level) {
   return kPalette[static_cast<std::size_t>(((level % n) + n) % n)];
 }
 
+std::vector<LodLevelRun> lod_level_runs(const LodSet& set, const std::vector<LodRange>& ranges) {
+  std::vector<int> level_of(set.files.size(), -1);
+  for (const LodLeaf& leaf : set.leaves)
+    for (std::size_t level = 0; level < leaf.levels.size(); ++level) {
+      const int file = leaf.levels[level].file;
+      if (file < 0 || static_cast<std::size_t>(file) >= level_of.size()) continue;  // read_lod_set refuses these
+      int& known = level_of[static_cast<std::size_t>(file)];
+      if (known >= 0 && known != static_cast<int>(level))
+        throw Error(printable_file_text(set.meta_path, kMaxPrintedPathBytes) + ": chunk file " + std::to_string(file) +
+                    " holds levels " + std::to_string(known) + " and " + std::to_string(level));
+      known = static_cast<int>(level);
+    }
+  std::vector<LodLevelRun> runs;
+  for (const LodRange& r : ranges) {
+    const bool known = r.file >= 0 && static_cast<std::size_t>(r.file) < level_of.size();
+    const int level = known ? level_of[static_cast<std::size_t>(r.file)] : -1;
+    if (level < 0)
+      throw Error(printable_file_text(set.meta_path, kMaxPrintedPathBytes) + ": a drawn range names chunk file " +
+                  std::to_string(r.file) + ", which no level holds");
+    if (runs.empty() || runs.back().level != level) runs.push_back({level, 0});
+    runs.back().count += r.count;
+  }
+  return runs;
+}
+
 Scene tint_by_level(const Scene& scene, const std::vector<LodLevelRun>& runs) {
   std::uint64_t covered = 0;
   for (const LodLevelRun& r : runs) covered += r.count;

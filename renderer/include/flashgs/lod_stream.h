@@ -15,7 +15,6 @@
 #include "flashgs/frame_memory.h"
 #include "flashgs/lod_cut.h"
 #include "flashgs/lod_set.h"
-#include "flashgs/lod_tint.h"
 #include "flashgs/scene.h"
 
 namespace flashgs {
@@ -66,13 +65,13 @@ class LodStreamer {
   // the same pointer as before while nothing drawn changed. Never waits for a chunk.
   std::shared_ptr<const Scene> update(const Camera& camera);
   LodStreamStats stats() const;
-  // The levels of the scene update() last returned, run by run in its order (the level overlay).
-  const std::vector<LodLevelRun>& drawn_levels() const { return m_level_runs; }
   // Blocks until no chunk is queued or loading (tests; a benchmark's warm start).
   void wait_until_idle();
   // One line per chunk that could not be read since the last call (the rest keeps rendering).
   std::vector<std::string> take_errors();
   const LodSet& set() const { return m_set; }
+  // The ranges of the scene update() last returned, in its order (the level overlay's input).
+  const std::vector<LodRange>& drawn_ranges() const { return m_drawn; }
 
  private:
   struct Chunk;
@@ -101,7 +100,6 @@ class LodStreamer {
   LodCut m_cut;
   std::vector<LodRange> m_drawn;  // what m_scene holds, in leaf order
   std::shared_ptr<const Scene> m_scene;
-  std::vector<LodLevelRun> m_level_runs;  // m_scene's levels
   LodStreamStats m_stats;
   bool m_have_last_position = false;
   float m_last_position[3] = {0, 0, 0};

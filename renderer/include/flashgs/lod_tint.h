@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "flashgs/lod_set.h"
 #include "flashgs/scene.h"
 
 namespace flashgs {
@@ -15,6 +16,11 @@ struct LodLevelRun {
   int level = 0;
   std::uint64_t count = 0;
 };
+
+// The levels of a drawn scene made of `ranges` of `set`'s chunk files, one after another: a
+// chunk file holds one level. Throws flashgs::Error naming the set when a range's file is not
+// one level's.
+std::vector<LodLevelRun> lod_level_runs(const LodSet& set, const std::vector<LodRange>& ranges);
 
 // The overlay's colour of `level` (linear RGB in [0, 1]); the palette repeats after
 // lod_palette_size() levels.
