@@ -14,10 +14,13 @@
 
 #include "flashgs/demo_scene.h"
 #include "flashgs/error.h"
+#include "flashgs/file_access.h"
 #include "flashgs/io.h"
 #include "flashgs/lod_build.h"
 #include "flashgs/lod_cut.h"
 #include "flashgs/lod_stream.h"
+#include "flashgs/lod_tint.h"
+#include "flashgs/model_constants.h"
 #include "flashgs/renderer.h"
 #include "lod_merge.h"
 #include "test_support.h"
@@ -195,6 +198,34 @@ TEST(LodBuild, ASmallMemoryCapBucketsTheSceneOnTheDisk) {
   EXPECT_FALSE(fs::exists(dir + "/.lod-build-tmp"));
 }
 
+// Leaves are merged on several threads; the set must be byte for byte the one a single thread
+// writes (several buckets, several groups of leaves per bucket, chunk files shared by leaves).
+TEST(LodBuild, AnyThreadCountWritesTheSameBytes) {
+  auto build = [](int threads) {
+    const std::string dir = fresh_folder("threads_" + std::to_string(threads) + "_" + std::to_string(getpid()));
+    LodBuildOptions options;
+    options.leaf_gaussians = 512;
+    options.file_gaussians = 3000;
+    options.memory_bytes = 1 << 20;
+    options.threads = threads;
+    build_lod_set(demo_scene_path(), dir, options);
+    return dir;
+  };
+  const std::string one = build(1), four = build(4);
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(one)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(static_cast<std::size_t>(std::distance(fs::directory_iterator(four), fs::directory_iterator())), names.size());
+  EXPECT_GT(names.size(), 10u);
+  for (const std::string& name : names) {
+    const std::vector<char> a = read_regular_file(one + "/" + name), b = read_regular_file(four + "/" + name);
+    EXPECT_EQ(a.size(), b.size()) << name;
+    EXPECT_TRUE(a == b) << name << " differs between 1 and 4 threads";
+  }
+  fs::remove_all(one);
+  fs::remove_all(four);
+}
+
 TEST(LodCut, IsDeterministicWithinItsBudgetAndFinerForASmallerError) {
   const LodSet set = read_lod_set(demo_set());
   const Camera camera = test::load_demo_cameras()[3].resized(640, 360);
@@ -351,6 +382,134 @@ TEST(LodStream, ACorruptChunkIsOneLineAndTheRestKeepsRendering) {
   EXPECT_GT(scene->size(), 0u);
   EXPECT_GT(streamer.stats().leaves_coarser, 0) << "the broken chunk's leaves are drawn at a coarser level";
   EXPECT_EQ(streamer.stats().files_failed, 1);
+}
+
+// The level overlay: every Gaussian takes its run's level colour, the geometry stays, and runs
+// that do not cover the scene are refused.
+TEST(LodTint, EachGaussianTakesItsLevelsColourAndTheGeometryStays) {
+  Scene scene = two_gaussians(0.5f, 1.0f);
+  scene.append(two_gaussians(0.8f, 2.0f));
+  scene.append(two_gaussians(0.3f, 3.0f));  // six Gaussians
+  Scene with_sh;
+  with_sh.sh_degree = 1;
+  with_sh.positions = scene.positions;
+  with_sh.scales = scene.scales;
+  with_sh.rotations = scene.rotations;
+  with_sh.opacities = scene.opacities;
+  with_sh.sh_dc = scene.sh_dc;
+  with_sh.sh_rest.assign(scene.size() * 9, 0.25f);
+  const std::vector<LodLevelRun> runs = {{0, 2}, {3, 3}, {0, 1}};
+  const Scene tinted = tint_by_level(with_sh, runs);
+  ASSERT_EQ(tinted.size(), with_sh.size());
+  EXPECT_EQ(tinted.sh_degree, 0);
+  EXPECT_TRUE(tinted.sh_rest.empty());
+  EXPECT_EQ(tinted.positions, with_sh.positions);
+  EXPECT_EQ(tinted.scales, with_sh.scales);
+  EXPECT_EQ(tinted.rotations, with_sh.rotations);
+  EXPECT_EQ(tinted.opacities, with_sh.opacities);
+  const int level_of[6] = {0, 0, 3, 3, 3, 0};
+  for (std::size_t i = 0; i < tinted.size(); ++i) {
+    const std::array<float, 3> want = lod_level_colour(level_of[i]);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(0.5 + model::kShC0 * tinted.sh_dc[i * 3 + k], want[static_cast<std::size_t>(k)], 1e-6) << "Gaussian " << i;
+  }
+  EXPECT_NE(lod_level_colour(0), lod_level_colour(3));
+  EXPECT_EQ(lod_level_colour(lod_palette_size() + 2), lod_level_colour(2));
+  EXPECT_THROW(tint_by_level(with_sh, {{0, 2}, {1, 3}}), Error);
+  EXPECT_THROW(tint_by_level(with_sh, {{0, 7}}), Error);
+}
+
+// A drawn scene's ranges become runs of levels by the chunk file each range is in.
+TEST(LodTint, RangesBecomeRunsByTheirFilesLevel) {
+  LodSet set;
+  set.meta_path = "set/lod-meta.json";
+  set.level_count = 2;
+  set.files = {"0_0.ply", "1_0.ply", "0_1.ply"};
+  set.leaves.resize(2);
+  set.leaves[0].levels = {LodRange{0, 0, 10}, LodRange{1, 0, 5}};
+  set.leaves[1].levels = {LodRange{2, 0, 8}, LodRange{1, 5, 4}};
+  const std::vector<LodLevelRun> runs =
+      lod_level_runs(set, {LodRange{0, 0, 10}, LodRange{2, 0, 8}, LodRange{1, 5, 4}, LodRange{1, 0, 5}});
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0].level, 0);
+  EXPECT_EQ(runs[0].count, 18u);
+  EXPECT_EQ(runs[1].level, 1);
+  EXPECT_EQ(runs[1].count, 9u);
+  EXPECT_THROW(lod_level_runs(set, {LodRange{3, 0, 1}}), Error);
+  set.leaves[1].levels[1].file = 0;  // a file of two levels
+  EXPECT_THROW(lod_level_runs(set, {LodRange{0, 0, 10}}), Error);
+}
+
+// The streamer says which level each drawn Gaussian came from: the runs cover the drawn scene
+// and add up to its per-level counts; the overlay colours each run by its level.
+TEST(LodStream, TheLevelRunsFollowTheDrawnScene) {
+  const LodSet set = read_lod_set(demo_set());
+  LodStreamOptions options;
+  options.cut.max_error_px = 8.0f;  // at 320x180: all four levels of the demo set
+  LodStreamer streamer(set, options);
+  const Camera camera = test::load_demo_cameras()[3].resized(320, 180);
+  streamer.update(camera);
+  streamer.wait_until_idle();
+  const std::shared_ptr<const Scene> scene = streamer.update(camera);
+  const std::vector<LodLevelRun> runs = lod_level_runs(set, streamer.drawn_ranges());
+  std::vector<std::uint64_t> per_level(static_cast<std::size_t>(set.level_count), 0);
+  std::uint64_t total = 0;
+  for (const LodLevelRun& r : runs) {
+    ASSERT_GE(r.level, 0);
+    ASSERT_LT(r.level, set.level_count);
+    per_level[static_cast<std::size_t>(r.level)] += r.count;
+    total += r.count;
+  }
+  EXPECT_EQ(total, scene->size());
+  EXPECT_EQ(per_level, streamer.stats().drawn_per_level);
+  EXPECT_GE(std::count_if(per_level.begin(), per_level.end(), [](std::uint64_t n) { return n > 0; }), 2)
+      << "the view should mix levels at 8 px";
+  const Scene tinted = tint_by_level(*scene, runs);
+  std::size_t at = 0;
+  for (const LodLevelRun& r : runs) {
+    const std::array<float, 3> want = lod_level_colour(r.level);
+    EXPECT_NEAR(0.5 + model::kShC0 * tinted.sh_dc[at * 3], want[0], 1e-6);
+    at += r.count;
+  }
+}
+
+// A set built with SOG chunks (L_K/meta.json, as PlayCanvas's tools write them) streams the
+// frame of the same set built with PLY chunks, within SOG's quantisation.
+TEST(LodBuild, SogChunksStreamThePlySetsFrameWithinQuantisation) {
+  const std::string dir = fresh_folder("sog_chunks_" + std::to_string(getpid()));
+  LodBuildOptions options;
+  options.leaf_gaussians = 2048;
+  options.file_gaussians = 8192;
+  options.chunk_format = LodChunkFormat::sog;
+  const LodBuildReport report = build_lod_set(demo_scene_path(), dir, options);
+  const LodSet sog = read_lod_set(dir), ply = read_lod_set(demo_set());
+  ASSERT_EQ(sog.files.size(), ply.files.size());
+  for (const std::string& f : sog.files) EXPECT_EQ(f.substr(f.size() - 10), "/meta.json") << f;
+  std::uint64_t ply_bytes = 0;
+  for (std::size_t f = 0; f < ply.files.size(); ++f) ply_bytes += fs::file_size(ply.file_path(static_cast<int>(f)));
+  std::printf("SOG chunks: %.2f MB, PLY chunks: %.2f MB\n", double(report.bytes_written) / 1e6, double(ply_bytes) / 1e6);
+  EXPECT_LT(report.bytes_written, ply_bytes / 2);
+  LodStreamOptions stream;
+  stream.cut.max_error_px = 8.0f;  // every level's chunks drawn
+  LodStreamer from_sog(sog, stream), from_ply(ply, stream);
+  auto renderer = make_cpu_renderer(2);
+  for (int index : {3, 17}) {
+    const Camera camera = test::load_demo_cameras()[static_cast<std::size_t>(index)].resized(320, 180);
+    Image images[2];
+    LodStreamer* streamers[2] = {&from_sog, &from_ply};
+    for (int k = 0; k < 2; ++k) {
+      streamers[k]->update(camera);
+      streamers[k]->wait_until_idle();
+      renderer->set_scene(streamers[k]->update(camera));
+      renderer->render(camera, RenderOptions{}, images[k], nullptr);
+    }
+    EXPECT_EQ(from_sog.stats().drawn_per_level, from_ply.stats().drawn_per_level) << "camera " << index;
+    EXPECT_TRUE(from_sog.take_errors().empty());
+    const ImageDifference d = compare_images(images[0], images[1]);
+    std::printf("camera %d: SOG chunks vs PLY chunks %.1f dB\n", index, d.psnr_db);
+    EXPECT_GT(d.psnr_db, 30.0) << "camera " << index;
+  }
+  fs::remove_all(dir);
 }
 
 // A set written by PlayCanvas's tools (SOG chunks) streams the same way.

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +20,7 @@
 #include "flashgs/image_io.h"
 #include "flashgs/frame_memory.h"
 #include "flashgs/lod_build.h"
+#include "flashgs/lod_tint.h"
 #include "flashgs/generators.h"
 #include "flashgs/keyframe_path.h"
 #include "heatmap_legend.h"
@@ -1237,6 +1239,175 @@ TEST(Viewer, StreamingALodSetAtFullDetailShowsTheSourceScenesFrame) {
   const RunResult not_a_set = run(common + "--stream");
   EXPECT_EQ(not_a_set.exit_code, 0) << not_a_set.output;
   EXPECT_NE(not_a_set.output.find("is not a LOD set: drawn whole"), std::string::npos) << not_a_set.output;
+}
+
+namespace {
+
+// The share of lit pixels whose colour points the way of one of the level palette's colours
+// (over a black background a pixel is its Gaussians' colours weighted by their coverage).
+double palette_share(const flashgs::Image& image, int levels) {
+  std::size_t lit = 0, matching = 0;
+  for (std::size_t p = 0; p + 2 < image.rgb.size(); p += 3) {
+    const float* c = &image.rgb[p];
+    const double norm = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
+    if (norm < 0.05) continue;
+    ++lit;
+    for (int level = 0; level < levels; ++level) {
+      const std::array<float, 3> q = flashgs::lod_level_colour(level);
+      const double qn = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2]);
+      if ((c[0] * q[0] + c[1] * q[1] + c[2] * q[2]) / (norm * qn) > 0.995) {
+        ++matching;
+        break;
+      }
+    }
+  }
+  return lit ? double(matching) / double(lit) : 0.0;
+}
+
+}  // namespace
+
+// --lod-overlay draws each Gaussian in its level's colour: the streamed image's colours come
+// from the palette (the scene's own colours do not).
+TEST(Viewer, TheLevelOverlayColoursTheStreamedImageByLevel) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir(), set = dir + "/overlay_demo_set";
+  std::filesystem::remove_all(set);
+  flashgs::LodBuildOptions options;
+  options.leaf_gaussians = 2048;
+  const flashgs::LodBuildReport built = flashgs::build_lod_set(flashgs::demo_scene_path(), set, options);
+  std::filesystem::copy_file(flashgs::demo_cameras_path(), set + "/cameras.json");
+  const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --camera 7 --frames 2 --exit '" + set +
+                             "' --stream --max-error-px 8 ";  // four levels at 320x180
+  const RunResult tinted = run(common + "--lod-overlay --screenshot " + dir + "/overlay.pfm");
+  ASSERT_EQ(tinted.exit_code, 0) << tinted.output;
+  EXPECT_NE(tinted.output.find("level overlay on"), std::string::npos) << tinted.output;
+  const RunResult plain = run(common + "--screenshot " + dir + "/no_overlay.pfm");
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const double with = palette_share(flashgs::read_image(dir + "/overlay.pfm"), built.levels);
+  const double without = palette_share(flashgs::read_image(dir + "/no_overlay.pfm"), built.levels);
+  std::printf("lit pixels in a palette colour: %.3f with the overlay, %.3f without\n", with, without);
+  // Measured: 0.89 and 0.02 (pixels where cells of two levels overlap mix two palette colours).
+  EXPECT_GT(with, 0.8);
+  EXPECT_LT(without, 0.3);
+}
+
+// --stream of a scene file builds its LOD set once into a cache folder beside it (keyed by the
+// file's path, size and time), streams it, and opens the cached set next time without building;
+// a changed file builds anew. Where the file's folder is not writable, the user's cache serves.
+TEST(Viewer, StreamingASceneFileBuildsItsLodSetOnceAndThenOpensTheCachedSet) {
+  REQUIRE_DISPLAY(prefix);
+  namespace fs = std::filesystem;
+  const std::string dir = out_dir() + "/stream_cache";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/scene");
+  const std::string ply = dir + "/scene/demo.ply";
+  fs::copy_file(flashgs::demo_scene_path(), ply);
+  fs::copy_file(flashgs::demo_cameras_path(), dir + "/scene/cameras.json");
+  auto cache_folders = [&] {
+    std::vector<std::string> found;
+    for (const auto& e : fs::directory_iterator(dir + "/scene"))
+      if (e.path().filename().string().rfind("demo.ply.lod-", 0) == 0) found.push_back(e.path().string());
+    return found;
+  };
+  const std::string command = prefix + "env XDG_CACHE_HOME='" + dir + "/cache' " + viewer() +
+                              " --backend cpu --size 320x180 --camera 7 --frames 2 --exit --stream --max-error-px 0"
+                              " --lod-leaf-size 2048 --lod-file-size 8192 '" + ply + "' --screenshot ";
+  const RunResult first = run(command + dir + "/first.pfm");
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  EXPECT_NE(first.output.find("building the LOD set of " + ply), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find("built the LOD set of " + ply), std::string::npos) << first.output;
+  EXPECT_NE(first.output.find("stream settled: 30.0k drawn (levels 0:30.0k)"), std::string::npos) << first.output;
+  ASSERT_EQ(cache_folders().size(), 1u);
+  const std::string folder = cache_folders()[0];
+  EXPECT_TRUE(fs::exists(folder + "/lod-meta.json"));
+  EXPECT_NE(first.output.find("streaming " + folder + "/lod-meta.json by view"), std::string::npos) << first.output;
+
+  const RunResult again = run(command + dir + "/again.pfm");
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(again.output.find("building the LOD set"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("opened the cached LOD set of " + ply + ": " + folder + "/lod-meta.json"), std::string::npos)
+      << again.output;
+  const flashgs::ImageDifference same =
+      flashgs::compare_images(flashgs::read_image(dir + "/first.pfm"), flashgs::read_image(dir + "/again.pfm"));
+  EXPECT_EQ(same.max_abs, 0.0);
+
+  // Another modification time: another key, built anew beside the old one.
+  fs::last_write_time(ply, fs::last_write_time(ply) + std::chrono::seconds(5));
+  const RunResult changed = run(command + dir + "/changed.pfm");
+  ASSERT_EQ(changed.exit_code, 0) << changed.output;
+  EXPECT_NE(changed.output.find("built the LOD set of " + ply), std::string::npos) << changed.output;
+  EXPECT_EQ(cache_folders().size(), 2u);
+
+  if (::geteuid() != 0) {  // permissions do not bind root
+    fs::remove_all(dir + "/scene/" + fs::path(folder).filename().string());
+    for (const std::string& f : cache_folders()) fs::remove_all(f);
+    fs::permissions(dir + "/scene", fs::perms::owner_write, fs::perm_options::remove);
+    const RunResult read_only = run(command + dir + "/read_only.pfm");
+    fs::permissions(dir + "/scene", fs::perms::owner_write, fs::perm_options::add);
+    ASSERT_EQ(read_only.exit_code, 0) << read_only.output;
+    EXPECT_NE(read_only.output.find("into " + dir + "/cache/flashgs/lod/demo.ply-"), std::string::npos) << read_only.output;
+    EXPECT_TRUE(cache_folders().empty());
+  }
+  // A file that is not a scene: one line naming it, nothing left behind.
+  const std::string broken = dir + "/scene/broken.ply";
+  std::ofstream(broken) << "ply\nformat binary_little_endian 1.0\nelement vertex 5\nend_header\n";
+  const RunResult bad = run(prefix + "env XDG_CACHE_HOME='" + dir + "/cache' " + viewer() +
+                            " --backend cpu --size 320x180 --frames 1 --exit --stream '" + broken + "'");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("load failed (no scene loaded yet): " + broken), std::string::npos) << bad.output;
+  for (const auto& e : fs::directory_iterator(dir + "/scene"))
+    EXPECT_EQ(e.path().filename().string().find("broken.ply.lod-"), std::string::npos) << e.path();
+}
+
+// Interactive, the build of a scene file's LOD set is the scene's load beside the window: its
+// progress shows, and the set streams once it is built.
+TEST(Viewer, AStreamedSceneFilesBuildShowsAsTheLoadsProgress) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string dir = out_dir() + "/stream_cache_live";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(flashgs::demo_scene_path(), dir + "/demo.ply");
+  const std::string steps = "wait_for \"load progress shown\" || status=11\n"
+                            "[ $status -eq 0 ] && { open_load_gate; wait_for \"built the LOD set of\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { wait_for \"stream settled\" || status=14; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "stream_cache_live",
+                                      "--backend cpu --size 1280x800 --stream --lod-leaf-size 2048 '" + dir + "/demo.ply'" +
+                                          load_gate_args("stream_cache_live"),
+                                      steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (11 progress, 12 build, 13 crash, 14 stream, 15 close)\n" << r.output;
+  EXPECT_NE(r.output.find("streaming " + dir + "/demo.ply.lod-"), std::string::npos) << r.output;
+#endif
+}
+
+// The Scene panel's "level colours" box turns the overlay on while the set streams (a real
+// click, XTEST), and off again.
+TEST(Viewer, TheLevelColoursBoxTurnsTheOverlayOnAndOffLive) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  const std::string set = out_dir() + "/live_overlay_set";
+  std::filesystem::remove_all(set);
+  flashgs::LodBuildOptions options;
+  options.leaf_gaussians = 2048;
+  flashgs::build_lod_set(flashgs::demo_scene_path(), set, options);
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { wait_for \"stream settled\" || status=11; }\n"
+                            "[ $status -eq 0 ] && { click \"level colours\" && wait_for \"level overlay on\" || status=12; }\n"
+                            "[ $status -eq 0 ] && { click \"level colours\" && wait_for \"level overlay off\" || status=14; }\n"
+                            "[ $status -eq 0 ] && { close_window || status=15; }\n";
+  const RunResult r = run_live_viewer(prefix, "live_overlay",
+                                      "--backend cpu --size 1280x800 --log-input --stream --max-error-px 8 '" + set + "'", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code
+                            << " failed (10 start, 11 stream, 12 overlay on, 13 crash, 14 overlay off, 15 close)\n" << r.output;
+#endif
 }
 
 // Frames and scenes too large for this machine are refused with their figures, before any

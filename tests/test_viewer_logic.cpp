@@ -25,6 +25,7 @@
 #include "flashgs/generators.h"
 #include "flashgs/io.h"
 #include "key_script.h"
+#include "lod_cache.h"
 #include "flashgs/frame_memory.h"
 #include "heatmap_legend.h"
 #include "memory_budget.h"
@@ -1077,4 +1078,36 @@ TEST(ViewerLoad, SogLodSetLoadsTheAskedLevelAndListsTheLevels) {
   } catch (const flashgs::Error& e) {
     EXPECT_NE(std::string(e.what()).find("not a SOG LOD set"), std::string::npos) << e.what();
   }
+}
+
+// A scene file's LOD set cache: beside the file and in the user's cache, under a key that
+// changes with the file's size and time and with the build's sizes, and only with those.
+TEST(ViewerLodCache, TheKeyFollowsTheFileAndTheBuildSizes) {
+  namespace fs = std::filesystem;
+  const std::string dir = scratch_dir("lod_cache");
+  const std::string file = dir + "/big.ply";
+  std::ofstream(file) << "twelve bytes";
+  setenv("XDG_CACHE_HOME", (dir + "/cache").c_str(), 1);
+  flashgs::LodBuildOptions options;
+  const fv::LodCacheFolders a = fv::lod_cache_folders(file, options);
+  unsetenv("XDG_CACHE_HOME");
+  EXPECT_EQ(a.beside.rfind(file + ".lod-", 0), 0u) << a.beside;
+  EXPECT_EQ(a.beside.size(), file.size() + 5 + 16) << a.beside;
+  EXPECT_EQ(a.user.rfind(dir + "/cache/flashgs/lod/big.ply-", 0), 0u) << a.user;
+  EXPECT_EQ(a.beside.substr(a.beside.size() - 16), a.user.substr(a.user.size() - 16));
+  EXPECT_EQ(fv::lod_cache_folders(file, options).beside, a.beside) << "the same file and sizes: the same key";
+  options.leaf_gaussians = 2048;
+  EXPECT_NE(fv::lod_cache_folders(file, options).beside, a.beside);
+  options = flashgs::LodBuildOptions{};
+  options.file_gaussians = 8192;
+  EXPECT_NE(fv::lod_cache_folders(file, options).beside, a.beside);
+  options = flashgs::LodBuildOptions{};
+  fs::last_write_time(file, fs::last_write_time(file) + std::chrono::seconds(3));
+  const std::string after_touch = fv::lod_cache_folders(file, options).beside;
+  EXPECT_NE(after_touch, a.beside);
+  const fs::file_time_type touched = fs::last_write_time(file);
+  std::ofstream(file, std::ios::app) << "!";
+  fs::last_write_time(file, touched);
+  EXPECT_NE(fv::lod_cache_folders(file, options).beside, after_touch) << "another size";
+  EXPECT_THROW(fv::lod_cache_folders(dir + "/absent.ply", options), flashgs::Error);
 }

@@ -19,6 +19,7 @@
 #include "flashgs/generators.h"
 #include "path_note.h"
 #include "rate_meter.h"
+#include "read_rate_history.h"
 #include "render_gate.h"
 #include "render_worker.h"
 #include "viewer_settings.h"
@@ -229,6 +230,27 @@ TEST(ViewerRateMeter, CountsEventsPerSecondAndFallsToZero) {
   for (int i = 0; i <= 10; ++i) meter.record(10.0 + 0.1 * i);  // 10 per second
   EXPECT_NEAR(meter.rate(11.0), 10.0, 0.01);
   EXPECT_EQ(meter.rate(12.5), 0.0) << "no frames in the last second: idle, not the old rate";
+}
+
+// The streamed bytes per second: one sample per half second, a new stream (its count back at
+// zero) starts over without a negative rate, and only the last half minute is kept.
+TEST(ViewerReadRate, SamplesBytesPerSecondEveryHalfSecond) {
+  fv::ReadRateHistory h;
+  h.observe(5.0, 1000);
+  EXPECT_TRUE(h.rates().empty()) << "the first look only starts the count";
+  h.observe(5.2, 2000);
+  EXPECT_TRUE(h.rates().empty()) << "less than half a second";
+  h.observe(5.5, 6000);
+  ASSERT_EQ(h.rates().size(), 1u);
+  EXPECT_FLOAT_EQ(h.rates()[0], 10000.0f);  // 5000 bytes in 0.5 s
+  h.observe(6.5, 6000);
+  EXPECT_FLOAT_EQ(h.latest(), 0.0f);
+  h.observe(7.0, 10);  // a new stream
+  EXPECT_EQ(h.rates().size(), 2u);
+  h.observe(8.0, 1010);
+  EXPECT_FLOAT_EQ(h.latest(), 1000.0f);
+  for (int i = 0; i < 100; ++i) h.observe(9.0 + i, 1010);
+  EXPECT_EQ(static_cast<int>(h.rates().size()), fv::ReadRateHistory::kLength);
 }
 
 TEST(ViewerPathNote, TheDriverTextBecomesPlainWords) {

@@ -37,6 +37,8 @@ struct BuildArgs {
   std::uint64_t leaf = 16384, file = 262144;
   int levels = 0;
   std::uint64_t memory_mb = 2048;
+  int threads = 0;
+  std::string chunk_format = "ply";
 };
 
 void run_build(const BuildArgs& args) {
@@ -45,6 +47,8 @@ void run_build(const BuildArgs& args) {
   options.file_gaussians = args.file;
   options.levels = args.levels;
   options.memory_bytes = args.memory_mb << 20;
+  options.threads = args.threads;
+  options.chunk_format = args.chunk_format == "sog" ? LodChunkFormat::sog : LodChunkFormat::ply;
   const bool tty = isatty(STDERR_FILENO);
   const char* last_stage = "";
   int last_percent = -1;
@@ -244,6 +248,13 @@ void register_lod(CLI::App& app) {
   b->add_option("--levels", build->levels, "levels (default: until about 256 Gaussians per leaf)")->check(whole_number())->check(CLI::Range(1, 16));
   b->add_option("--file-size", build->file, "Gaussians per chunk file, at most")->check(whole_number())->check(CLI::Range(1, 1 << 28));
   b->add_option("--memory", build->memory_mb, "MiB the builder may hold at once")->check(whole_number())->check(CLI::Range(16, 1 << 22));
+  b->add_option("--threads", build->threads, "threads merging leaves (0: every core; the set is the same for any count)")
+      ->check(whole_number())
+      ->check(CLI::Range(0, 1024));
+  b->add_option("--chunk-format", build->chunk_format,
+                 "ply: INRIA PLY chunks at full precision (default); sog: SOG chunk folders (quantised, smaller), "
+                 "which PlayCanvas's viewers stream")
+      ->check(CLI::IsMember({"ply", "sog"}));
   b->callback([build] { run_build(*build); });
 
   auto fly = std::make_shared<FlyArgs>();

@@ -5,6 +5,7 @@
 
 #include "count_text.h"
 #include "flashgs/lod_set.h"
+#include "flashgs/lod_tint.h"
 
 namespace flashgs::viewer {
 namespace {
@@ -29,12 +30,31 @@ void LodStreamView::start(const std::string& meta_path, const StreamSettings& se
   m_settings = settings;
 }
 
-std::shared_ptr<const Scene> LodStreamView::update(const Camera& camera, bool settle) {
+void LodStreamView::stop() {
+  m_streamer.reset();
+  m_tinted_from.reset();
+  m_tinted.reset();
+  m_read_rates.clear();
+}
+
+std::shared_ptr<const Scene> LodStreamView::update(const Camera& camera, bool settle, double now_s) {
   if (!m_streamer) return nullptr;
-  if (!settle) return m_streamer->update(camera);
-  m_streamer->update(camera);
-  m_streamer->wait_until_idle();
-  return m_streamer->update(camera);
+  if (settle) {
+    m_streamer->update(camera);
+    m_streamer->wait_until_idle();
+  }
+  std::shared_ptr<const Scene> scene = m_streamer->update(camera);
+  m_read_rates.observe(now_s, m_streamer->stats().bytes_read);
+  if (!m_overlay || !scene) {
+    m_tinted_from.reset();
+    m_tinted.reset();
+    return scene;
+  }
+  if (scene != m_tinted_from) {  // a copy of what is drawn, the levels' colours in place of the scene's
+    m_tinted = std::make_shared<const Scene>(tint_by_level(*scene, lod_level_runs(m_streamer->set(), m_streamer->drawn_ranges())));
+    m_tinted_from = scene;
+  }
+  return m_tinted;
 }
 
 void LodStreamView::change(const StreamSettings& settings) {

@@ -9,6 +9,7 @@
 #include "flashgs/camera.h"
 #include "flashgs/lod_stream.h"
 #include "flashgs/scene.h"
+#include "read_rate_history.h"
 
 namespace flashgs::viewer {
 
@@ -24,12 +25,17 @@ class LodStreamView {
   // Starts streaming the set at `meta_path` (lod-meta.json). Throws flashgs::Error naming the
   // file when it cannot be read; the previous stream, if any, then stays.
   void start(const std::string& meta_path, const StreamSettings& settings);
-  void stop() { m_streamer.reset(); }
+  void stop();
   bool active() const { return m_streamer != nullptr; }
-  // The scene to draw for `camera`: a new pointer when what is drawn changed, else the last one.
-  // `settle`: wait for the view's chunks first (scripted runs, whose frames must not depend on
-  // how fast the disk was).
-  std::shared_ptr<const Scene> update(const Camera& camera, bool settle);
+  // The scene to draw for `camera`: a new pointer when what is drawn changed (or the level
+  // overlay was turned on or off), else the last one. `settle`: wait for the view's chunks first
+  // (scripted runs, whose frames must not depend on how fast the disk was). `now_s`: a steady
+  // clock's seconds, for the read rate.
+  std::shared_ptr<const Scene> update(const Camera& camera, bool settle, double now_s);
+  // The level overlay: each Gaussian drawn in its level's colour (lod_level_colour).
+  void set_level_overlay(bool on) { m_overlay = on; }
+  bool level_overlay() const { return m_overlay; }
+  const ReadRateHistory& read_rates() const { return m_read_rates; }
   // Budget and error bound changed live (the streamer is made again; its chunks are read again).
   void change(const StreamSettings& settings);
   const StreamSettings& settings() const { return m_settings; }
@@ -43,6 +49,9 @@ class LodStreamView {
   std::string m_meta_path;
   StreamSettings m_settings;
   std::unique_ptr<LodStreamer> m_streamer;
+  bool m_overlay = false;
+  std::shared_ptr<const Scene> m_tinted_from, m_tinted;  // the overlay's copy of the drawn scene
+  ReadRateHistory m_read_rates;
 };
 
 }  // namespace flashgs::viewer

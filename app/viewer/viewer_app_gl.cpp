@@ -95,6 +95,7 @@ ViewerApp::ViewerApp(ViewerArgs args)
   m_settings.forced_width = m_args.render_width;
   m_settings.forced_height = m_args.render_height;
   m_settings.heatmap = m_args.heatmap;
+  m_settings.lod_overlay = m_args.lod_overlay;
   if (given(m_args.orbit)) m_settings.mode = m_args.orbit ? NavigationMode::orbit : NavigationMode::fly;  // auto: install_scene
   m_settings.show_ui = !m_args.no_ui;
   m_settings.show_help = m_args.help_window;
@@ -985,6 +986,10 @@ UiModel ViewerApp::panel_model(int fb_w, int fb_h) {
   model.lod_gaussians = m_scene.lod_gaussians.empty() ? nullptr : &m_scene.lod_gaussians;
   model.lod_level = m_scene.lod_level;
   model.stream_summary = m_stream.summary();
+  if (m_stream.active()) {
+    model.stream_levels = m_stream.stats().drawn_per_level;
+    model.stream_read_rates = &m_stream.read_rates().rates();
+  }
   model.camera_count = static_cast<int>(m_scene.cameras.size());
   model.scene_note = m_scene.cameras_note;
   model.load_error = m_load_error;

@@ -55,6 +55,15 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
       ->check(whole_number());
   app.add_option("--max-error-px", a->stream_max_error_px, "--stream: refine a cell while its error in pixels is larger")
       ->check(finite_in(kStreamErrorRange));
+  app.add_option("--lod-leaf-size", a->lod_leaf_size,
+                 "--stream of a scene file (not a LOD set): Gaussians of a leaf cell of the set built for it, about")
+      ->check(whole_number())
+      ->check(CLI::Range(1, 1 << 26));
+  app.add_option("--lod-file-size", a->lod_file_size,
+                 "--stream of a scene file: Gaussians per chunk file of the set built for it, at most")
+      ->check(whole_number())
+      ->check(CLI::Range(1, 1 << 28));
+  app.add_flag("--lod-overlay", a->lod_overlay, "--stream: start with each Gaussian in its level's colour (Scene panel)");
   app.add_option("--host-memory", a->host_memory_mb, "--stream: MiB of host memory for chunks and drawn scenes (default: no cap)")
       ->check(whole_number());
   app.add_option("--gpu-memory", a->gpu_memory_mb, "--stream: MiB of GPU memory for the drawn scene (default: no cap)")

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/lod_build.h"
 #include "flashgs/options.h"
 #include "compare_mode.h"
 #include "kernel_option.h"
@@ -21,6 +22,10 @@ struct ViewerArgs {
   bool stream = false;        // stream a LOD set by view instead of loading one level whole
   std::uint64_t stream_budget = 0;     // --budget: Gaussians drawn at most (0: the caps' only)
   float stream_max_error_px = 1.0f;    // --max-error-px
+  bool lod_overlay = false;            // --lod-overlay: start with the level colours on
+  // --stream of a scene file: its cached set's leaf cells and chunk files, in Gaussians.
+  std::uint64_t lod_leaf_size = LodBuildOptions{}.leaf_gaussians;
+  std::uint64_t lod_file_size = LodBuildOptions{}.file_gaussians;
   std::uint64_t host_memory_mb = 0, gpu_memory_mb = 0;  // --host-memory, --gpu-memory (0: no cap)
   int window_width = 1280, window_height = 800;
   int render_width = 0, render_height = 0;  // > 0: render at exactly this size

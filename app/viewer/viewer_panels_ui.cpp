@@ -2,6 +2,7 @@
 #include "viewer_panels_ui.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -9,6 +10,8 @@
 #include <imgui_stdlib.h>
 
 #include "count_text.h"
+#include "flashgs/frame_memory.h"
+#include "flashgs/lod_tint.h"
 #include "scene_loader.h"
 #include "heatmap_legend.h"
 #include "help_overlay_ui.h"
@@ -175,6 +178,37 @@ void kernel_combo(const UiModel& m, ViewerSettings& s) {
                       m.trained_kernel.c_str());
 }
 
+// The streamed cut's level histogram, one bar per level in the level overlay's colour: the
+// overlay's legend and the Gaussians drawn at each level.
+void level_histogram(const std::vector<std::uint64_t>& drawn) {
+  std::uint64_t most = 1;
+  for (std::uint64_t n : drawn) most = std::max(most, n);
+  const float h = ImGui::GetTextLineHeight(), width = ui(150);
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  for (std::size_t level = 0; level < drawn.size(); ++level) {
+    const std::array<float, 3> c = lod_level_colour(static_cast<int>(level));
+    const ImU32 colour = ImGui::ColorConvertFloat4ToU32(ImVec4(c[0], c[1], c[2], 1.0f));
+    const ImVec2 at = ImGui::GetCursorScreenPos();
+    const float filled = width * static_cast<float>(static_cast<double>(drawn[level]) / static_cast<double>(most));
+    draw->AddRectFilled(at, ImVec2(at.x + width, at.y + h), IM_COL32(60, 60, 60, 255));
+    draw->AddRectFilled(at, ImVec2(at.x + filled, at.y + h), colour);
+    ImGui::Dummy(ImVec2(width, h));
+    ImGui::SameLine();
+    ImGui::Text("level %zu: %s", level, human_count(double(drawn[level])).c_str());
+  }
+}
+
+// The bytes the stream read per second over the last half minute.
+void read_rate_graph(const std::vector<float>& rates) {
+  float top = 1.0f;
+  for (float r : rates) top = std::max(top, r);
+  const std::string latest = "read " + format_bytes(static_cast<std::uint64_t>(rates.empty() ? 0.0f : rates.back())) + "/s";
+  ImGui::PlotLines("##read rate", rates.data(), static_cast<int>(rates.size()), 0, latest.c_str(), 0.0f, top * 1.1f,
+                   ImVec2(ui(260), ui(40)));
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("chunk bytes read from the disk per second, last 30 s (top: %s/s)",
+                                                format_bytes(static_cast<std::uint64_t>(top)).c_str());
+}
+
 void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string& path_buffer) {
   if (!ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) return;
   if (m.scene_path.empty()) {
@@ -212,6 +246,11 @@ void scene_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
     ImGui::SetNextItemWidth(ui(200));
     ImGui::SliderFloat("budget (M)", &s.stream_budget_millions, 0.0f, 100.0f, s.stream_budget_millions > 0 ? "%.2f M" : "caps only");
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("Gaussians drawn at most, in millions (0: what the memory caps allow)");
+    ImGui::Checkbox("level colours", &s.lod_overlay);
+    note_widget_place("level colours");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("each Gaussian in the colour of the level it is drawn at (the legend below)");
+    level_histogram(m.stream_levels);
+    if (m.stream_read_rates) read_rate_graph(*m.stream_read_rates);
   }
   if (!m.scene_note.empty()) {
     colored_wrapped(ImVec4(0.9f, 0.8f, 0.4f, 1), m.scene_note);

@@ -32,6 +32,8 @@ struct UiModel {
   const std::vector<std::size_t>* lod_gaussians = nullptr;  // a SOG LOD set's levels, else null
   int lod_level = -1;
   std::string stream_summary;  // a LOD set streamed by view: what is drawn and in memory; empty otherwise
+  std::vector<std::uint64_t> stream_levels;            // ...the Gaussians drawn at each level
+  const std::vector<float>* stream_read_rates = nullptr;  // ...bytes read per second, oldest first
   int camera_count = 0;
   std::string scene_note;         // loader report / cameras problem
   std::string load_error;         // the last failed load and what is shown instead, one sentence

@@ -12,12 +12,23 @@
 #include "flashgs/error.h"
 #include "flashgs/scene_summary.h"
 #include "flashgs/frame_memory.h"
+#include "lod_cache.h"
 #include "memory_budget.h"
 #include "scene_state.h"
 #include "viewer_app_gl.h"
 #include "window_gl.h"
 
 namespace flashgs::viewer {
+namespace {
+
+LodBuildOptions lod_cache_options(const ViewerArgs& args) {
+  LodBuildOptions options;
+  options.leaf_gaussians = args.lod_leaf_size;
+  options.file_gaussians = args.lod_file_size;
+  return options;
+}
+
+}  // namespace
 
 void ViewerApp::install_scene(LoadedScene scene) {
   m_path->set_scene(scene.scene);  // throws on failure: the old scene stays
@@ -112,7 +123,19 @@ bool ViewerApp::update_stream(const Camera& camera) {
     m_stream.stop();
     return false;
   }
-  const std::shared_ptr<const Scene> scene = m_stream.update(camera, m_scripted);
+  if (m_stream.level_overlay() != m_settings.lod_overlay) {
+    m_stream.set_level_overlay(m_settings.lod_overlay);
+    std::fprintf(stderr, "flashgs-viewer: level overlay %s\n", m_settings.lod_overlay ? "on" : "off");
+  }
+  std::shared_ptr<const Scene> scene;
+  try {
+    scene = m_stream.update(camera, m_scripted, ms_since_start() / 1000.0);
+  } catch (const std::exception& e) {  // no memory for the overlay's copy: the scene's own colours
+    set_notice("level overlay off: " + error_text(e));
+    m_settings.lod_overlay = false;
+    m_stream.set_level_overlay(false);
+    scene = m_stream.update(camera, false, ms_since_start() / 1000.0);
+  }
   for (const std::string& line : m_stream.take_errors()) set_notice(line);
   const bool loading = m_stream.loading();
   if (m_stream_was_loading && !loading)  // tests and users see when the view's chunks are all in
@@ -138,7 +161,8 @@ void ViewerApp::report_failed_load(const std::string& error) {
 bool ViewerApp::open_scene(const std::string& path) {
   m_path_buffer = path;  // kept in the box when it fails, to be corrected
   try {
-    install_scene(load_scene(path, path == m_args.scene ? m_args.cameras : ""));
+    const std::string cameras = path == m_args.scene ? m_args.cameras : "";
+    install_scene(m_args.stream ? load_streamed_scene(path, cameras, nullptr, lod_cache_options(m_args)) : load_scene(path, cameras));
     m_load_error.clear();
     return true;
   } catch (const std::exception& e) {
@@ -155,7 +179,12 @@ void ViewerApp::request_open(const std::string& path) {
   }
   // Parsing a large PLY takes seconds: it runs beside the frame loop, which keeps drawing the
   // current scene; the new one is installed (uploaded) on this thread once it is ready.
-  if (!m_loader.start(path)) set_notice("still loading " + m_loader.path() + "; " + path + " ignored");
+  SceneLoader::LoadFunction load;  // the constructor's: the file whole
+  if (m_args.stream)
+    load = [options = lod_cache_options(m_args)](const std::string& p, LoadProgress& progress) {
+      return load_streamed_scene(p, "", &progress, options);
+    };
+  if (!m_loader.start(path, load)) set_notice("still loading " + m_loader.path() + "; " + path + " ignored");
   m_logged_load_progress = false;
 }
 
@@ -227,8 +256,10 @@ LoadedScene load_start_scene(const ViewerArgs& args, LoadProgress* progress) {
   } else {
     const std::string path = args.scene.empty() ? demo_scene_path() : args.scene;
     try {
-      // lod -1: the finest that fits; a streamed set starts from its coarsest level.
-      scene = load_scene(path, args.cameras, progress, args.stream ? kCoarsestLodLevel : args.lod);
+      // lod -1: the finest that fits. A streamed set starts from its coarsest level; a named
+      // scene file is streamed through the LOD set cached for it (the bundled demo is drawn whole).
+      if (args.stream && !args.scene.empty()) scene = load_streamed_scene(path, args.cameras, progress, lod_cache_options(args));
+      else scene = load_scene(path, args.cameras, progress, args.stream ? kCoarsestLodLevel : args.lod);
     } catch (const LoadCancelled&) {
       throw;
     } catch (const std::exception& e) {

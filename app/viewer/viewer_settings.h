@@ -50,6 +50,7 @@ struct ViewerSettings {
   float fov_x_degrees = 60.0f;      // horizontal field of view of the viewer camera
   float stream_max_error_px = 1.0f;      // a streamed LOD set: refine while a cell's error is larger
   float stream_budget_millions = 0.0f;   // a streamed LOD set: Gaussians drawn at most (0: the caps')
+  bool lod_overlay = false;              // a streamed LOD set: each Gaussian in its level's colour
   float render_scale = 1.0f;        // render resolution = framebuffer size * scale
   bool adaptive_resolution = true;  // fewer pixels while moving when a full frame takes > 33 ms
   int forced_width = 0, forced_height = 0;  // > 0: render at exactly this size (scripted runs)

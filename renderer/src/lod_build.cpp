@@ -14,8 +14,14 @@
 #include "flashgs/file_access.h"
 #include "flashgs/io.h"
 #include "flashgs/lod_set.h"
+#include "format_writers.h"
 #include "gaussian_batches.h"
 #include "lod_merge.h"
+#include "parallel_errors.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace flashgs {
 namespace {
@@ -211,8 +217,9 @@ class Buckets {
 // written out once it holds `file_gaussians`.
 class LevelWriter {
  public:
-  LevelWriter(int level, std::uint64_t file_gaussians, const fs::path& folder, LodSet& set, LodBuildReport& report)
-      : m_level(level), m_file_gaussians(file_gaussians), m_folder(folder), m_set(set), m_report(report) {}
+  LevelWriter(int level, std::uint64_t file_gaussians, LodChunkFormat format, const fs::path& folder, LodSet& set,
+              LodBuildReport& report)
+      : m_level(level), m_file_gaussians(file_gaussians), m_format(format), m_folder(folder), m_set(set), m_report(report) {}
   LodRange append(const Scene& leaf_level) {
     if (m_file < 0 || (m_pending.size() > 0 && m_pending.size() + leaf_level.size() > m_file_gaussians)) start_file();
     LodRange range{m_file, m_pending.size(), leaf_level.size()};
@@ -231,20 +238,29 @@ class LevelWriter {
   void start_file() {
     if (m_file >= 0) write_file();
     m_file = static_cast<int>(m_set.files.size());
-    m_set.files.push_back(std::to_string(m_level) + "_" + std::to_string(m_next_name++) + ".ply");
+    const std::string name = std::to_string(m_level) + "_" + std::to_string(m_next_name++);
+    m_set.files.push_back(m_format == LodChunkFormat::sog ? name + "/meta.json" : name + ".ply");
     m_pending = Scene{};
   }
   void write_file() {
     const fs::path path = m_folder / m_set.files[static_cast<std::size_t>(m_file)];
-    save_ply(m_pending, path.string());
     std::error_code error;
-    m_report.bytes_written += fs::file_size(path, error);
+    if (m_format == LodChunkFormat::sog) {
+      if (!fs::create_directory(path.parent_path(), error) && error)
+        fail(path.parent_path().string(), "cannot create the chunk folder: " + error.message());
+      save_sog_folder(m_pending, path.string(), SceneWriteOptions{});
+      for (const auto& e : fs::directory_iterator(path.parent_path(), error)) m_report.bytes_written += e.file_size(error);
+    } else {
+      save_ply(m_pending, path.string());
+      m_report.bytes_written += fs::file_size(path, error);
+    }
     ++m_report.files;
     m_pending = Scene{};
   }
 
   int m_level;
   std::uint64_t m_file_gaussians;
+  LodChunkFormat m_format;
   fs::path m_folder;
   LodSet& m_set;
   LodBuildReport& m_report;
@@ -283,6 +299,34 @@ LodBox bound_of(const Scene& scene) {
       box.max[k] = std::max(box.max[k], scene.positions[i * 3 + k]);
     }
   return box;
+}
+
+// One leaf's levels, finest first, and its cell (its level 0's bounding box).
+struct LeafLevels {
+  LodBox bound;
+  std::vector<Scene> levels;  // empty: the leaf holds no Gaussians
+};
+
+LeafLevels leaf_levels(Scene level0, int levels) {
+  LeafLevels out;
+  if (level0.size() == 0) return out;
+  out.bound = bound_of(level0);
+  out.levels.reserve(static_cast<std::size_t>(levels));
+  out.levels.push_back(std::move(level0));
+  for (int l = 1; l < levels; ++l) {
+    const Scene& finer = out.levels.back();
+    out.levels.push_back(finer.size() > 1 ? coarser_level(finer, out.bound) : finer);
+  }
+  return out;
+}
+
+int build_threads(int asked) {
+  if (asked > 0) return asked;
+#ifdef _OPENMP
+  return std::max(1, omp_get_max_threads());
+#else
+  return 1;
+#endif
 }
 
 // The written tree: the k-d tree without its empty leaves, nodes in post order (the root last).
@@ -372,8 +416,11 @@ LodBuildReport build_lod_set(const std::string& input, const std::string& out_fo
   const std::uint64_t file_gaussians = std::max<std::uint64_t>(
       1, std::min(options.file_gaussians, options.memory_bytes / 4 / (gaussian_bytes * static_cast<std::uint64_t>(levels))));
   std::vector<LevelWriter> writers;
-  for (int level = 0; level < levels; ++level) writers.emplace_back(level, file_gaussians, folder, set, report);
+  for (int level = 0; level < levels; ++level) writers.emplace_back(level, file_gaussians, options.chunk_format, folder, set, report);
   std::vector<int> new_leaf(static_cast<std::size_t>(tree.leaf_count()), -1);
+  report.level_gaussians.assign(static_cast<std::size_t>(levels), 0);
+  const int threads = build_threads(options.threads);
+  const int group_leaves = 4 * threads;
   std::uint64_t built = 0;
   for (int b = 0; b < buckets.count(); ++b) {
     const int first = buckets.first_leaf(b);
@@ -394,22 +441,37 @@ LodBuildReport build_lod_set(const std::string& input, const std::string& out_fo
       }
       fs::remove(bucket_path, error);
     }
-    for (int leaf = first; leaf < end; ++leaf) {
-      Scene level = std::move(leaves[static_cast<std::size_t>(leaf - first)]);
-      if (level.size() == 0) continue;
-      new_leaf[static_cast<std::size_t>(leaf)] = static_cast<int>(set.leaves.size());
-      LodLeaf out;
-      out.bound = bound_of(level);
-      for (int l = 0; l < levels; ++l) {
-        if (l > 0 && level.size() > 1) level = coarser_level(level, out.bound);
-        out.levels.push_back(writers[static_cast<std::size_t>(l)].append(level));
-        report.level_gaussians.resize(static_cast<std::size_t>(levels), 0);
-        report.level_gaussians[static_cast<std::size_t>(l)] += level.size();
+    // A group of leaves at a time: their levels merged in parallel (each leaf's alone, so the
+    // result does not depend on the threads), then written in leaf order. A group holds its
+    // leaves' levels beside the bucket: about twice their level 0.
+    for (int group = first; group < end; group += group_leaves) {
+      const int group_end = std::min(end, group + group_leaves);
+      std::vector<LeafLevels> merged(static_cast<std::size_t>(group_end - group));
+      ParallelErrors errors;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+      for (int leaf = group; leaf < group_end; ++leaf)
+        errors.capture([&] {
+          merged[static_cast<std::size_t>(leaf - group)] =
+              leaf_levels(std::move(leaves[static_cast<std::size_t>(leaf - first)]), levels);
+        });
+      errors.rethrow();
+      for (int leaf = group; leaf < group_end; ++leaf) {
+        LeafLevels& m = merged[static_cast<std::size_t>(leaf - group)];
+        if (m.levels.empty()) continue;
+        new_leaf[static_cast<std::size_t>(leaf)] = static_cast<int>(set.leaves.size());
+        LodLeaf out;
+        out.bound = m.bound;
+        for (int l = 0; l < levels; ++l) {
+          const Scene& level = m.levels[static_cast<std::size_t>(l)];
+          out.levels.push_back(writers[static_cast<std::size_t>(l)].append(level));
+          report.level_gaussians[static_cast<std::size_t>(l)] += level.size();
+        }
+        m = LeafLevels{};
+        built += leaf_counts[static_cast<std::size_t>(leaf)];
+        set.leaves.push_back(std::move(out));
       }
-      built += leaf_counts[static_cast<std::size_t>(leaf)];
-      set.leaves.push_back(std::move(out));
+      progress("building", built, sorted);
     }
-    progress("building", built, sorted);
   }
   for (LevelWriter& w : writers) w.finish();
   report.leaves = static_cast<int>(set.leaves.size());

@@ -9,11 +9,17 @@
 
 namespace flashgs {
 
+// How the chunk files are written: INRIA PLY at full precision (L_K.ply, any 3DGS tool reads
+// it), or SOG folders (L_K/meta.json and WebP textures, quantised; PlayCanvas's viewers read it).
+enum class LodChunkFormat { ply, sog };
+
 struct LodBuildOptions {
   std::uint64_t leaf_gaussians = 16384;    // a leaf cell's Gaussians at level 0, about
   int levels = 0;                          // 0: enough for about 256 Gaussians per leaf at the coarsest
   std::uint64_t file_gaussians = 262144;   // Gaussians per chunk file and level, at most
   std::uint64_t memory_bytes = 2ull << 30; // what the builder may hold at once (buckets, chunk buffers)
+  int threads = 0;                         // leaves merged at once; 0: every core (the output is the same)
+  LodChunkFormat chunk_format = LodChunkFormat::ply;
   // Called as the build goes: a stage name ("sampling", "sorting", "building"), done and total.
   std::function<void(const char* stage, std::uint64_t done, std::uint64_t total)> progress;
 };

@@ -78,6 +78,8 @@ class LodStreamer {
   // One line per chunk that could not be read since the last call (the rest keeps rendering).
   std::vector<std::string> take_errors();
   const LodSet& set() const { return m_set; }
+  // The ranges of the scene update() last returned, in its order (the level overlay's input).
+  const std::vector<LodRange>& drawn_ranges() const { return m_drawn; }
 
  private:
   struct Chunk;
