@@ -1070,6 +1070,17 @@ TEST(Viewer, DepthAndCountViewsReplaceTheColour) {
   EXPECT_NE(bad_cli.output.find("--view"), std::string::npos) << bad_cli.output;
 }
 
+// OpenImageIO (and the ~240 libraries it brings) is loaded only when an image is read or
+// written, not at every start: neither program links it, and both still write PNG (the other
+// tests' screenshots and renders).
+TEST(ViewerStartup, NeitherProgramLinksOpenImageIO) {
+  for (const std::string& program : {viewer(), cli()}) {
+    const RunResult r = run("ldd '" + program + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("libOpenImageIO"), std::string::npos) << program << "\n" << r.output;
+  }
+}
+
 // G / --grid: the ground grid and the world axes are drawn over the frame (the x axis red, the
 // y axis green), the frustums in orange.
 TEST(Viewer, GridAxesAndFrustumsAreDrawnOverTheFrame) {
