@@ -57,7 +57,7 @@ OiioModule load_oiio_module() {
     m.why_not = std::string("the OpenImageIO module ") + FLASHGS_OIIO_MODULE + " lacks its functions";
   }
 #else
-  m.why_not = "this build lacks OpenImageIO";
+  m.why_not = "this build has none";
 #endif
   return m;
 }
