@@ -741,6 +741,26 @@ TEST(Viewer, F1ShowsHelpTabHidesThePanelsAndEscQuits) {
 #endif
 }
 
+// V steps through the views with real key presses: colour, depth, count (each logging its
+// legend once its frame is shown), then colour again.
+TEST(Viewer, TheVKeyStepsThroughTheViews) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // GLFW key code: V 86.
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { hold V \" key86 \" && wait_for \"view depth: \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { hold V \" key86 \" && wait_for \"view count: \" || status=12; }\n"
+                            "[ $status -eq 0 ] && close_window\n";
+  const RunResult r = run_live_viewer(prefix, "view_key", "--backend cpu --size 480x270 --log-input", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 no depth view, 12 no count view, 13 crash)\n"
+                            << r.output;
+  EXPECT_LT(r.output.find("view depth: "), r.output.find("view count: ")) << r.output;
+#endif
+}
+
 // A path typed into the scene field and sent with Enter that fails to open: the typing goes
 // on in the field, so a letter typed next is text, not a shortcut that the settings keep (B
 // used to switch to the baseline and leave it in settings.ini).

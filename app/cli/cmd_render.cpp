@@ -46,7 +46,8 @@ struct RenderCommand {
     Image image;
     FrameStats stats;
     for (int i = 0; i < repeat; ++i) renderer->render(cam, options, image, &stats);
-    if (frame_view != FrameView::colour) image = debug_image(frame_view, stats, cam, options);
+    std::string scale_line;
+    if (frame_view != FrameView::colour) image = debug_image(frame_view, stats, cam, options, &scale_line);
     write_image(image, output);
     std::printf("%s: %zu Gaussians (SH degree %d), camera %d \"%s\" at %dx%d, %s on %s\n", scene_path.c_str(),
                 loaded->size(), loaded->sh_degree, camera.index, cam.name.c_str(), cam.width, cam.height,
@@ -54,21 +55,24 @@ struct RenderCommand {
     std::printf("kernel: %s\n", render.kernel.chosen() ? (options.kernel.description() + " (--kernel)").c_str()
                                                         : kernel_summary(loaded->trained_kernel).c_str());
     std::printf("%s", format_stats(stats).c_str());
-    std::printf("wrote %s\n", output.c_str());
+    std::printf("%swrote %s\n", scale_line.c_str(), output.c_str());
   }
 
-  // The frame's debug view, its scale printed: what the colours stand for.
+  // The frame's debug view, and in `scale_line` what its colours stand for.
   static Image debug_image(FrameView frame_view, const FrameStats& stats, const Camera& cam,
-                           const RenderOptions& options) {
+                           const RenderOptions& options, std::string* scale_line) {
     const DebugScale scale = debug_scale(stats);
+    char text[200];
     if (frame_view == FrameView::depth && scale.any_blended)
-      std::printf("view depth: blended depth from %.6g (dark) to %.6g (bright) scene units; the background where "
-                  "nothing blended\n", scale.near_depth, scale.far_depth);
+      std::snprintf(text, sizeof text,
+                    "view depth: blended depth from %.6g (dark) to %.6g (bright) scene units; the background where "
+                    "nothing blended\n", scale.near_depth, scale.far_depth);
     else if (frame_view == FrameView::depth)
-      std::printf("view depth: nothing blended, the background only\n");
+      std::snprintf(text, sizeof text, "view depth: nothing blended, the background only\n");
     else
-      std::printf("view count: Gaussians blended per pixel, log scale from 0 (dark) to %u (bright)\n",
-                  scale.max_blended);
+      std::snprintf(text, sizeof text, "view count: Gaussians blended per pixel, log scale from 0 (dark) to %u (bright)\n",
+                    scale.max_blended);
+    *scale_line = text;
     return debug_view_image(frame_view, stats, cam.width, cam.height, scale, options.background);
   }
 
