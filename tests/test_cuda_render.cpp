@@ -650,7 +650,7 @@ void expect_same_planes(const std::string& what, const Result& cpu, const Result
   EXPECT_LE(d.max_abs, test::kExpUlpMaxAbs) << what;
 }
 
-TEST(CudaPixelPlanes, MatchTheCpuPlanes) {
+TEST(CudaPixelPlanes, MatchTheCpuPlanesOnTheDemoScene) {
   FLASHGS_REQUIRE_CUDA();
   const auto scene = test::load_demo_scene();
   auto cpu = make_cpu_renderer();
@@ -665,7 +665,13 @@ TEST(CudaPixelPlanes, MatchTheCpuPlanes) {
       const Result g = render(*gpu, camera, o);
       expect_same_planes("demo " + camera.name + " " + o.label(), c, g);
     }
+}
+
+TEST(CudaPixelPlanes, MatchTheCpuPlanesOnRealScenes) {
+  FLASHGS_REQUIRE_CUDA();
   FLASHGS_REQUIRE_SHARED_SCENES();
+  auto cpu = make_cpu_renderer();
+  auto gpu = make_cuda_renderer();
   for (const std::string& name : test::shared_scene_names()) {
     const auto real = test::load_shared_scene(name);
     cpu->set_scene(real);
