@@ -1,6 +1,8 @@
 // The CPU backend: flash vs baseline vs the fp64 reference, determinism, options, real scenes.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -119,6 +121,127 @@ TEST(CpuDeterminism, FewerThreadsGrantedThanAskedGiveTheSameFrame) {
 #else
   GTEST_SKIP() << "built without OpenMP";
 #endif
+}
+
+// A 65x65 camera at the origin looking down +z, focal length 64 px, the principal point at
+// pixel (32, 32).
+Camera axis_camera() {
+  const float identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, origin[3] = {0, 0, 0};
+  return Camera::from_pose(65, 65, 64.0f, 64.0f, identity, origin);
+}
+
+// Round Gaussians of world radius `sigma` at (x, 0, z) of the axis camera, grey, degree 0.
+Scene round_gaussians(const std::vector<std::array<float, 2>>& x_and_z, float sigma, float opacity) {
+  Scene scene;
+  for (const auto& [x, z] : x_and_z) {
+    scene.positions.insert(scene.positions.end(), {x, 0.0f, z});
+    scene.scales.insert(scene.scales.end(), {sigma, sigma, sigma});
+    scene.rotations.insert(scene.rotations.end(), {1.0f, 0.0f, 0.0f, 0.0f});
+    scene.opacities.push_back(opacity);
+    scene.sh_dc.insert(scene.sh_dc.end(), {0.3f, 0.3f, 0.3f});
+  }
+  return scene;
+}
+
+// The alpha 3DGS gives a round Gaussian of world radius sigma at (x, 0, z) at pixel offset
+// (dx, 0) from its centre: its screen variance along x is sigma^2 (f / z)^2 (1 + (x / z)^2)
+// (the projection's Jacobian) plus the classic 0.3 px^2 dilation.
+double expected_alpha(double x, double z, double sigma, double opacity, double dx) {
+  const double f = 64.0, var_x = sigma * sigma * (f / z) * (f / z) * (1.0 + (x / z) * (x / z)) + kClassicDilation;
+  return std::min(0.99, opacity * std::exp(-0.5 * dx * dx / var_x));
+}
+
+Frame render_planes(const Scene& scene, const Camera& camera, RenderOptions options) {
+  options.collect_pixel_planes = true;
+  return render(std::make_shared<const Scene>(scene), camera, options);
+}
+
+std::size_t at(const Camera& camera, int x, int y) { return static_cast<std::size_t>(y) * camera.width + x; }
+
+// Two Gaussians 16 pixels apart on screen, at depths 2 and 5 (screen sigma about 4 px): at each
+// centre only that Gaussian blends; half-way both do, the near one first; a corner blends none.
+TEST(CpuPixelPlanes, TwoGaussiansGiveTheirDepthAndCount) {
+  const Camera camera = axis_camera();
+  // Screen centres (24, 32) and (40, 32); world radii for 4 px at their depths.
+  const double za = 2.0, zb = 5.0, xa = -8.0 * za / 64.0, xb = 8.0 * zb / 64.0;
+  Scene scene = round_gaussians({{float(xa), float(za)}}, 0.125f, 0.8f);
+  scene.append(round_gaussians({{float(xb), float(zb)}}, 0.3125f, 0.8f));
+  for (const RenderOptions& options : {RenderOptions{}, RenderOptions::baseline()}) {
+    const Frame f = render_planes(scene, camera, options);
+    ASSERT_EQ(f.stats.pixel_depth.size(), 65u * 65u);
+    ASSERT_EQ(f.stats.pixel_blended.size(), 65u * 65u);
+    EXPECT_EQ(f.stats.pixel_blended[at(camera, 24, 32)], 1u);
+    EXPECT_NEAR(f.stats.pixel_depth[at(camera, 24, 32)], za, 1e-5);
+    EXPECT_EQ(f.stats.pixel_blended[at(camera, 40, 32)], 1u);
+    EXPECT_NEAR(f.stats.pixel_depth[at(camera, 40, 32)], zb, 1e-5);
+    // Half-way: w_a = alpha_a, w_b = alpha_b (1 - alpha_a).
+    const double alpha_a = expected_alpha(xa, za, 0.125, 0.8, 8.0), alpha_b = expected_alpha(xb, zb, 0.3125, 0.8, 8.0);
+    ASSERT_GT(alpha_a, 1.0 / 255.0);
+    ASSERT_GT(alpha_b, 1.0 / 255.0);
+    const double wa = alpha_a, wb = alpha_b * (1.0 - alpha_a);
+    EXPECT_EQ(f.stats.pixel_blended[at(camera, 32, 32)], 2u);
+    EXPECT_NEAR(f.stats.pixel_depth[at(camera, 32, 32)], (wa * za + wb * zb) / (wa + wb), 2e-3) << options.label();
+    EXPECT_EQ(f.stats.pixel_blended[at(camera, 1, 1)], 0u);
+    EXPECT_TRUE(std::isnan(f.stats.pixel_depth[at(camera, 1, 1)]));
+  }
+}
+
+// Ten nearly opaque Gaussians stacked on the axis: transmittance 1 - 0.95, then 0.05^2, 0.05^3,
+// and the fourth would take it below 1e-4, so the pixel stops after three: the count is 3 and
+// the depth the first three's weighted mean, as the colour's walk.
+TEST(CpuPixelPlanes, CountStopsWhereTheColourWalkStops) {
+  const Camera camera = axis_camera();
+  std::vector<std::array<float, 2>> stack;
+  for (int k = 0; k < 10; ++k) stack.push_back({0.0f, 2.0f + float(k)});
+  const Scene scene = round_gaussians(stack, 0.1f, 0.95f);
+  const Frame f = render_planes(scene, camera, RenderOptions{});
+  EXPECT_EQ(f.stats.pixel_blended[at(camera, 32, 32)], 3u);
+  const double w[3] = {0.95, 0.95 * 0.05, 0.95 * 0.05 * 0.05};
+  EXPECT_NEAR(f.stats.pixel_depth[at(camera, 32, 32)], (w[0] * 2 + w[1] * 3 + w[2] * 4) / (w[0] + w[1] + w[2]), 1e-4);
+}
+
+// On the demo scene: the frame with planes is the scalar kernel's colour image byte for byte,
+// no pixel blends more Gaussians than its tile has pairs, depths lie between the near plane and
+// the farthest Gaussian, and a pixel that blended nothing is the background.
+TEST(CpuPixelPlanes, PlanesComeFromTheColourWalk) {
+  const auto scene = test::load_demo_scene();
+  const Camera camera = test::load_demo_cameras()[4].resized(320, 180);
+  RenderOptions options;
+  options.collect_tile_counts = true;
+  options.background[2] = 0.25f;
+  const Frame f = render_planes(*scene, camera, options);
+  auto scalar = make_cpu_renderer(0, CpuBlend::scalar);
+  scalar->set_scene(scene);
+  Image plain;
+  RenderOptions without = options;
+  without.collect_pixel_planes = false;
+  scalar->render(camera, without, plain, nullptr);
+  EXPECT_EQ(f.image.rgb, plain.rgb);
+  std::uint32_t most = 0;
+  std::size_t empty = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const std::size_t p = at(camera, x, y);
+      const std::uint32_t tile = (y / 16) * f.stats.tiles_x + x / 16;
+      ASSERT_LE(f.stats.pixel_blended[p], f.stats.tile_pair_counts[tile]) << x << "," << y;
+      most = std::max(most, f.stats.pixel_blended[p]);
+      if (f.stats.pixel_blended[p] == 0) {
+        ++empty;
+        EXPECT_TRUE(std::isnan(f.stats.pixel_depth[p]));
+        EXPECT_EQ(f.image.pixel(x, y)[2], 0.25f);
+      } else {
+        EXPECT_GT(f.stats.pixel_depth[p], 0.2f);
+      }
+    }
+  EXPECT_GT(most, 10u);
+  EXPECT_LT(empty, static_cast<std::size_t>(camera.width) * camera.height);
+}
+
+// A frame without the option carries no planes (they cost a pass over the pixels).
+TEST(CpuPixelPlanes, OnlyWhenAsked) {
+  const Frame f = render(test::load_demo_scene(), test::load_demo_cameras()[0].resized(64, 36), RenderOptions{});
+  EXPECT_TRUE(f.stats.pixel_depth.empty());
+  EXPECT_TRUE(f.stats.pixel_blended.empty());
 }
 
 TEST(CpuStats, TileCountsSumToThePairs) {

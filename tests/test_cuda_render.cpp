@@ -651,6 +651,95 @@ TEST(CudaStats, TileCountsMatchTheCpu) {
   }
 }
 
+// The debug planes of a CUDA frame (the per-pixel kernel, whatever the algorithm) against the
+// CPU's (the scalar kernel's walk): the same count at all but the pixels where expf's ulps put
+// a Gaussian on the other side of 1/255 or of the stop rule (at most 1e-4 of them, off by at
+// most 2), the same depth within 1e-4 relative where the counts agree, and the same colour
+// bound as the colour frames.
+void expect_same_planes(const std::string& what, const Result& cpu, const Result& gpu) {
+  ASSERT_EQ(gpu.stats.pixel_depth.size(), cpu.stats.pixel_depth.size()) << what;
+  ASSERT_EQ(gpu.stats.pixel_blended.size(), cpu.stats.pixel_blended.size()) << what;
+  ASSERT_FALSE(cpu.stats.pixel_blended.empty()) << what;
+  std::size_t count_differs = 0, depth_differs = 0;
+  for (std::size_t i = 0; i < cpu.stats.pixel_blended.size(); ++i) {
+    const std::uint32_t c = cpu.stats.pixel_blended[i], g = gpu.stats.pixel_blended[i];
+    if (c != g) {
+      ++count_differs;
+      EXPECT_LE(std::max(c, g) - std::min(c, g), 2u) << what << " pixel " << i;
+      continue;
+    }
+    const float zc = cpu.stats.pixel_depth[i], zg = gpu.stats.pixel_depth[i];
+    if (c == 0) {
+      EXPECT_TRUE(std::isnan(zg)) << what << " pixel " << i;
+    } else if (!(std::abs(zc - zg) <= 1e-4f * zc)) {
+      ++depth_differs;
+    }
+  }
+  const double pixels = double(cpu.stats.pixel_blended.size());
+  std::printf("%-40s count differs at %zu, depth at %zu of %.0f pixels\n", what.c_str(), count_differs,
+              depth_differs, pixels);
+  EXPECT_LE(double(count_differs), 1e-4 * pixels + 1) << what;
+  EXPECT_LE(double(depth_differs), 1e-4 * pixels + 1) << what;
+  const ImageDifference d = compare_images(cpu.image, gpu.image);
+  EXPECT_LE(d.max_abs, test::kExpUlpMaxAbs) << what;
+}
+
+TEST(CudaPixelPlanes, MatchTheCpuPlanesOnTheDemoScene) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = test::load_demo_scene();
+  auto cpu = make_cpu_renderer();
+  auto gpu = make_cuda_renderer();
+  cpu->set_scene(scene);
+  gpu->set_scene(scene);
+  const auto cameras = test::load_demo_cameras();
+  for (const Camera& camera : {cameras[0], cameras[5].resized(1001, 563)})
+    for (RenderOptions o : {RenderOptions{}, RenderOptions::baseline()}) {
+      o.collect_pixel_planes = true;
+      const Result c = render(*cpu, camera, o);
+      const Result g = render(*gpu, camera, o);
+      expect_same_planes("demo " + camera.name + " " + o.label(), c, g);
+    }
+}
+
+TEST(CudaPixelPlanes, MatchTheCpuPlanesOnRealScenes) {
+  FLASHGS_REQUIRE_CUDA();
+  FLASHGS_REQUIRE_SHARED_SCENES();
+  auto cpu = make_cpu_renderer();
+  auto gpu = make_cuda_renderer();
+  for (const std::string& name : test::shared_scene_names()) {
+    const auto real = test::load_shared_scene(name);
+    cpu->set_scene(real);
+    gpu->set_scene(real);
+    RenderOptions o;
+    o.collect_pixel_planes = true;
+    const Camera camera = test::load_shared_cameras(name)[0];
+    expect_same_planes(name + " " + o.label(), render(*cpu, camera, o), render(*gpu, camera, o));
+  }
+}
+
+// Planes on every output of the CUDA backend: a host frame with the flash path's switches
+// that the per-pixel kernel leaves out (exp2, macro bins, the half blend) gives the planes of
+// the plain flash frame, and a frame without the option carries none.
+TEST(CudaPixelPlanes, SameWhateverTheFlashSwitches) {
+  FLASHGS_REQUIRE_CUDA();
+  const auto scene = test::load_demo_scene();
+  auto gpu = make_cuda_renderer();
+  gpu->set_scene(scene);
+  const Camera camera = test::load_demo_cameras()[2].resized(640, 360);
+  RenderOptions plain;
+  plain.exp2_alpha = plain.macro_bins = false;
+  plain.collect_pixel_planes = true;
+  const Result reference = render(*gpu, camera, plain);
+  RenderOptions half = plain;
+  half.exp2_alpha = half.macro_bins = half.fp16_blend = true;
+  const Result g = render(*gpu, camera, half);
+  EXPECT_EQ(g.stats.pixel_blended, reference.stats.pixel_blended);
+  EXPECT_EQ(g.image.rgb, reference.image.rgb);
+  const Result none = render(*gpu, camera, RenderOptions{});
+  EXPECT_TRUE(none.stats.pixel_depth.empty());
+  EXPECT_TRUE(none.stats.pixel_blended.empty());
+}
+
 // Stage times from the stage events, on both sort paths: stages that meet with nothing queued
 // between them share an event (a bin-sort frame has no ranges stage of its own), and every
 // stage read must come from events that were recorded (an elapsed time of an unrecorded event

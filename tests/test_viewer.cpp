@@ -1,6 +1,7 @@
 // The viewer run headless (Xvfb + Mesa, CPU path): scripted screenshots match the CLI's render, keys move the camera.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 
 #include <sys/stat.h>
@@ -741,6 +743,26 @@ TEST(Viewer, F1ShowsHelpTabHidesThePanelsAndEscQuits) {
 #endif
 }
 
+// V steps through the views with real key presses: colour, depth, count (each logging its
+// legend once its frame is shown), then colour again.
+TEST(Viewer, TheVKeyStepsThroughTheViews) {
+#ifndef FLASHGS_X11_INPUT
+  GTEST_SKIP() << "built without libXtst: the input helper is absent";
+#else
+  REQUIRE_DISPLAY(prefix);
+  if (prefix == " ") GTEST_SKIP() << "needs xvfb-run (a private display)";
+  // GLFW key code: V 86.
+  const std::string steps = "wait_for \"UI ready\" || status=10\n"
+                            "[ $status -eq 0 ] && { hold V \" key86 \" && wait_for \"view depth: \" || status=11; }\n"
+                            "[ $status -eq 0 ] && { hold V \" key86 \" && wait_for \"view count: \" || status=12; }\n"
+                            "[ $status -eq 0 ] && close_window\n";
+  const RunResult r = run_live_viewer(prefix, "view_key", "--backend cpu --size 480x270 --log-input", steps, 13);
+  EXPECT_EQ(r.exit_code, 0) << "step " << r.exit_code << " failed (10 start, 11 no depth view, 12 no count view, 13 crash)\n"
+                            << r.output;
+  EXPECT_LT(r.output.find("view depth: "), r.output.find("view count: ")) << r.output;
+#endif
+}
+
 // A path typed into the scene field and sent with Enter that fails to open: the typing goes
 // on in the field, so a letter typed next is text, not a shortcut that the settings keep (B
 // used to switch to the baseline and leave it in settings.ini).
@@ -980,6 +1002,104 @@ TEST(Viewer, HeatmapOverlayAndLegendAreDrawn) {
     float brightest = 0.0f;
     for (int dx = -1; dx <= 1; ++dx) brightest = std::max(brightest, on.pixel(x + dx, 240)[0]);
     EXPECT_GT(brightest, 0.7f) << "no tick mark for " << value << " at x " << x;
+  }
+}
+
+// The distance from `p` to the nearest colour of the heat map's ramp (sampled finely).
+float distance_to_ramp(const float* p) {
+  float best = 1e9f;
+  for (int i = 0; i <= 512; ++i) {
+    const auto c = flashgs::viewer::heat_colour(float(i) / 512.0f);
+    best = std::min(best, std::max({std::abs(p[0] - c[0]), std::abs(p[1] - c[1]), std::abs(p[2] - c[2])}));
+  }
+  return best;
+}
+
+// The fraction of `image`'s pixels off the ramp (by more than 8-bit rounding), black ones aside.
+double off_ramp_fraction(const flashgs::Image& image) {
+  std::size_t off = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const float* p = image.pixel(x, y);
+      if (p[0] + p[1] + p[2] == 0.0f) continue;
+      off += distance_to_ramp(p) > 3.0f / 255.0f;
+    }
+  return double(off) / (double(image.width) * image.height);
+}
+
+// --view depth and --view count replace the colour by the debug image (every pixel on the
+// ramp, or the background where depth has nothing), each logs its legend, the two differ, the
+// depth view is what `flashgs render --view depth` writes, and a bad name is refused naming it.
+TEST(Viewer, DepthAndCountViewsReplaceTheColour) {
+  REQUIRE_DISPLAY(prefix);
+  const std::string dir = out_dir();
+  const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --camera 1 --frames 2 --no-ui ";
+  std::map<std::string, flashgs::Image> shots;
+  std::map<std::string, std::string> logs;
+  for (const std::string view : {"colour", "depth", "count"}) {
+    const std::string shot = dir + "/view_" + view + kExt;
+    std::filesystem::remove(shot);
+    const RunResult r = run(common + "--view " + view + " --screenshot " + shot + " --exit");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    shots[view] = flashgs::read_image(shot);
+    logs[view] = r.output;
+    ASSERT_EQ(shots[view].width, 320) << view;
+  }
+  EXPECT_EQ(logs["colour"].find("flashgs-viewer: view "), std::string::npos) << logs["colour"];
+  EXPECT_GT(off_ramp_fraction(shots["colour"]), 0.2) << "the colour frame is not a debug image";
+  EXPECT_LT(off_ramp_fraction(shots["depth"]), 1e-3);
+  EXPECT_LT(off_ramp_fraction(shots["count"]), 1e-3);
+  EXPECT_LT(flashgs::compare_images(shots["colour"], shots["depth"]).psnr_db, 25.0);
+  EXPECT_LT(flashgs::compare_images(shots["depth"], shots["count"]).psnr_db, 25.0);
+  // "view depth: blended depth, scene units, near A far B, ticks A@0% ... B@100%"
+  const std::string depth_key = "view depth: blended depth, scene units, near ";
+  const auto near_at = logs["depth"].find(depth_key);
+  ASSERT_NE(near_at, std::string::npos) << logs["depth"];
+  const auto far_at = logs["depth"].find(" far ", near_at);
+  ASSERT_NE(far_at, std::string::npos) << logs["depth"];
+  const double near_z = std::atof(logs["depth"].c_str() + near_at + depth_key.size());
+  const double far_z = std::atof(logs["depth"].c_str() + far_at + 5);
+  EXPECT_GT(near_z, 0.2) << logs["depth"];
+  EXPECT_GT(far_z, near_z) << logs["depth"];
+  EXPECT_NE(logs["depth"].find("@100%"), std::string::npos) << logs["depth"];
+  const long long max_count = number_after(logs["count"], "Gaussians blended per pixel, log scale, max ");
+  EXPECT_GT(max_count, 1) << logs["count"];
+  // The nearest blended pixel is dark (the ramp's start), the farthest bright: somewhere the
+  // depth image holds both ends.
+  float darkest = 1e9f, brightest = 0.0f;
+  for (int y = 0; y < 180; ++y)
+    for (int x = 0; x < 320; ++x) {
+      const float* p = shots["depth"].pixel(x, y);
+      if (p[0] + p[1] + p[2] == 0.0f) continue;
+      darkest = std::min(darkest, p[1]);
+      brightest = std::max(brightest, p[1]);
+    }
+  EXPECT_LT(darkest, 0.05f);
+  EXPECT_GT(brightest, 0.85f);
+  // The CLI's depth view of the same frame.
+  const std::string ref = dir + "/view_depth_cli" + kExt;
+  const RunResult c = run(cli() + " render --backend cpu -c 1 -r 320x180 --view depth -o " + ref);
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_NE(c.output.find("view depth: blended depth from "), std::string::npos) << c.output;
+  EXPECT_GE(flashgs::compare_images(shots["depth"], flashgs::read_image(ref)).psnr_db, 40.0);
+  // A name that is no view: one line naming the option, from both programs.
+  const RunResult bad = run(common + "--view normals --exit");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--view"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("normals"), std::string::npos) << bad.output;
+  const RunResult bad_cli = run(cli() + " render --view normals -o " + dir + "/never" + kExt);
+  EXPECT_NE(bad_cli.exit_code, 0);
+  EXPECT_NE(bad_cli.output.find("--view"), std::string::npos) << bad_cli.output;
+}
+
+// OpenImageIO (and the ~240 libraries it brings) is loaded only when an image is read or
+// written, not at every start: neither program links it, and both still write PNG (the other
+// tests' screenshots and renders).
+TEST(ViewerStartup, NeitherProgramLinksOpenImageIO) {
+  for (const std::string& program : {viewer(), cli()}) {
+    const RunResult r = run("ldd '" + program + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("libOpenImageIO"), std::string::npos) << program << "\n" << r.output;
   }
 }
 
@@ -1467,7 +1587,9 @@ TEST(Viewer, ARenderSizeBeyondTheTextureLimitFallsBackToOneThatFits) {
 TEST(Viewer, AFrameThatRunsOutOfMemoryIsReportedNotFatal) {
   SKIP_IF_ADDRESS_SPACE_CAP_MEETS_SANITIZER();
   REQUIRE_DISPLAY(prefix);
-  const RunResult r = run(prefix + "sh -c 'ulimit -v 3000000; exec " + viewer() +
+  // 2 GB of address space: the viewer's own (Mesa, the threads' stacks) and the frame's 1.7 GB
+  // of float RGB do not fit, so the render runs out before any texture is asked for.
+  const RunResult r = run(prefix + "sh -c 'ulimit -v 2000000; exec " + viewer() +
                           " --backend cpu --size 320x180 --render-size 12000x12000 --frames 2 --exit'");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("a 12000x12000 frame failed: "), std::string::npos) << r.output;

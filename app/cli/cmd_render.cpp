@@ -3,6 +3,7 @@
 
 #include "backend_factory.h"
 #include "commands.h"
+#include "flashgs/debug_view.h"
 #include "flashgs/error.h"
 #include "flashgs/image_io.h"
 #include "flashgs/io.h"
@@ -24,6 +25,7 @@ struct RenderCommand {
   int repeat = 1;
   std::string path_file;  // --path: a camera path's frames into the folder `output`
   int fps = 0;            // --fps: overrides the path file's
+  std::string view = "colour";  // --view: the colour, or a debug view (flashgs/debug_view.h)
 
   void run() const {
     if (!path_file.empty()) return run_path();
@@ -37,10 +39,15 @@ struct RenderCommand {
     auto renderer = create_backend(render.backend);
     check_frame_fits(*renderer, cam, loaded->size(), size_option);
     renderer->set_scene(loaded);
-    const RenderOptions options = render.options(*loaded);
+    FrameView frame_view = FrameView::colour;
+    parse_frame_view(view, &frame_view);  // checked by the option
+    RenderOptions options = render.options(*loaded);
+    options.collect_pixel_planes = frame_view != FrameView::colour;
     Image image;
     FrameStats stats;
     for (int i = 0; i < repeat; ++i) renderer->render(cam, options, image, &stats);
+    std::string scale_line;
+    if (frame_view != FrameView::colour) image = debug_image(frame_view, stats, cam, options, &scale_line);
     write_image(image, output);
     std::printf("%s: %zu Gaussians (SH degree %d), camera %d \"%s\" at %dx%d, %s on %s\n", scene_path.c_str(),
                 loaded->size(), loaded->sh_degree, camera.index, cam.name.c_str(), cam.width, cam.height,
@@ -48,7 +55,25 @@ struct RenderCommand {
     std::printf("kernel: %s\n", render.kernel.chosen() ? (options.kernel.description() + " (--kernel)").c_str()
                                                         : kernel_summary(loaded->trained_kernel).c_str());
     std::printf("%s", format_stats(stats).c_str());
-    std::printf("wrote %s\n", output.c_str());
+    std::printf("%swrote %s\n", scale_line.c_str(), output.c_str());
+  }
+
+  // The frame's debug view, and in `scale_line` what its colours stand for.
+  static Image debug_image(FrameView frame_view, const FrameStats& stats, const Camera& cam,
+                           const RenderOptions& options, std::string* scale_line) {
+    const DebugScale scale = debug_scale(stats);
+    char text[200];
+    if (frame_view == FrameView::depth && scale.any_blended)
+      std::snprintf(text, sizeof text,
+                    "view depth: blended depth from %.6g (dark) to %.6g (bright) scene units; the background where "
+                    "nothing blended\n", scale.near_depth, scale.far_depth);
+    else if (frame_view == FrameView::depth)
+      std::snprintf(text, sizeof text, "view depth: nothing blended, the background only\n");
+    else
+      std::snprintf(text, sizeof text, "view count: Gaussians blended per pixel, log scale from 0 (dark) to %u (bright)\n",
+                    scale.max_blended);
+    *scale_line = text;
+    return debug_view_image(frame_view, stats, cam.width, cam.height, scale, options.background);
   }
 
   // What the scene file declares, against loading it and one frame, before it is read. A
@@ -113,7 +138,16 @@ void register_render(CLI::App& app) {
                                "frame_00000.png ... into the --output folder");
   sub->add_option("--fps", command->fps, "with --path: frames per second (default: the path file's)")
       ->check(whole_number())->check(CLI::Range(1, kMaxPathFps))->needs(path);
-  path->excludes("--camera")->excludes("--eye")->excludes("--repeat");
+  auto* view = sub->add_option("--view", command->view,
+                               std::string("what the image shows: ") + kFrameViewChoices +
+                                   " (depth: the blended depth, count: Gaussians blended per pixel, both on a "
+                                   "colour scale printed with the frame; from the per-pixel blend, slower)")
+                   ->check([](const std::string& text) {
+                     FrameView v;
+                     return parse_frame_view(text, &v) ? std::string()
+                                                       : "'" + text + "' is not one of " + kFrameViewChoices;
+                   });
+  path->excludes("--camera")->excludes("--eye")->excludes("--repeat")->excludes(view);
   sub->callback([command, sub] {
     if (!command->path_file.empty() && sub->get_option("--output")->count() == 0) command->output = "path_frames";
     command->run();

@@ -1,4 +1,4 @@
-// The heat map's colour scale: a viridis-like ramp (perceptually uniform, readable with colour-blindness), its legend ticks and caption.
+// The heat map's colour scale (flashgs/colour_ramp.h): its legend ticks and caption.
 #pragma once
 
 #include <array>
@@ -6,19 +6,15 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/colour_ramp.h"
+
 namespace flashgs::viewer {
 
-// Stops of the ramp, evenly spaced from 0 to 1 (display RGB in [0, 1], interpolated linearly):
-// the published viridis colours at 0, 1/8, ..., 1 (matplotlib's, van der Walt and Smith
-// 2015). The overlay shader receives this table, so that legend and overlay agree.
-inline constexpr int kRampStops = 9;
-extern const std::array<std::array<float, 3>, kRampStops> kHeatRamp;
-
-// The ramp's colour at t in [0, 1] (clamped).
-std::array<float, 3> heat_colour(float t);
-
-// Where a pair count sits on the scale, 0..1: log(1 + c) / log(1 + max), or c / max.
-float heat_position(double count, double max_count, bool log_scale);
+// The ramp lives in the renderer library (the CLI's debug images use it too).
+using ::flashgs::heat_colour;
+using ::flashgs::heat_position;
+using ::flashgs::kHeatRamp;
+using ::flashgs::kRampStops;
 
 // The legend bar is kLegendBarPoints wide and its labels are in ImGui's default font, a
 // monospace one of kLegendCharPoints a character; both grow with the UI scale, so the bar holds

@@ -29,6 +29,7 @@ inline constexpr Shortcut kShortcuts[] = {
     {"K", "next kernel: classic, anti-aliased (gsplat), anti-aliased (Mip-Splatting)"},
     {"C", "compare two configurations for this view"},
     {"H", "tile heat map (pairs per tile)"},
+    {"V", "view: colour, blended depth, Gaussians blended per pixel"},
     {"F12 / Shift+F12", "screenshot of the render / of the whole window"},
     {"Ctrl+O, or drop a file", "open a scene (PLY, folder or 3DGS output)"},
     {"Tab", "hide / show the panels"},

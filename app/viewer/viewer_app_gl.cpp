@@ -102,6 +102,7 @@ ViewerApp::ViewerApp(ViewerArgs args)
   m_settings.screenshot_overlay = m_args.screenshot_overlay;
   m_settings.show_grid = m_args.grid;
   m_settings.show_centres = m_args.centres;
+  parse_frame_view(m_args.view, &m_settings.view);  // checked by the option
   m_settings.show_frustums = m_args.frustums;
   m_settings.up_axis = int(std::find(kUpAxisNames, kUpAxisNames + kUpAxisCount, m_args.up) - kUpAxisNames) % kUpAxisCount;
   m_settings.compare_view = m_args.compare_view == "numbers" ? CompareView::numbers
@@ -292,6 +293,7 @@ void ViewerApp::read_keys(NavigationInput& nav, UiActions& actions) {
   if (pressed(GLFW_KEY_SPACE)) actions.toggle_play = true;
   if (pressed(GLFW_KEY_C)) actions.compare = true;
   if (pressed(GLFW_KEY_H)) m_settings.heatmap = !m_settings.heatmap;
+  if (pressed(GLFW_KEY_V)) m_settings.view = next_frame_view(m_settings.view);
   if (pressed(GLFW_KEY_F1)) {
     m_settings.show_help = !m_settings.show_help;
     std::fprintf(stderr, "flashgs-viewer: help %s (F1)\n", m_settings.show_help ? "shown" : "closed");
@@ -595,6 +597,7 @@ void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
   request.camera = m_controller.render_camera(rw, rh, m_settings.fov_x_degrees);
   request.options = m_settings.options;
   request.options.collect_tile_counts = m_settings.heatmap;  // counts cost a copy: only when shown
+  request.options.collect_pixel_planes = m_settings.view != FrameView::colour;
   request.reduced = reduced;
   const bool streamed = m_stream.active() && update_stream(request.camera);
   const bool changed = streamed || !m_have_request || !same_camera(request.camera, m_requested.camera) ||
@@ -697,6 +700,7 @@ void ViewerApp::draw_and_present(int fb_w, int fb_h) {
   // once (a GPU path rendering every frame); otherwise the newest is shown.
   if (!(m_delivered && (m_settings.continuous || m_scripted))) m_path->present_latest();
   m_presenter->show(m_path->shown_texture());
+  if (m_debug_shown != FrameView::colour) m_presenter->show(0);  // show_debug_view uploaded it there
   HeatmapView heat;
   heat.log_scale = m_settings.heatmap_log;
   heat.opacity = m_settings.heatmap_opacity;
@@ -1020,6 +1024,8 @@ UiModel ViewerApp::panel_model(int fb_w, int fb_h) {
   model.compare = &m_compare;
   model.heatmap_max = m_presenter->heatmap_max();
   model.tile_size = gm::kTileSize;
+  model.debug_shown = m_debug_shown;
+  model.debug_scale = m_debug_scale;
   model.compare_shown = comparison_shown();
   model.divider = m_divider.fraction();
   model.difference_factor = m_difference_factor;
@@ -1135,6 +1141,7 @@ void ViewerApp::render_and_present(int fb_w, int fb_h) {
   m_before_render_ms = ms_since(m_frame_start);
   request_frame(fb_w, fb_h, m_moving || ms_since(m_last_motion) < kSettleMs);
   collect_frame();
+  show_debug_view();
   const auto t_compare = Clock::now();
   finish_comparison(/*at_once=*/false);
   m_compare_show_ms = ms_since(t_compare);

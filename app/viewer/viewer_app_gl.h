@@ -13,6 +13,7 @@
 #include "compare_task.h"
 #include "file_browser_ui.h"
 #include "file_dialog.h"
+#include "debug_view_legend.h"
 #include "heatmap_legend.h"
 #include "lod_stream_view.h"
 #include "path_editor.h"
@@ -144,6 +145,9 @@ class ViewerApp {
   void key_guides(std::vector<WorldSegment>& world) const;  // the keys and the curve over the scene
   void start_key_render(const std::string& folder);
   void log_legend();   // the heat-map legend's ticks, once per change
+  // The debug view (depth, count) of the shown frame in place of its colour, when chosen and
+  // the frame has its planes (viewer_debug_view_gl.cpp).
+  void show_debug_view();
   void finish_script();
   void check_displayed_frame();
 
@@ -204,6 +208,10 @@ class ViewerApp {
   bool m_drag_on_ui = false;   // the held press landed on an ImGui window
   double m_press_x = 0, m_press_y = 0;  // where the left button went down (a click snaps to a frustum)
   HeatScale m_heat_scale;
+  Image m_debug_image;                         // the debug view on screen...
+  FrameView m_debug_shown = FrameView::colour;  // ...which one it is (colour: none)
+  DebugScale m_debug_scale;                    // ...and its scale (the legend's)
+  std::string m_logged_debug_legend;
   std::string m_logged_legend;
   FileDialog m_dialog;
   FileBrowser m_browser;

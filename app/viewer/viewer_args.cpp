@@ -9,6 +9,7 @@
 
 #include "compare_mode.h"
 #include "finite_option.h"
+#include "flashgs/debug_view.h"
 #include "flashgs/error.h"
 #include "flashgs/io.h"
 #include "flashgs/parse.h"
@@ -99,6 +100,13 @@ int parse_viewer_args(int argc, char** argv, ViewerArgs* a) {
   app.add_flag("--fly", a->fly, "start in fly mode")->excludes(orbit);
   app.add_flag("--grid", a->grid, "start with the ground grid and axes shown (G)");
   app.add_flag("--centres", a->centres, "start with the Gaussians' centres drawn as dots (a debug view)");
+  app.add_option("--view", a->view,
+                 std::string("start with this view (V): ") + kFrameViewChoices +
+                     " (depth: the blended depth, count: Gaussians blended per pixel)")
+      ->check([](const std::string& text) {
+        FrameView v;
+        return parse_frame_view(text, &v) ? std::string() : "'" + text + "' is not one of " + kFrameViewChoices;
+      });
   app.add_flag("--frustums", a->frustums, "start with the training cameras drawn as frustums");
   app.add_flag("--help-window", a->help_window, "start with the shortcut table open (F1)");
   app.add_option("--compare-view", a->compare_view, "what a comparison shows: numbers, split or difference")

@@ -49,6 +49,7 @@ struct ViewerArgs {
   bool orbit = false;            // start in orbit mode
   bool fly = false;              // start in fly mode (neither: orbit for object-sized scenes)
   bool grid = false, frustums = false, centres = false;
+  std::string view = "colour";   // --view: flashgs/debug_view.h's names
   bool help_window = false;      // start with the shortcut table open
   std::string compare_view = "split";  // numbers | split | difference
   std::string compare_left = "baseline", compare_right = "current";  // compare_mode.h choice names

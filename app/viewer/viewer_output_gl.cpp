@@ -32,7 +32,9 @@ void ViewerApp::save_screenshot(const std::string& path) {
     Image image;
     const Image* host = m_path->last_image();
     const std::string ext = std::filesystem::path(path).extension().string();
-    if (host && host->width == m_presenter->width() && host->height == m_presenter->height()) {
+    if (m_debug_shown != FrameView::colour) {
+      image = m_debug_image;  // the debug view on screen, as shown
+    } else if (host && host->width == m_presenter->width() && host->height == m_presenter->height()) {
       image = *host;
     } else if (ext == ".exr" || ext == ".EXR" || ext == ".pfm") {
       // Float formats get the float frame, rendered again for the same view.

@@ -599,6 +599,21 @@ void overlay_panel(const UiModel& m, ViewerSettings& s, UiActions& a, std::strin
   ImGui::SliderFloat("opacity", &s.heatmap_opacity, kHeatmapOpacityRange.min, kHeatmapOpacityRange.max, "%.2f", kClamp);
   ImGui::SameLine();
   ImGui::Checkbox("in screenshots", &s.screenshot_overlay);
+  ImGui::SetNextItemWidth(ui(150));
+  if (ImGui::BeginCombo("View (V)", frame_view_label(s.view))) {
+    for (FrameView v : kFrameViews)
+      if (ImGui::Selectable(frame_view_label(v), v == s.view)) s.view = v;
+    ImGui::EndCombo();
+  }
+  note_widget_place("View");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("Depth: the blended depth sum(w z) / sum(w), w = alpha T, per pixel; Blended count: the "
+                      "Gaussians each pixel blended before it stopped.\nBoth from the per-pixel blend that makes the "
+                      "colour (on %s: %s), so slower than the colour frame.",
+                      m.backend == Backend::cpu ? "the CPU" : "CUDA",
+                      m.backend == Backend::cpu ? "its scalar kernel"
+                                                : "the per-pixel 3DGS kernel, also when flash is chosen");
+  ImGui::SameLine();
   ImGui::Checkbox("Gaussian centres", &s.show_centres);
   if (ImGui::IsItemHovered())
     ImGui::SetTooltip("each Gaussian's centre as a dot in its base colour (at most %d; every k-th beyond)",
@@ -701,6 +716,36 @@ void legend_labels(const UiModel& m, const ViewerSettings& s) {
   note_drawn_place("legend caption", caption_x, r[1] - line - ui(3),
                    caption_x + ImGui::CalcTextSize(caption.c_str()).x, r[1] - ui(3));
   for (const LegendTick& t : legend_ticks(m.heatmap_max, s.heatmap_log)) {
+    const float x = r[0] + t.position * (r[2] - r[0]);
+    draw->AddLine(ImVec2(x, r[3]), ImVec2(x, r[3] + ui(4)), white, ui(1.0f));
+    const float w = ImGui::CalcTextSize(t.label.c_str()).x;
+    draw->AddText(ImVec2(x - 0.5f * w, r[3] + ui(4)), white, t.label.c_str());
+  }
+}
+
+// The debug view's legend, bar included (drawn here: no shader draws it), the width of the
+// heat map's and above it (the two may be on together).
+void debug_legend(const UiModel& m, const ViewerSettings& s) {
+  if (m.debug_shown == FrameView::colour) return;
+  ImDrawList* draw = ImGui::GetForegroundDrawList();
+  const float* heat = m.legend_rect_points;
+  const float lift = s.heatmap ? ui(60) : 0.0f;
+  const float r[4] = {heat[0], heat[1] - lift, heat[2], heat[3] - lift};
+  const ImU32 white = IM_COL32(255, 255, 255, 255), backing = IM_COL32(0, 0, 0, 160);
+  const float line = ImGui::GetTextLineHeight();
+  const std::string caption = debug_legend_caption(m.debug_shown);
+  draw->AddRectFilled(ImVec2(r[0] - ui(16), r[1] - line - ui(6)), ImVec2(r[2] + ui(16), r[3] + line + ui(6)), backing,
+                      ui(3.0f));
+  draw->AddText(ImVec2(r[0], r[1] - line - ui(3)), white, caption.c_str());
+  // The ramp as one gradient between each pair of its stops.
+  auto colour = [](const std::array<float, 3>& c) { return ImGui::ColorConvertFloat4ToU32(ImVec4(c[0], c[1], c[2], 1)); };
+  for (int i = 0; i + 1 < kRampStops; ++i) {
+    const float x0 = r[0] + (r[2] - r[0]) * float(i) / (kRampStops - 1);
+    const float x1 = r[0] + (r[2] - r[0]) * float(i + 1) / (kRampStops - 1);
+    const ImU32 a = colour(kHeatRamp[i]), b = colour(kHeatRamp[i + 1]);
+    draw->AddRectFilledMultiColor(ImVec2(x0, r[1]), ImVec2(x1, r[3]), a, b, b, a);
+  }
+  for (const LegendTick& t : debug_legend_ticks(m.debug_shown, m.debug_scale)) {
     const float x = r[0] + t.position * (r[2] - r[0]);
     draw->AddLine(ImVec2(x, r[3]), ImVec2(x, r[3] + ui(4)), white, ui(1.0f));
     const float w = ImGui::CalcTextSize(t.label.c_str()).x;
@@ -815,11 +860,13 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
 void draw_legend_labels(const UiModel& m, const ViewerSettings& s) {
   g_ui = m.ui_scale;
   if (s.heatmap && !m.compare_shown) legend_labels(m, s);
+  if (!m.compare_shown) debug_legend(m, s);
 }
 
 void draw_overlays(const UiModel& m, ViewerSettings& s) {
   g_ui = m.ui_scale;
   if (s.heatmap && !m.compare_shown) legend_labels(m, s);
+  if (!m.compare_shown) debug_legend(m, s);
   compare_labels(m, s);
   draw_help_window(&s.show_help, m.ui_scale);
   if (!s.show_ui) draw_hidden_panels_hint(m.ui_scale);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "compare_mode.h"
+#include "debug_view_legend.h"
 #include "heatmap_legend.h"
 #include "path_editor.h"
 #include "flashgs/stats.h"
@@ -63,6 +64,8 @@ struct UiModel {
   std::string dialog_tool;        // the desktop file dialog in use ("zenity"), empty: in-app browser
   bool dialog_open = false;
   float legend_rect_points[4] = {0, 0, 0, 0};  // where the legend bar is drawn, window points
+  FrameView debug_shown = FrameView::colour;   // the debug view on screen (colour: none)...
+  DebugScale debug_scale;                      // ...and its scale
   float ui_scale = 1.0f;          // widget size multiplier (high-DPI screens)
   std::string status;             // last screenshot / action message
   float world_up[3] = {0, -1, 0};

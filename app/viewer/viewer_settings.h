@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "flashgs/debug_view.h"
 #include "flashgs/options.h"
 
 namespace flashgs::viewer {
@@ -69,6 +70,7 @@ struct ViewerSettings {
   bool show_grid = false;           // ground grid and axes over the image (G)
   bool show_frustums = false;       // the training cameras as frustums, clickable
   bool show_centres = false;        // the Gaussians' centres as dots (a debug view; kMaxCentreMarks)
+  FrameView view = FrameView::colour;  // the colour, or the blended depth or count (V)
   bool heatmap_lock_max = false;    // keep the heat map's maximum while switching configurations
   bool screenshot_overlay = false;  // screenshots show the heat map as the window does
   std::string screenshot_folder;    // where F12 saves (timestamped names); empty: working directory

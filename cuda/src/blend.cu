@@ -48,7 +48,9 @@ __device__ __forceinline__ BlendGaussian load_gaussian(const BlendGaussian* g) {
 }
 
 // The 3DGS render kernel: one 16x16 block per tile, one thread per pixel. The arithmetic is
-// the CPU's operation for operation (this file is built with -fmad=false), with expf.
+// the CPU's operation for operation (this file is built with -fmad=false), with expf. With
+// a.pixel_depth each pixel also sums its weights and weighted depths and counts its Gaussians,
+// as the CPU's scalar kernel does.
 template <bool SURFACE>
 __global__ void __launch_bounds__(kTile * kTile) blend_per_pixel_kernel(BlendArgs a) {
   __shared__ BlendGaussian batch[kTile * kTile];
@@ -61,6 +63,9 @@ __global__ void __launch_bounds__(kTile * kTile) blend_per_pixel_kernel(BlendArg
   const uint2 range = a.tile_ranges[tile];
   const float fx = static_cast<float>(x), fy = static_cast<float>(y);
   float t = 1.0f, cr = 0.0f, cg = 0.0f, cb = 0.0f;
+  float weight_sum = 0.0f, weighted_depth = 0.0f;
+  std::uint32_t blended = 0;
+  const bool planes = a.pixel_depth != nullptr;
   for (unsigned base = range.x; base < range.y; base += kTile * kTile) {
     if (__syncthreads_count(done) == kTile * kTile) break;
     const unsigned idx = base + threadIdx.x;
@@ -85,11 +90,21 @@ __global__ void __launch_bounds__(kTile * kTile) blend_per_pixel_kernel(BlendArg
       cg += g.green * w;
       cb += g.blue * w;
       t = next_t;
+      if (planes) {
+        weight_sum += w;
+        weighted_depth += w * g.depth;
+        ++blended;
+      }
     }
     __syncthreads();
   }
-  if (inside) write_pixel<SURFACE>(a, x, y, cr + t * a.background[0], cg + t * a.background[1],
-                                   cb + t * a.background[2]);
+  if (!inside) return;
+  write_pixel<SURFACE>(a, x, y, cr + t * a.background[0], cg + t * a.background[1], cb + t * a.background[2]);
+  if (planes) {
+    const std::size_t at = static_cast<std::size_t>(y) * a.width + x;
+    a.pixel_depth[at] = blended > 0 ? weighted_depth / weight_sum : __int_as_float(0x7fc00000);  // NaN: none
+    a.pixel_blended[at] = blended;
+  }
 }
 
 constexpr int kWarpsPerBlock = 4;

@@ -367,6 +367,20 @@ class CudaRendererImpl final : public CudaRenderer {
 
   void finish() override { check_cuda(cudaStreamSynchronize(stream_), "frame"); }
 
+  // The debug planes of the last frame (per_pixel_options), waited for.
+  void download_pixel_planes(int width, int height, FrameStats& stats) {
+    const std::size_t pixels = static_cast<std::size_t>(width) * height;
+    stats.pixel_depth.resize(pixels);
+    stats.pixel_blended.resize(pixels);
+    check_cuda(cudaMemcpyAsync(stats.pixel_depth.data(), pixel_depth_.as<void>(), pixels * sizeof(float),
+                               cudaMemcpyDeviceToHost, stream_),
+               "depth plane download");
+    check_cuda(cudaMemcpyAsync(stats.pixel_blended.data(), pixel_blended_.as<void>(), pixels * sizeof(std::uint32_t),
+                               cudaMemcpyDeviceToHost, stream_),
+               "blended-count plane download");
+    check_cuda(cudaStreamSynchronize(stream_), "debug plane download");
+  }
+
   void download_tile_counts(std::vector<std::uint32_t>& counts) override {
     counts.resize(last_tiles_);
     std::vector<uint2> ranges(last_tiles_);
@@ -386,7 +400,7 @@ class CudaRendererImpl final : public CudaRenderer {
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &record_ids_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
             &values_[1], &ranges_, &tile_lists_, &bin_fill_, &bin_ready_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
-            &deferred_footprints_, &deferred_records_, &deferred_hits_, &deferred_items_};
+            &deferred_footprints_, &deferred_records_, &deferred_hits_, &deferred_items_, &pixel_depth_, &pixel_blended_};
   }
 
   // A sphere around every Gaussian centre (the farthest depth a frame can sort is the camera's
@@ -768,7 +782,7 @@ class CudaRendererImpl final : public CudaRenderer {
     blend.tiles_x = cam.tiles_x;
     blend.tiles_y = cam.tiles_y;
     for (int k = 0; k < 3; ++k) blend.background[k] = options.background[k];
-    blend.kernel = f.baseline ? cuda::BlendKernel::per_pixel
+    blend.kernel = f.baseline || options.collect_pixel_planes ? cuda::BlendKernel::per_pixel
                               : (options.pipelined_blend ? cuda::BlendKernel::warp_tile_pipelined
                                                          : cuda::BlendKernel::warp_tile);
     blend.exp2_alpha = f.args->exp2_alpha;
@@ -786,6 +800,12 @@ class CudaRendererImpl final : public CudaRenderer {
     blend.gaussians = b.blend;
     blend.image_rgb = f.float_image ? b.image_rgb : nullptr;
     blend.surface = f.surface;
+    if (options.collect_pixel_planes) {
+      pixel_depth_.reserve(f.pixels * sizeof(float), "depth plane");
+      pixel_blended_.reserve(f.pixels * sizeof(std::uint32_t), "blended-count plane");
+      blend.pixel_depth = pixel_depth_.as<float>();
+      blend.pixel_blended = pixel_blended_.as<std::uint32_t>();
+    }
     cuda::launch_blend(blend, stream_);
     check_cuda(cudaEventRecord(events[kBlended], stream_), "event record");
     // The fullest tile and the tile pairs, for the statistics (after the last timed event:
@@ -803,10 +823,20 @@ class CudaRendererImpl final : public CudaRenderer {
     }
   }
 
+  // The debug planes come from the per-pixel kernel, which reads the float alpha form of
+  // per-tile lists: a frame that collects them keeps its geometry switches (the same pairs but
+  // for the bins) and leaves out the exp2 form, the half blend and the macro bins.
+  static RenderOptions per_pixel_options(const RenderOptions& options) {
+    RenderOptions o = options;
+    o.exp2_alpha = o.fp16_blend = o.macro_bins = false;
+    return o;
+  }
+
   // Renders one frame: its path planned, its buffers sized, its preprocess queued and its
   // counts read back, then the rest of its work queued; its statistics where asked for.
-  void run_frame(const Camera& camera, const RenderOptions& options, FrameTarget target, Image* out,
+  void run_frame(const Camera& camera, const RenderOptions& asked, FrameTarget target, Image* out,
                  std::uint64_t surface, FrameStats* stats_out) {
+    const RenderOptions options = asked.collect_pixel_planes ? per_pixel_options(asked) : asked;
     if (!scene_ && !pooled_) throw Error("cuda renderer: no scene set");
     if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
     if (surface) check_surface(surface, camera);
@@ -1085,6 +1115,7 @@ class CudaRendererImpl final : public CudaRenderer {
     stats.scene_device_bytes = scene_pos_.bytes() + scene_rot_.bytes() + scene_scale_.bytes() + scene_dc_.bytes() +
                                scene_rest_.bytes() + scene_chunks_.bytes() + scene_ids_.bytes() + pool_bytes_;
     if (options.collect_tile_counts) download_tile_counts(stats.tile_pair_counts);
+    if (options.collect_pixel_planes) download_pixel_planes(cam.width, cam.height, stats);
     return stats;
   }
 
@@ -1179,6 +1210,7 @@ class CudaRendererImpl final : public CudaRenderer {
   DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_, bin_fill_,
       bin_ready_, dense_bins_, tile_order_, tile_places_, chunk_list_, image_,
       cub_temp_, deferred_footprints_, deferred_records_, deferred_hits_, deferred_items_;
+  DeviceBuffer pixel_depth_, pixel_blended_;  // RenderOptions::collect_pixel_planes
 };
 
 }  // namespace

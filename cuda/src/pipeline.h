@@ -332,6 +332,10 @@ struct BlendArgs {
   const BlendGaussian* gaussians;
   float* image_rgb;              // float output, or
   unsigned long long surface;    // RGBA8 surface (when image_rgb is null)
+  // Per-pixel kernel: the debug planes (FrameStats::pixel_depth, pixel_blended), width x
+  // height each, or null.
+  float* pixel_depth;
+  std::uint32_t* pixel_blended;
 };
 void launch_blend(const BlendArgs& args, cudaStream_t stream);
 // Blocks of the default warp blend (8 x 8 regions, pipelined, exp2, float output) that the

@@ -33,7 +33,7 @@ void order_tiles_by_pairs(Frame& frame, std::size_t tiles) {
 }  // namespace
 
 bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const std::function<bool()>& cancelled,
-           float* rgb) {
+           float* rgb, const PixelPlanes* planes) {
   const int tiles_x = frame.camera.tiles_x;
   const std::size_t tiles = static_cast<std::size_t>(tiles_x) * frame.camera.tiles_y;
   order_tiles_by_pairs(frame, tiles);
@@ -53,8 +53,8 @@ bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const
       const std::uint64_t begin = frame.tile_start[tile], end = frame.tile_start[tile + 1];
       const TileJob job{frame.tile_ids.data() + begin, end - begin, static_cast<int>(tile % tiles_x),
                         static_cast<int>(tile / tiles_x), options.background};
-      if (kernel == BlendKernel::scalar)
-        blend_tile_scalar(frame, job, rgb);
+      if (kernel == BlendKernel::scalar || planes)
+        blend_tile_scalar(frame, job, rgb, planes);
       else
         blend_tile_simd(frame, job, rgb, kernel == BlendKernel::simd ? SpanPruning::on : SpanPruning::off);
     });

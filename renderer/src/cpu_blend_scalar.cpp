@@ -15,8 +15,9 @@ constexpr int kTilePixels = gm::kTileSize * gm::kTileSize;
 
 // Composites one tile. Gaussian-outer, pixel-inner: each Gaussian is read once per tile and
 // the pixel loop runs over contiguous arrays. Per pixel the rules are those of 3DGS:
-// alpha = min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4.
-void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb) {
+// alpha = min(0.99, o e^power), skip alpha < 1/255, stop before T < 1e-4. With `planes` each
+// pixel also sums its blend weights and weighted depths and counts its Gaussians.
+void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb, const PixelPlanes* planes) {
   const std::uint32_t* ids = tile.ids;
   const std::uint64_t count = tile.count;
   const float* background = tile.background;
@@ -28,14 +29,19 @@ void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb) {
   float transmittance[kTilePixels];
   float color[kTilePixels][3];
   bool active[kTilePixels];
+  float weight_sum[kTilePixels], weighted_depth[kTilePixels];
+  std::uint32_t blended[kTilePixels];
   int active_count = tile_w * tile_h;
   for (int p = 0; p < kTilePixels; ++p) {
     transmittance[p] = 1.0f;
     color[p][0] = color[p][1] = color[p][2] = 0.0f;
     active[p] = true;
+    weight_sum[p] = weighted_depth[p] = 0.0f;
+    blended[p] = 0;
   }
   for (std::uint64_t k = 0; k < count && active_count > 0; ++k) {
     const BlendGaussian& g = frame.blend_data[ids[k]];
+    const float depth = planes ? frame.footprints[ids[k]].depth : 0.0f;
     // Only the rows, and in each row the pixels, that can reach power_cut; the margins (0.5
     // in q, one pixel each side) exceed the float rounding of the per-pixel power, so pruning
     // never changes which pixels pass the exact test below.
@@ -76,6 +82,11 @@ void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb) {
         color[p][1] += g.rgb[1] * weight;
         color[p][2] += g.rgb[2] * weight;
         transmittance[p] = next_t;
+        if (planes) {
+          weight_sum[p] += weight;
+          weighted_depth[p] += weight * depth;
+          ++blended[p];
+        }
       }
     }
   }
@@ -84,6 +95,11 @@ void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb) {
       const int p = y * gm::kTileSize + x;
       float* out = rgb + (static_cast<std::size_t>(y_begin + y) * width + x_begin + x) * 3;
       for (int ch = 0; ch < 3; ++ch) out[ch] = color[p][ch] + transmittance[p] * background[ch];
+      if (planes) {
+        const std::size_t at = static_cast<std::size_t>(y_begin + y) * width + x_begin + x;
+        planes->depth[at] = blended[p] > 0 ? weighted_depth[p] / weight_sum[p] : NAN;
+        planes->blended[at] = blended[p];
+      }
     }
 }
 

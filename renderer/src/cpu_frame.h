@@ -183,13 +183,21 @@ void sort_by_tile(Frame& frame, FrameStats& stats, double* ranges_ms);
 // the whole tile (every Gaussian of a tile visits every live row; slow), for the tests, which
 // check that the spans change no byte.
 enum class BlendKernel { simd, scalar, simd_unpruned };
+// Where the scalar kernel writes the debug planes (FrameStats::pixel_depth, pixel_blended),
+// each width x height.
+struct PixelPlanes {
+  float* depth;
+  std::uint32_t* blended;
+};
 // Blends every tile, densest first. `cancelled` is asked between tiles; once it says yes the
-// remaining tiles are left as they are and blend returns false.
+// remaining tiles are left as they are and blend returns false. With `planes` every tile runs
+// the scalar kernel, which fills them too.
 bool blend(const RenderOptions& options, Frame& frame, BlendKernel kernel, const std::function<bool()>& cancelled,
-           float* rgb);
+           float* rgb, const PixelPlanes* planes = nullptr);
 // The scalar reference kernel (cpu_blend_scalar.cpp) and the SIMD one (cpu_blend_simd.cpp;
-// without Highway it is the scalar one). Both write the tile's pixels of `rgb`.
-void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb);
+// without Highway it is the scalar one). Both write the tile's pixels of `rgb`; the scalar one
+// also those of `planes` where given.
+void blend_tile_scalar(const Frame& frame, const TileJob& tile, float* rgb, const PixelPlanes* planes = nullptr);
 enum class SpanPruning { on, off };
 void blend_tile_simd(const Frame& frame, const TileJob& tile, float* rgb, SpanPruning pruning = SpanPruning::on);
 // The SIMD kernel's alpha before its 0.99 cap, opacity e^(-q/2) computed as 2^(q * -log2(e)/2 +

@@ -106,7 +106,16 @@ class CpuRenderer final : public Renderer {
     if (cancelled()) return finish_cancelled();
     t = Clock::now();
     if (out.width != camera.width || out.height != camera.height) out.resize(camera.width, camera.height);
-    const bool complete = cpu::blend(options, frame_, kernel_, cancelled, out.rgb.data());
+    cpu::PixelPlanes planes{};
+    const bool want_planes = options.collect_pixel_planes && stats_out;
+    if (want_planes) {
+      const std::size_t pixels = static_cast<std::size_t>(camera.width) * camera.height;
+      stats.pixel_depth.resize(pixels);
+      stats.pixel_blended.resize(pixels);
+      planes = {stats.pixel_depth.data(), stats.pixel_blended.data()};
+    }
+    const bool complete =
+        cpu::blend(options, frame_, kernel_, cancelled, out.rgb.data(), want_planes ? &planes : nullptr);
     stats.times.blend_ms = ms_since(t);
     if (!complete) return finish_cancelled();
     stats.times.total_ms = ms_since(start);

@@ -1,23 +1,18 @@
-// Image file IO: OpenImageIO when available, with the built-in PPM/PFM formats always.
+// Image file IO: PNG/EXR/anything through the OpenImageIO module when built with it (loaded at
+// the first such read or write), with the built-in PPM/PFM formats always.
 #include "flashgs/image_io.h"
 
-#include <unistd.h>
+#include <dlfcn.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <cmath>
 #include <cstdio>
-#include <mutex>
+#include <filesystem>
 #include <vector>
 
 #include "flashgs/error.h"
 #include "flashgs/file_write.h"
 #include "flashgs/netpbm.h"
-
-#ifdef FLASHGS_HAVE_OIIO
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-#endif
+#include "image_oiio_module.h"
 
 namespace flashgs {
 namespace {
@@ -30,129 +25,112 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
-#ifdef FLASHGS_HAVE_OIIO
-// OpenImageIO's writes go through this proxy onto the output file's descriptor: the first
-// error the system gives is kept, since a format plugin may not look at what a write returns
-// (a PNG written to /dev/full, every byte of it refused, reported success).
-class DescriptorOutput final : public OIIO::Filesystem::IOProxy {
- public:
-  DescriptorOutput(int fd, const std::string& path) : IOProxy(path, Write), m_fd(fd) {}
-  const char* proxytype() const override { return "flashgs_descriptor"; }
-  size_t write(const void* buf, size_t size) override {
-    const size_t n = pwrite(buf, size, m_pos);
-    m_pos += static_cast<int64_t>(n);
-    return n;
-  }
-  size_t pwrite(const void* buf, size_t size, int64_t offset) override {
-    size_t done = 0;
-    while (done < size) {
-      const ssize_t n = ::pwrite(m_fd, static_cast<const char*>(buf) + done, size - done, offset + done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        const std::lock_guard<std::mutex> lock(m_mutex);
-        if (!m_error) m_error = n < 0 ? errno : ENOSPC;
-        break;
-      }
-      done += static_cast<size_t>(n);
-    }
-    const std::lock_guard<std::mutex> lock(m_mutex);
-    m_size = std::max(m_size, static_cast<size_t>(offset) + done);
-    return done;
-  }
-  size_t size() const override {
-    const std::lock_guard<std::mutex> lock(m_mutex);
-    return m_size;
-  }
-  // The errno value of the first failed write, 0 when none failed.
-  int error_number() const {
-    const std::lock_guard<std::mutex> lock(m_mutex);
-    return m_error;
-  }
-
- private:
-  int m_fd;
-  mutable std::mutex m_mutex;  // guards the two below (plugins may write from several threads)
-  size_t m_size = 0;
-  int m_error = 0;
+// The OpenImageIO module's functions, or why there are none.
+struct OiioModule {
+  decltype(&flashgs_oiio_can_write) can_write = nullptr;
+  decltype(&flashgs_oiio_write) write = nullptr;
+  decltype(&flashgs_oiio_read) read = nullptr;
+  std::string why_not;  // empty when loaded
 };
 
-// Encodes `image` with OpenImageIO into `file`; the format is the one `path`'s extension names.
-void write_with_oiio(const Image& image, const std::string& path, const std::string& ext, OutputFile& file) {
-  DescriptorOutput proxy(file.descriptor(), path);  // outlives `out`, whose destructor may still write
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw Error(path + ": cannot write this format (" + OIIO::geterror() + ")");
-  const bool is_float = ext == "exr" || ext == "hdr" || ext == "tif" || ext == "tiff";
-  OIIO::ImageSpec spec(image.width, image.height, 3, is_float ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-  // A plugin without I/O proxies opens the temporary by name; file.finish() still syncs and
-  // checks it, but only its status tells of a write that failed.
-  const bool proxied = out->supports("ioproxy") && out->set_ioproxy(&proxy);
-  if (!out->open(proxied ? path : file.temp_path(), spec)) throw Error(path + ": " + out->geterror());
-  bool ok;
-  if (is_float) {
-    ok = out->write_image(OIIO::TypeDesc::FLOAT, image.rgb.data());
-  } else {
-    std::vector<unsigned char> bytes(image.rgb.size());
-    std::transform(image.rgb.begin(), image.rgb.end(), bytes.begin(), to_byte);
-    ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+OiioModule load_oiio_module() {
+  OiioModule m;
+#ifdef FLASHGS_OIIO_MODULE
+  // Where the build put it, else beside the running program (a copied build tree).
+  std::vector<std::string> places = {FLASHGS_OIIO_MODULE};
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) places.push_back((self.parent_path() / std::filesystem::path(FLASHGS_OIIO_MODULE).filename()).string());
+  void* handle = nullptr;
+  for (const std::string& place : places)
+    if ((handle = dlopen(place.c_str(), RTLD_NOW | RTLD_LOCAL))) break;
+  if (!handle) {
+    const char* why = dlerror();
+    m.why_not = std::string("the OpenImageIO module ") + FLASHGS_OIIO_MODULE + " did not load (" + (why ? why : "?") + ")";
+    return m;
   }
-  ok = out->close() && ok;
-  if (proxy.error_number()) file.write_failed(proxy.error_number());
-  if (!ok) throw Error(path + ": " + out->geterror());
-}
+  m.can_write = reinterpret_cast<decltype(m.can_write)>(dlsym(handle, "flashgs_oiio_can_write"));
+  m.write = reinterpret_cast<decltype(m.write)>(dlsym(handle, "flashgs_oiio_write"));
+  m.read = reinterpret_cast<decltype(m.read)>(dlsym(handle, "flashgs_oiio_read"));
+  if (!m.can_write || !m.write || !m.read) {
+    m = OiioModule{};
+    m.why_not = std::string("the OpenImageIO module ") + FLASHGS_OIIO_MODULE + " lacks its functions";
+  }
+#else
+  m.why_not = "this build has none";
 #endif
+  return m;
+}
+
+// Loaded once, at the first use (thread-safe).
+const OiioModule& oiio() {
+  static const OiioModule module = load_oiio_module();
+  return module;
+}
+
+// Encodes `image` with OpenImageIO into `file`; the format is the one `path`'s extension names.
+void write_with_oiio(const OiioModule& m, const Image& image, const std::string& path, const std::string& ext,
+                     OutputFile& file) {
+  const bool is_float = ext == "exr" || ext == "hdr" || ext == "tif" || ext == "tiff";
+  std::vector<unsigned char> bytes;
+  if (!is_float) {
+    bytes.resize(image.rgb.size());
+    std::transform(image.rgb.begin(), image.rgb.end(), bytes.begin(), to_byte);
+  }
+  const void* pixels = is_float ? static_cast<const void*>(image.rgb.data()) : bytes.data();
+  char error[1024] = "";
+  int write_errno = 0;
+  const int status = m.write(path.c_str(), file.descriptor(), file.temp_path().c_str(), image.width, image.height,
+                             is_float ? 1 : 0, pixels, &write_errno, error, sizeof error);
+  if (write_errno) file.write_failed(write_errno);
+  if (status != 0) throw Error(error);
+}
 
 }  // namespace
 
-bool image_io_has_oiio() {
-#ifdef FLASHGS_HAVE_OIIO
-  return true;
-#else
-  return false;
-#endif
-}
+bool image_io_has_oiio() { return oiio().why_not.empty(); }
 
 bool image_format_writable(const std::string& path) {
   const std::string ext = extension_of(path);
   if (ext == "ppm" || ext == "pfm") return true;
-#ifdef FLASHGS_HAVE_OIIO
-  if (!ext.empty() && OIIO::ImageOutput::create(path)) return true;
-  OIIO::geterror();  // clears the message, so that a later error does not carry it
-  return false;
-#else
-  return false;
-#endif
+  const OiioModule& m = oiio();
+  return m.why_not.empty() && !ext.empty() && m.can_write(path.c_str()) != 0;
 }
 
 void write_image(const Image& image, const std::string& path) {
   const std::string ext = extension_of(path);
   if (ext == "ppm") return write_ppm(image, path);
   if (ext == "pfm") return write_pfm(image, path);
-#ifdef FLASHGS_HAVE_OIIO
-  write_file_atomically(path, [&](OutputFile& file) { write_with_oiio(image, path, ext, file); });
-#else
-  throw Error(path + ": ." + ext + " needs OpenImageIO, which this build lacks; use .ppm or .pfm");
-#endif
+  const OiioModule& m = oiio();
+  if (!m.why_not.empty()) throw Error(path + ": ." + ext + " needs OpenImageIO: " + m.why_not + "; use .ppm or .pfm");
+  write_file_atomically(path, [&](OutputFile& file) { write_with_oiio(m, image, path, ext, file); });
 }
 
 Image read_image(const std::string& path) {
   const std::string ext = extension_of(path);
   if (ext == "ppm" || ext == "pfm") return read_netpbm(path);
-#ifdef FLASHGS_HAVE_OIIO
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error(path + ": cannot read (" + OIIO::geterror() + ")");
-  const OIIO::ImageSpec& spec = in->spec();
-  std::vector<float> pixels(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
-    throw Error(path + ": " + in->geterror());
+  const OiioModule& m = oiio();
+  if (!m.why_not.empty()) throw Error(path + ": reading ." + ext + " needs OpenImageIO: " + m.why_not);
+  struct Buffer {
+    std::vector<float> pixels;
+    int width = 0, height = 0, channels = 0;
+  } buffer;
+  auto take = [](void* context, int width, int height, int channels) -> float* {
+    Buffer& b = *static_cast<Buffer*>(context);
+    b.width = width;
+    b.height = height;
+    b.channels = channels;
+    b.pixels.assign(static_cast<std::size_t>(width) * height * channels, 0.0f);
+    return b.pixels.data();
+  };
+  char error[1024] = "";
+  if (m.read(path.c_str(), take, &buffer, error, sizeof error) != 0) throw Error(error);
   Image image;
-  image.resize(spec.width, spec.height);
-  for (std::size_t p = 0; p < static_cast<std::size_t>(spec.width) * spec.height; ++p)
+  image.resize(buffer.width, buffer.height);
+  for (std::size_t p = 0; p < static_cast<std::size_t>(buffer.width) * buffer.height; ++p)
     for (int ch = 0; ch < 3; ++ch)
-      image.rgb[p * 3 + ch] = pixels[p * spec.nchannels + std::min(ch, spec.nchannels - 1)];
+      image.rgb[p * 3 + ch] = buffer.pixels[p * buffer.channels + std::min(ch, buffer.channels - 1)];
   return image;
-#else
-  throw Error(path + ": reading ." + ext + " needs OpenImageIO, which this build lacks");
-#endif
 }
 
 }  // namespace flashgs

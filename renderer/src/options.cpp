@@ -47,7 +47,8 @@ bool operator==(const RenderOptions& a, const RenderOptions& b) {
   return a.algorithm == b.algorithm && a.kernel == b.kernel && a.tau == b.tau && a.sh_degree_cap == b.sh_degree_cap &&
          a.fp16_sh == b.fp16_sh && a.fp16_shape == b.fp16_shape &&
          a.fp16_blend == b.fp16_blend &&
-         a.collect_tile_counts == b.collect_tile_counts && std::equal(a.background, a.background + 3, b.background);
+         a.collect_tile_counts == b.collect_tile_counts &&
+         a.collect_pixel_planes == b.collect_pixel_planes && std::equal(a.background, a.background + 3, b.background);
 }
 
 std::vector<RenderOptions> single_switch_configs() {

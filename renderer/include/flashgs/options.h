@@ -52,6 +52,10 @@ struct RenderOptions {
   // with exp2_alpha (the float expf loop has no half form); the CPU renders the exact image.
   bool fp16_blend = false;
   bool collect_tile_counts = false;  // fill FrameStats::tile_pair_counts
+  // Fill FrameStats::pixel_depth and pixel_blended (the debug views) from the walk that makes
+  // the colour: on the CPU the scalar blend kernel, on CUDA the per-pixel (3DGS) blend kernel,
+  // whatever the algorithm (the image is the same; the frame is slower).
+  bool collect_pixel_planes = false;
 
   // The options of the original 3DGS rasterizer (every switch off).
   static RenderOptions baseline();

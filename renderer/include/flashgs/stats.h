@@ -34,6 +34,12 @@ struct FrameStats {
   // RenderOptions::collect_tile_counts is set.
   std::vector<std::uint32_t> tile_pair_counts;
   std::uint32_t max_tile_pairs = 0;
+  // Per pixel, row-major width x height, filled only when RenderOptions::collect_pixel_planes
+  // is set: the alpha-weighted mean view depth of the Gaussians blended there,
+  // sum(w_i z_i) / sum(w_i) with w_i = alpha_i T_i (NaN where none was), and how many were
+  // blended (alpha >= 1/255 before the pixel's transmittance stopped it).
+  std::vector<float> pixel_depth;
+  std::vector<std::uint32_t> pixel_blended;
 
   std::uint64_t gaussians = 0;          // in the scene
   std::uint64_t visible = 0;            // emitted at least one pair
