@@ -360,6 +360,7 @@ TEST(LodStream, TheFramesWorkingMemoryIsInsideTheCap) {
   EXPECT_GT(scene->size(), 0u);
   EXPECT_LE(s.host_high_water, options.host_bytes);
   EXPECT_GE(s.host_bytes, options.host_frame.fixed + scene->size() * (scene_bytes + options.host_frame.per_gaussian));
+  EXPECT_GE(s.host_high_water, s.host_bytes) << "the high-water mark is below what is held now";
 }
 
 TEST(LodStream, ACorruptChunkIsOneLineAndTheRestKeepsRendering) {

@@ -298,6 +298,7 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
     std::lock_guard<std::mutex> lock(m_mutex);
     // The scene drawn now and the frame that renders it.
     m_drawn_bytes = m_scene->size() * (m_bytes_per_gaussian + m_options.host_frame.per_gaussian) + m_options.host_frame.fixed;
+    m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
   }
   m_stats.drawn_gaussians = m_scene->size();
   return m_scene;
