@@ -17,6 +17,8 @@
 namespace flashgs {
 namespace cuda {
 
+static_assert(kChunkSize == kScenePartPageGaussians, "a pool page is a chunk of the chunk cull");
+
 // The sphere around a drawn set's centres and its largest opacity (what a frame's key format
 // and chunk test need of the scene).
 struct SceneBounds {

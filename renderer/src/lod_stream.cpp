@@ -24,9 +24,8 @@ namespace {
 // Gaussian-tile pairs per drawn Gaussian that the frame costs are sized for (flash on the real
 // scenes: 1.5-6 at 1080p).
 constexpr std::uint64_t kPairsPerGaussian = 4;
-// What a GPU renderer's pool of parts adds per drawn Gaussian (an id), and its page (ScenePool).
+// What a GPU renderer's pool of parts adds per drawn Gaussian (an id).
 constexpr std::uint64_t kDeviceIdBytes = 4;
-constexpr std::uint64_t kDevicePage = 256;
 // Frames of the camera's last step to look ahead when prefetching.
 constexpr float kPrefetchFrames = 8.0f;
 
@@ -90,7 +89,7 @@ LodStreamer::LodStreamer(LodSet set, LodStreamOptions options) : m_set(std::move
     // each Gaussian with a 4-byte id, and stages uploads in up to a sixteenth of the cap.
     const std::uint64_t cap = options.device_bytes;
     const std::uint64_t per_gaussian = m_bytes_per_gaussian + kDeviceIdBytes;
-    const std::uint64_t held = options.device_frame.fixed + cap / 16 + m_set.leaves.size() * kDevicePage * per_gaussian;
+    const std::uint64_t held = options.device_frame.fixed + cap / 16 + m_set.leaves.size() * kScenePartPageGaussians * per_gaussian;
     m_budget = std::min(m_budget, cap > held ? (cap - held) / (per_gaussian + options.device_frame.per_gaussian) : 0);
   }
   m_chunk_cap = std::numeric_limits<std::uint64_t>::max();

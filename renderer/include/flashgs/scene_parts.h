@@ -11,6 +11,10 @@
 
 namespace flashgs {
 
+// Gaussians per page of a GPU backend's pool of parts (the CUDA backend's chunk): a part takes
+// whole pages, so a cap on GPU memory must allow for each part's last page partly empty.
+constexpr std::size_t kScenePartPageGaussians = 256;
+
 // Gaussians [first, first + count) of `source`. Two parts with the same key hold the same
 // Gaussians for as long as either is in use (a LOD set's chunk file and offset).
 struct ScenePart {
