@@ -6,6 +6,8 @@
 #include "flashgs/error.h"
 
 #ifdef FLASHGS_HAVE_CUDA
+#include <cuda_runtime_api.h>
+
 #include "flashgs/cuda_renderer.h"
 #endif
 
@@ -65,6 +67,28 @@ void finish_queued_frames(Renderer& renderer) {
   }
 #endif
   throw Error("internal error: the " + renderer.name() + " backend cannot queue frames");
+}
+
+void render_to_device(Renderer& renderer, const Camera& camera, const RenderOptions& options, void* destination,
+                      void* producer_stream, FrameStats* stats, const std::string& name) {
+#ifdef FLASHGS_HAVE_CUDA
+  if (auto* cuda = dynamic_cast<CudaRenderer*>(&renderer)) {
+    if (producer_stream) {  // the frame's copy into the buffer waits for the producer's work
+      cudaEvent_t produced = nullptr;
+      cudaError_t status = cudaEventCreateWithFlags(&produced, cudaEventDisableTiming);
+      if (status == cudaSuccess) status = cudaEventRecord(produced, static_cast<cudaStream_t>(producer_stream));
+      if (status == cudaSuccess) status = cudaStreamWaitEvent(static_cast<cudaStream_t>(cuda->stream()), produced, 0);
+      if (produced) cudaEventDestroy(produced);
+      if (status != cudaSuccess)
+        throw Error(name + ": cannot wait for the stream that made it (" + cudaGetErrorString(status) + ")");
+    }
+    cuda->render_to_device(camera, options, destination, stats);
+    return;
+  }
+#else
+  (void)camera, (void)options, (void)destination, (void)producer_stream, (void)stats;
+#endif
+  throw Error(name + ": the " + renderer.name() + " backend renders into host memory; a CUDA array needs backend=\"cuda\"");
 }
 
 }  // namespace flashgs::cli

@@ -30,4 +30,11 @@ void render_queued(Renderer& renderer, const Camera& camera, const RenderOptions
 // Waits until the frames render_queued queued have finished. Only where can_queue_frames.
 void finish_queued_frames(Renderer& renderer);
 
+// Renders a frame into `destination`, a device buffer of height x width x 3 floats (the CUDA
+// backend: CudaRenderer::render_to_device), after the work queued on `producer_stream` (a
+// cudaStream_t, 0 for none) so far; finished when it returns. Throws flashgs::Error naming
+// `name` on another backend.
+void render_to_device(Renderer& renderer, const Camera& camera, const RenderOptions& options, void* destination,
+                      void* producer_stream, FrameStats* stats, const std::string& name);
+
 }  // namespace flashgs::cli

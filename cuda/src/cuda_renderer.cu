@@ -365,6 +365,12 @@ class CudaRendererImpl final : public CudaRenderer {
     run_frame(camera, options, FrameTarget::device_image, nullptr, 0, stats);
   }
 
+  void render_to_device(const Camera& camera, const RenderOptions& options, void* destination,
+                        FrameStats* stats) override {
+    if (!destination) throw Error("cuda renderer: no device buffer to render into");
+    run_frame(camera, options, FrameTarget::device_copy, nullptr, 0, stats, destination);
+  }
+
   void finish() override { check_cuda(cudaStreamSynchronize(stream_), "frame"); }
 
   // The debug planes of the last frame (per_pixel_options), waited for.
@@ -700,9 +706,10 @@ class CudaRendererImpl final : public CudaRenderer {
                   std::to_string(camera.height) + " frame");
   }
 
-  // Where a frame's pixels go: the host (render: downloaded, the frame waited for), a surface
-  // or the device image (render_to_surface, render_queued: neither).
-  enum class FrameTarget { host_image, surface, device_image };
+  // Where a frame's pixels go: the host (render: downloaded, the frame waited for), a caller's
+  // device buffer (render_to_device: copied there, waited for), a surface or the device image
+  // (render_to_surface, render_queued: neither).
+  enum class FrameTarget { host_image, device_copy, surface, device_image };
 
   // What the work after the pair count needs of its frame (run_frame).
   struct FramePlan {
@@ -711,11 +718,14 @@ class CudaRendererImpl final : public CudaRenderer {
     const RenderOptions* options;
     const cuda::PreprocessArgs* args;
     Image* out;
+    void* device_out;  // render_to_device's buffer
     std::uint64_t surface;
-    bool float_image;  // the blend writes the device image (out, or a queued frame)
+    bool float_image;  // the blend writes the device image (out, device_out, or a queued frame)
     std::uint64_t tiles, bins, pixels;
     bool baseline, fused, binned;
     bool sort_follows_project;  // nothing is queued between the project and sort stages
+    // The host waits for the frame's end (its image goes to the host or a caller's buffer).
+    bool waited() const { return out != nullptr || device_out != nullptr; }
   };
 
   // Queues the frame's work after preprocess: separate emission, sort, ranges, blend, the
@@ -824,6 +834,10 @@ class CudaRendererImpl final : public CudaRenderer {
       check_cuda(cudaMemcpyAsync(out->rgb.data(), b.image_rgb, f.pixels * 3 * sizeof(float), cudaMemcpyDeviceToHost,
                                  stream_),
                  "image download");
+    } else if (f.device_out) {
+      check_cuda(cudaMemcpyAsync(f.device_out, b.image_rgb, f.pixels * 3 * sizeof(float), cudaMemcpyDeviceToDevice,
+                                 stream_),
+                 "image copy to the caller's device buffer");
     }
   }
 
@@ -839,7 +853,7 @@ class CudaRendererImpl final : public CudaRenderer {
   // Renders one frame: its path planned, its buffers sized, its preprocess queued and its
   // counts read back, then the rest of its work queued; its statistics where asked for.
   void run_frame(const Camera& camera, const RenderOptions& asked, FrameTarget target, Image* out,
-                 std::uint64_t surface, FrameStats* stats_out) {
+                 std::uint64_t surface, FrameStats* stats_out, void* device_out = nullptr) {
     const RenderOptions options = asked.collect_pixel_planes ? per_pixel_options(asked) : asked;
     if (!scene_ && !pooled_) throw Error("cuda renderer: no scene set");
     if (camera.width < 1 || camera.height < 1) throw Error("cuda renderer: image size must be at least 1x1");
@@ -868,9 +882,9 @@ class CudaRendererImpl final : public CudaRenderer {
     // back at its end, after the blend: a copy between preprocess and sort kept the GPU idle
     // for 15-25 us on the H200 machine. A surface frame reads them back at once, so that
     // the host can go on while the GPU blends.
-    const bool count_at_end = queue_before_count && out;
+    const bool count_at_end = queue_before_count && (out || device_out);
     separate_emit_[event_set_] = !path.fused;
-    const FramePlan frame{&camera,    &path.cam,  &options,    &args,         out,        surface,     path.float_image,
+    const FramePlan frame{&camera,    &path.cam,  &options,    &args,         out,        device_out, surface,     path.float_image,
                           path.tiles, path.bins, path.pixels, path.baseline, path.fused, path.binned, count_at_end};
     const std::uint64_t pairs =
         queue_preprocess_and_read_back(frame, queue_before_count, count_at_end, previous_set, previous_complete);
@@ -1065,14 +1079,13 @@ class CudaRendererImpl final : public CudaRenderer {
     const cuda::PreprocessArgs& args = *frame.args;
     const std::uint64_t tiles = frame.tiles;
     const bool fused = frame.fused, binned = frame.binned;
-    Image* out = frame.out;
     if (args.warp_cooperative && fused)
       grow_deferred(readback_->counters.deferred, readback_->counters.deferred_items);
     last_tiles_ = tiles;
     last_bin_pairs_ = binned ? pairs : 0;
     last_records_ = compact_records_ ? readback_->counters.records : 0;
     last_frame_binned_ = binned;
-    if (out) {
+    if (frame.waited()) {
       check_cuda(cudaStreamSynchronize(stream_), "frame");
       settle(event_set_);
     }
@@ -1085,7 +1098,6 @@ class CudaRendererImpl final : public CudaRenderer {
     const RenderOptions& options = *frame.options;
     const std::size_t n = device_scene_.count;
     const bool binned = frame.binned;
-    Image* out = frame.out;
     FrameStats stats;
     const cuda::FrameCounters& c = readback_->counters;
     stats.sorted_pairs = pairs;
@@ -1101,7 +1113,7 @@ class CudaRendererImpl final : public CudaRenderer {
     // GPU time of each stage between events; host gaps (the pair-count wait) are not counted.
     // A surface frame is not waited for (the caller presents it while the GPU finishes): it
     // reports the previous frame's times, complete since this frame's pair-count wait.
-    if (out || !previous_complete) {
+    if (frame.waited() || !previous_complete) {
       check_cuda(cudaStreamSynchronize(stream_), "frame");
       stats.times = stage_times(event_set_);
       stats.max_tile_pairs = readback_->tile_totals[event_set_].max_tile_pairs;

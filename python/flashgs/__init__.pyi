@@ -7,6 +7,7 @@ import numpy.typing as npt
 FloatArray = npt.NDArray[np.float32]
 ArrayLike = Any  # a numpy array, a torch tensor (CPU, or CUDA with __cuda_array_interface__), a list
 Backend = Literal["auto", "cpu", "cuda"]
+Output = Literal["numpy", "torch"]
 
 __version__: str
 has_cuda: bool  # whether this build has the CUDA backend
@@ -152,12 +153,19 @@ class Renderer:
     def render(self, scene: Scene, camera: Sequence[Camera], width: Optional[int] = None,
                height: Optional[int] = None, options: Optional[RenderOptions] = None,
                **switches: Any) -> List[Frame]: ...
+    def render_into(self, scene: Scene, camera: Camera, out: Any, width: Optional[int] = None,
+                    height: Optional[int] = None, options: Optional[RenderOptions] = None,
+                    **switches: Any) -> FrameStats: ...
+    @staticmethod
+    def frame_size(camera: Camera, width: Optional[int] = None, height: Optional[int] = None) -> Tuple[int, int]: ...
 
 def load_scene(path: str, lod: Optional[int] = None) -> Scene: ...
 def load_cameras(path: str) -> List[Camera]: ...
 @overload
 def render(scene: Scene, camera: Camera, width: Optional[int] = None, height: Optional[int] = None,
-           backend: Backend = "auto", options: Optional[RenderOptions] = None, **switches: Any) -> Frame: ...
+           backend: Backend = "auto", options: Optional[RenderOptions] = None, output: Output = "numpy",
+           **switches: Any) -> Tuple[Any, FrameStats]: ...
 @overload
 def render(scene: Scene, camera: Sequence[Camera], width: Optional[int] = None, height: Optional[int] = None,
-           backend: Backend = "auto", options: Optional[RenderOptions] = None, **switches: Any) -> List[Frame]: ...
+           backend: Backend = "auto", options: Optional[RenderOptions] = None, output: Output = "numpy",
+           **switches: Any) -> List[Tuple[Any, FrameStats]]: ...

@@ -22,26 +22,50 @@ std::vector<py::ssize_t> byte_strides(const std::vector<py::ssize_t>& shape) {
   return strides;
 }
 
-// The array described by a __cuda_array_interface__ dictionary, copied to the host: float32 and
-// C-contiguous only, so that one copy brings it over.
-py::array_t<float> copy_cuda_array(const py::dict& interface, const std::string& name) {
-  const std::string type = py::str(interface["typestr"]);
+std::string shape_text(const std::vector<py::ssize_t>& shape) {
+  std::string text = "(";
+  for (std::size_t k = 0; k < shape.size(); ++k) text += (k ? ", " : "") + std::to_string(shape[k]);
+  return text + (shape.size() == 1 ? ",)" : ")");
+}
+
+// A __cuda_array_interface__ dictionary that we can read or write in one copy: float32,
+// C-contiguous, unmasked.
+struct CudaInterface {
   std::vector<py::ssize_t> shape;
-  for (py::handle extent : py::tuple(interface["shape"])) shape.push_back(extent.cast<py::ssize_t>());
+  std::uintptr_t data = 0;
+  bool readonly = false;
+  bool has_stream = false;
+  py::object stream;  // the "stream" entry (version 3)
+};
+
+CudaInterface contiguous_float_interface(const py::dict& interface, const std::string& name) {
+  CudaInterface a;
+  const std::string type = py::str(interface["typestr"]);
+  for (py::handle extent : py::tuple(interface["shape"])) a.shape.push_back(extent.cast<py::ssize_t>());
   bool contiguous = true;  // strides None (or left out) mean C order
   if (interface.contains("strides") && !interface["strides"].is_none()) {
     std::vector<py::ssize_t> strides;
     for (py::handle stride : py::tuple(interface["strides"])) strides.push_back(stride.cast<py::ssize_t>());
-    contiguous = strides == byte_strides(shape);
+    contiguous = strides == byte_strides(a.shape);
   }
   if (type != "<f4" || !contiguous)
     throw Error(name + ": a CUDA array must be contiguous float32 (it is " + type +
                 (contiguous ? "" : ", strided") + "; use tensor.float().contiguous())");
   if (interface.contains("mask") && !interface["mask"].is_none())
     throw Error(name + ": masked CUDA arrays are not supported");
-  const auto device = py::tuple(interface["data"])[0].cast<std::uintptr_t>();
-  py::array_t<float> host(shape);
-  copy_from_device(host.mutable_data(), device, static_cast<std::size_t>(host.size()) * sizeof(float), name);
+  const py::tuple data(interface["data"]);
+  a.data = data[0].cast<std::uintptr_t>();
+  a.readonly = data[1].cast<bool>();
+  a.has_stream = interface.contains("stream");
+  a.stream = a.has_stream ? py::object(interface["stream"]) : py::object(py::none());
+  return a;
+}
+
+// The array described by a __cuda_array_interface__ dictionary, copied to the host.
+py::array_t<float> copy_cuda_array(const py::dict& interface, const std::string& name) {
+  const CudaInterface a = contiguous_float_interface(interface, name);
+  py::array_t<float> host(a.shape);
+  copy_from_device(host.mutable_data(), a.data, static_cast<std::size_t>(host.size()) * sizeof(float), name);
   return host;
 }
 
@@ -70,6 +94,31 @@ py::array_t<float> host_float_array(py::handle object, const std::string& name) 
   return array;
 }
 
+DeviceArray writable_cuda_array(py::handle object, const std::string& name, const std::vector<py::ssize_t>& shape) {
+  if (!py::hasattr(object, "__cuda_array_interface__"))
+    throw Error(name + ": expected a CUDA array (e.g. a torch tensor on the GPU), got " +
+                std::string(py::str(py::type::handle_of(object).attr("__name__"))));
+  const CudaInterface a = contiguous_float_interface(object.attr("__cuda_array_interface__").cast<py::dict>(), name);
+  if (a.shape != shape)
+    throw Error(name + ": expected shape " + shape_text(shape) + " for the frame, got " + shape_text(a.shape));
+  if (a.readonly) throw Error(name + ": the CUDA array is read-only");
+  if (a.data == 0) throw Error(name + ": the CUDA array has no memory");
+  DeviceArray d;
+  d.data = reinterpret_cast<void*>(a.data);
+  // Our frames run on a non-blocking stream, which follows no other: the copy into the array
+  // waits for the producer's stream, an integer in version 3 of the interface (1 and 2 are the
+  // legacy and per-thread default streams, handles the CUDA runtime takes as they are). None
+  // says nothing is pending; without the entry (version 2) or with the ambiguous 0 we wait for
+  // the legacy default stream, where such producers queue their work.
+  if (!a.stream.is_none()) {
+    const auto stream = a.stream.cast<std::uintptr_t>();
+    d.stream = reinterpret_cast<void*>(stream != 0 ? stream : 1);
+  } else if (!a.has_stream) {
+    d.stream = reinterpret_cast<void*>(std::uintptr_t{1});
+  }
+  return d;
+}
+
 std::vector<float> checked_floats(const py::array_t<float>& array, const std::string& name,
                                   const std::vector<py::ssize_t>& shape) {
   bool fits = array.ndim() == static_cast<py::ssize_t>(shape.size());
@@ -85,9 +134,7 @@ std::vector<float> checked_floats(const py::array_t<float>& array, const std::st
 }
 
 std::string shape_text(const py::array& array) {
-  std::string text = "(";
-  for (py::ssize_t k = 0; k < array.ndim(); ++k) text += (k ? ", " : "") + std::to_string(array.shape(k));
-  return text + (array.ndim() == 1 ? ",)" : ")");
+  return shape_text(std::vector<py::ssize_t>(array.shape(), array.shape() + array.ndim()));
 }
 
 }  // namespace flashgs::python

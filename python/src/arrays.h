@@ -25,6 +25,17 @@ py::array_t<float> array_owning(std::vector<float>&& values, const std::vector<p
 // `name` when it is none of these.
 py::array_t<float> host_float_array(py::handle object, const std::string& name);
 
+// A CUDA array to write a frame into: its device address and the stream whose work so far it
+// depends on (a cudaStream_t; null: none).
+struct DeviceArray {
+  void* data = nullptr;
+  void* stream = nullptr;
+};
+
+// `object`'s __cuda_array_interface__ when it is a writable, C-contiguous float32 array of
+// `shape`; throws flashgs::Error naming `name` otherwise.
+DeviceArray writable_cuda_array(py::handle object, const std::string& name, const std::vector<py::ssize_t>& shape);
+
 // The rows of `array` (shape (rows, columns...)) as floats, after checking its shape: `dims`
 // dimensions, each of `shape` equal where it is not -1. Throws flashgs::Error naming `name`.
 std::vector<float> checked_floats(const py::array_t<float>& array, const std::string& name,

@@ -48,6 +48,25 @@ class PyRenderer {
     return py::make_tuple(array_owning(std::move(image.rgb), {h, w, 3}), std::move(stats));
   }
 
+  // One frame into `out`, a CUDA array of (H, W, 3) float32 (a torch tensor on the GPU): the
+  // image never leaves the device. Returns the statistics.
+  FrameStats render_into(const PyScene& scene, const Camera& camera, const RenderOptions& options,
+                         const py::object& out) {
+    const DeviceArray target = writable_cuda_array(out, "out", {camera.height, camera.width, 3});
+    check_fits(camera, scene.scene->size());
+    FrameStats stats;
+    {
+      py::gil_scoped_release unlocked;
+      std::lock_guard<std::mutex> one_frame_at_a_time(m_mutex);
+      if (m_scene != scene.scene) {
+        m_renderer->set_scene(scene.scene);
+        m_scene = scene.scene;
+      }
+      cli::render_to_device(*m_renderer, camera, options, target.data, target.stream, &stats, "out");
+    }
+    return stats;
+  }
+
  private:
   // Refuses a frame whose working memory this process cannot get, as `flashgs render` does.
   void check_fits(const Camera& camera, std::size_t gaussians) const {
@@ -108,7 +127,28 @@ void bind_renderer(py::module_& m) {
           py::arg("options") = py::none(),
           "Renders `camera` (or each of a sequence of cameras) of `scene`: (image, stats) with the image an "
           "(H, W, 3) float32 numpy array, row 0 at the top. width/height resize the camera (field of view kept); "
-          "keywords set RenderOptions on top of `options`.");
+          "keywords set RenderOptions on top of `options`.")
+      .def(
+          "render_into",
+          [](PyRenderer& self, const PyScene& scene, const Camera& camera, py::object out, std::optional<int> width,
+             std::optional<int> height, std::optional<PyRenderOptions> options, const py::kwargs& switches) {
+            const PyRenderOptions chosen = with_options(options.value_or(PyRenderOptions{}), switches);
+            return self.render_into(scene, sized(camera, width, height), chosen.resolved(*scene.scene), out);
+          },
+          py::arg("scene"), py::arg("camera"), py::arg("out"), py::arg("width") = py::none(),
+          py::arg("height") = py::none(), py::arg("options") = py::none(),
+          "Renders `camera` of `scene` into `out`, a CUDA array (__cuda_array_interface__, e.g. a torch tensor "
+          "on the GPU) of shape (H, W, 3) float32, C-contiguous, on the CUDA backend: the image stays on the "
+          "device. The frame waits for the work queued on the array's stream and is finished when this "
+          "returns. Returns the FrameStats.")
+      .def_static(
+          "frame_size",
+          [](const Camera& camera, std::optional<int> width, std::optional<int> height) {
+            const Camera c = sized(camera, width, height);
+            return py::make_tuple(c.width, c.height);
+          },
+          py::arg("camera"), py::arg("width") = py::none(), py::arg("height") = py::none(),
+          "(width, height) of the frame render() makes of `camera` with these width/height arguments.");
 }
 
 }  // namespace flashgs::python

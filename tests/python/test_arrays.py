@@ -159,3 +159,23 @@ def test_cuda_arrays_are_read_through_their_interface():
     expected = "means: cannot copy the CUDA array" if flashgs.has_cuda else "means: a CUDA array, but this build"
     with pytest.raises(flashgs.Error, match=expected):
         flashgs.Scene.from_arrays(**{**good, "means": FakeCudaArray((2, 3), strides=(12, 4))})
+
+
+def test_render_into_checks_the_array_before_the_backend(demo_scene, demo_cameras):
+    camera = demo_cameras[0]
+    w, h = flashgs.Renderer.frame_size(camera, width=64)
+    image, _ = flashgs.render(demo_scene, camera, width=64, backend="cpu")
+    assert image.shape == (h, w, 3)  # frame_size is the size render() makes
+    cpu = flashgs.Renderer("cpu")
+    with pytest.raises(flashgs.Error, match=r"out: expected a CUDA array \(e.g. a torch tensor on the GPU\), got ndarray"):
+        cpu.render_into(demo_scene, camera, np.zeros((h, w, 3), np.float32), width=64)
+    with pytest.raises(flashgs.Error, match=rf"out: expected shape \({h}, {w}, 3\) for the frame, got \(2, 3\)"):
+        cpu.render_into(demo_scene, camera, FakeCudaArray((2, 3)), width=64)
+    read_only = FakeCudaArray((h, w, 3))
+    read_only.__cuda_array_interface__["data"] = (0x10, True)
+    with pytest.raises(flashgs.Error, match="out: the CUDA array is read-only"):
+        cpu.render_into(demo_scene, camera, read_only, width=64)
+    with pytest.raises(flashgs.Error, match=r'out: the cpu .*backend renders into host memory; a CUDA array needs backend="cuda"'):
+        cpu.render_into(demo_scene, camera, FakeCudaArray((h, w, 3)), width=64)
+    with pytest.raises(flashgs.Error, match='output: expected "numpy" or "torch", got \'cupy\''):
+        flashgs.render(demo_scene, camera, backend="cpu", output="cupy")

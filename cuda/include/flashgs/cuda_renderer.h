@@ -30,6 +30,13 @@ class CudaRenderer : public Renderer {
   // the host's launches for the next frame overlap this one's GPU work (`flashgs bench` times
   // these). `stats` as render_to_surface; a later render() waits for every queued frame.
   virtual void render_queued(const Camera& camera, const RenderOptions& options, FrameStats* stats) = 0;
+  // Renders as render() does (this frame's statistics, the frame finished when it returns) but
+  // copies the float RGB image (height x width x 3, row 0 the top) into `destination`, a buffer
+  // of that many floats on this renderer's device, instead of the host: for callers whose
+  // frames stay on the GPU (a PyTorch tensor). Work the caller queued elsewhere that the buffer
+  // depends on must be finished or waited for on stream() first.
+  virtual void render_to_device(const Camera& camera, const RenderOptions& options, void* destination,
+                                FrameStats* stats) = 0;
   // Returns once every queued frame has finished on the GPU.
   virtual void finish() = 0;
   // Per-tile pair counts of the last frame (row-major tiles_y x tiles_x), copied from the
