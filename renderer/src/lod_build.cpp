@@ -277,18 +277,6 @@ struct TemporaryFolder {
   }
 };
 
-void prepare_output(const fs::path& folder) {
-  std::error_code error;
-  const fs::file_status status = fs::status(folder, error);
-  if (fs::exists(status)) {
-    if (!fs::is_directory(status)) fail(folder.string(), "exists and is not a folder");
-    if (!fs::is_empty(folder, error)) fail(folder.string(), "is not empty: name a new or empty folder for the LOD set");
-    return;
-  }
-  if (!fs::create_directories(folder, error) || error)
-    fail(folder.string(), "cannot create the folder: " + error.message());
-}
-
 LodBox bound_of(const Scene& scene) {
   LodBox box;
   box.min.fill(std::numeric_limits<float>::max());
@@ -350,6 +338,19 @@ int emit_tree(const std::vector<KdNode>& kd, int node, const std::vector<int>& n
 
 }  // namespace
 
+void prepare_lod_folder(const std::string& folder_name) {
+  const fs::path folder(folder_name);
+  std::error_code error;
+  const fs::file_status status = fs::status(folder, error);
+  if (fs::exists(status)) {
+    if (!fs::is_directory(status)) fail(folder.string(), "exists and is not a folder");
+    if (!fs::is_empty(folder, error)) fail(folder.string(), "is not empty: name a new or empty folder for the LOD set");
+    return;
+  }
+  if (!fs::create_directories(folder, error) || error)
+    fail(folder.string(), "cannot create the folder: " + error.message());
+}
+
 LodBuildReport build_lod_set(const std::string& input, const std::string& out_folder, const LodBuildOptions& options) {
   if (options.leaf_gaussians < 1) fail(out_folder, "the leaf size must be at least 1 Gaussian");
   if (options.file_gaussians < 1) fail(out_folder, "the chunk file size must be at least 1 Gaussian");
@@ -358,7 +359,7 @@ LodBuildReport build_lod_set(const std::string& input, const std::string& out_fo
   };
   GaussianBatches source(input);
   const fs::path folder(out_folder);
-  prepare_output(folder);
+  prepare_lod_folder(folder.string());
   TemporaryFolder temporary{folder / ".lod-build-tmp"};
   std::error_code error;
   if (!fs::create_directory(temporary.path, error)) fail(temporary.path.string(), "cannot create: " + error.message());

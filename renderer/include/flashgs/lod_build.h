@@ -35,6 +35,10 @@ struct LodBuildReport {
 
 // Builds the set in `out_folder` (created; it must be empty or absent) from the scene file
 // `input`. Throws flashgs::Error with one line naming the file or folder and the problem.
+// Makes `folder` ready for a new LOD set: created, or kept when it is an empty folder; throws
+// flashgs::Error naming it otherwise.
+void prepare_lod_folder(const std::string& folder);
+
 LodBuildReport build_lod_set(const std::string& input, const std::string& out_folder, const LodBuildOptions& options);
 
 }  // namespace flashgs
