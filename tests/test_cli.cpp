@@ -835,6 +835,8 @@ TEST(CliLodCity, ACityOfASetFliesOnTheCpuAndBadOptionsAreOneLine) {
       {"lod city" + base + " --blocks 2 --spacing nan", "--spacing"},
       {"lod city" + base + " --blocks 2 --spacing -1", "--spacing"},
       {"lod city" + base + " --blocks 2 --cameras 1", "--cameras"},
+      {"lod city" + base + " --blocks 2 --chunk-format sog", "--chunk-format requires --materialize"},
+      {"lod city" + base + " --blocks 2 --materialize --chunk-format webp", "--chunk-format"},
       {"lod city " + dir + "/city " + dir + "/refused --blocks 2", "already an instanced set"},
       {"lod city " + dir + "/nothing " + dir + "/refused --blocks 2", dir + "/nothing"},
       {"lod city " + dir + "/base " + dir + "/city --blocks 2", "is not empty"},

@@ -58,7 +58,8 @@ const std::string& base_set() {
   return folder;
 }
 
-std::string city_of(int blocks, const std::string& name, bool materialize = false) {
+std::string city_of(int blocks, const std::string& name, bool materialize = false,
+                    LodChunkFormat format = LodChunkFormat::ply) {
   const std::string out = scratch(name);
   LodCityOptions options;
   options.blocks = blocks;
@@ -67,6 +68,7 @@ std::string city_of(int blocks, const std::string& name, bool materialize = fals
   options.width = 320;
   options.height = 180;
   options.materialize = materialize;
+  options.chunk_format = format;
   write_lod_city(base_set(), out, options);
   return out;
 }
@@ -243,6 +245,14 @@ TEST(LodInstance, AMaterializedCityIsAPlainSetOfTheSameGaussians) {
   renderer->set_scene(std::make_shared<Scene>(b));
   renderer->render(camera, RenderOptions{}, y, nullptr);
   EXPECT_GT(compare_images(x, y).psnr_db, 80.0);
+  // SOG chunks (what PlayCanvas's viewers stream) hold the same Gaussians, quantised.
+  const std::string sog = city_of(2, "sog", true, LodChunkFormat::sog);
+  EXPECT_TRUE(fs::exists(sog + "/chunk-0/meta.json"));
+  const Scene c = read_sog_lod(sog + "/lod-meta.json", 0);
+  ASSERT_EQ(c.size(), a.size());
+  renderer->set_scene(std::make_shared<Scene>(c));
+  renderer->render(camera, RenderOptions{}, y, nullptr);
+  EXPECT_GT(compare_images(x, y).psnr_db, 25.0);
 }
 
 // A set whose meta is `tree` with `instances` (JSON text) beside the base's first chunk.

@@ -79,9 +79,11 @@ void run_build(const BuildArgs& args) {
 struct CityArgs {
   std::string base, output;
   LodCityOptions options;
+  std::string chunk_format = "ply";
 };
 
-void run_city(const CityArgs& args) {
+void run_city(CityArgs args) {
+  args.options.chunk_format = args.chunk_format == "sog" ? LodChunkFormat::sog : LodChunkFormat::ply;
   const auto t0 = Clock::now();
   const LodCityReport r = write_lod_city(args.base, args.output, args.options);
   const double seconds = ms_between(t0, Clock::now()) / 1000.0;
@@ -291,12 +293,18 @@ void register_lod(CLI::App& app) {
       ->check(CLI::Range(1, 65536));
   c->add_option("--spacing", city->options.spacing, "between block centres, in scene units (default: 1.1 x the base's width)")
       ->check(finite_in(1e-6, 1e9));
-  c->add_option("--up", city->options.up, "the base's up axis")->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
-  c->add_option("--cameras", city->options.path_cameras, "cameras of the fly-through written to cameras.json")
+  c->add_option("--up", city->options.up, "the base's up axis (default +z)")
+      ->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
+  c->add_option("--cameras", city->options.path_cameras, "cameras of the fly-through written to cameras.json (default 60)")
       ->check(whole_number())
       ->check(CLI::Range(2, 10000));
-  c->add_flag("--materialize", city->options.materialize,
-              "write each block's chunks moved for real (a plain set PlayCanvas can read; blocks x the base's bytes)");
+  CLI::Option* materialize = c->add_flag(
+      "--materialize", city->options.materialize,
+      "write each block's chunks moved for real: a plain set without our instance keys, blocks x the base's bytes");
+  c->add_option("--chunk-format", city->chunk_format,
+                "with --materialize: ply (default) or sog (SOG chunk folders, which PlayCanvas's viewers stream)")
+      ->check(CLI::IsMember({"ply", "sog"}))
+      ->needs(materialize);
   c->callback([city] { run_city(*city); });
 
   auto fly = std::make_shared<FlyArgs>();

@@ -67,7 +67,7 @@ std::uint64_t file_bytes(const std::string& path) {
 
 }  // namespace
 
-std::uint64_t materialize_lod_set(const LodSet& set, const std::string& out_folder) {
+std::uint64_t materialize_lod_set(const LodSet& set, const std::string& out_folder, LodChunkFormat format) {
   prepare_lod_folder(out_folder);
   LodSet plain = set;
   plain.folder = out_folder;
@@ -75,10 +75,8 @@ std::uint64_t materialize_lod_set(const LodSet& set, const std::string& out_fold
   plain.file_instance.clear();
   std::uint64_t written = 0;
   for (std::size_t f = 0; f < set.files.size(); ++f) {
-    plain.files[f] = "chunk-" + std::to_string(f) + ".ply";
-    const std::string path = (fs::path(out_folder) / plain.files[f]).string();
-    save_ply(read_lod_set_chunk(set, static_cast<int>(f)), path);
-    written += file_bytes(path);
+    plain.files[f] = lod_chunk_name("chunk-" + std::to_string(f), format);
+    written += write_lod_chunk(read_lod_set_chunk(set, static_cast<int>(f)), (fs::path(out_folder) / plain.files[f]).string(), format);
   }
   for (LodLeaf& leaf : plain.leaves) leaf.instance = -1;
   const std::string meta = (fs::path(out_folder) / "lod-meta.json").string();
@@ -133,7 +131,7 @@ LodCityReport write_lod_city(const std::string& base, const std::string& out_fol
 
   const fs::path out(out_folder);
   if (options.materialize) {
-    report.written_bytes = materialize_lod_set(city, out_folder);
+    report.written_bytes = materialize_lod_set(city, out_folder, options.chunk_format);
     report.files = static_cast<int>(city.files.size());
   } else {
     prepare_lod_folder(out_folder);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "flashgs/camera.h"
+#include "flashgs/lod_build.h"
 #include "flashgs/lod_set.h"
 
 namespace flashgs {
@@ -18,6 +19,7 @@ struct LodCityOptions {
   int path_cameras = 60;  // the fly-through written to cameras.json
   int width = 1920, height = 1080;
   bool materialize = false;  // write each block's chunks moved for real: a plain set, blocks x the base's bytes
+  LodChunkFormat chunk_format = LodChunkFormat::ply;  // of the chunks `materialize` writes
 };
 
 struct LodCityReport {
@@ -41,8 +43,8 @@ struct LodCityReport {
 LodCityReport write_lod_city(const std::string& base, const std::string& out_folder, const LodCityOptions& options);
 
 // Writes `set` into `out_folder` (new or empty) as a plain set: each entry of set.files read,
-// moved by its instance and written as a PLY chunk of its own, the leaves in the same order.
-// Returns the bytes written.
-std::uint64_t materialize_lod_set(const LodSet& set, const std::string& out_folder);
+// moved by its instance and written as a chunk of its own (`format`), the leaves in the same
+// order. Returns the bytes written.
+std::uint64_t materialize_lod_set(const LodSet& set, const std::string& out_folder, LodChunkFormat format);
 
 }  // namespace flashgs
