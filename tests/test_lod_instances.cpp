@@ -153,6 +153,14 @@ TEST(LodInstance, ACityStreamsTheFrameOfItsGaussiansMovedForReal) {
   ASSERT_EQ(set.instances.size(), 3u);
   ASSERT_EQ(set.leaves.size(), 3 * base.leaves.size());
   EXPECT_EQ(set.gaussians(0), 3 * base.gaussians(0));
+  // Each leaf's bound is its base leaf's moved by its block (the cut tests these), and reads back
+  // from the meta's short decimals as the same floats.
+  for (std::size_t i = 0; i < set.leaves.size(); ++i) {
+    const LodBox expected = transformed_bound(base.leaves[i % base.leaves.size()].bound,
+                                              set.instances[static_cast<std::size_t>(set.leaves[i].instance)]);
+    EXPECT_EQ(set.leaves[i].bound.min, expected.min) << "leaf " << i;
+    EXPECT_EQ(set.leaves[i].bound.max, expected.max) << "leaf " << i;
+  }
   const Camera camera = overview(city);
   LodStreamOptions options;
   options.cut.max_error_px = 0.0f;

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -30,6 +32,9 @@ constexpr int kMaxLevels = 32;
 constexpr int kMaxTreeDepth = 64;
 constexpr std::size_t kMaxFileNameBytes = 1024;
 constexpr std::size_t kMaxInstances = 1 << 20;
+// lod-meta.json grows with the leaves (about 500 bytes each with 7 levels): a city of 1,000
+// blocks of 256 leaves (3 billion Gaussians) is about 130 MB, which parses into several times that.
+constexpr std::size_t kMaxLodMetaBytes = std::size_t{256} << 20;
 
 // The name may come from a file (a chunk named in JSON) or a user's argument.
 [[noreturn]] void fail(const std::string& name, const std::string& problem) {
@@ -210,8 +215,21 @@ Scene read_chunk_internal(const std::string& path, LoadReport* report, LoadProgr
   return is_sog_chunk(path) ? read_sog_chunk(path, report, progress) : load_scene_file(path, report, progress);
 }
 
+// The double whose shortest decimal is the float's (at most 9 digits, where the float widened
+// to double prints 17): a city's tree holds tens of thousands of bounds. It reads back as `v`.
+double short_decimal(float v) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof(text), v).ptr;
+  return std::strtod(std::string(text, end).c_str(), nullptr);
+}
+
 json box_json(const LodBox& box) {
-  return json{{"min", {box.min[0], box.min[1], box.min[2]}}, {"max", {box.max[0], box.max[1], box.max[2]}}};
+  json out = json::object();
+  for (const char* key : {"min", "max"}) {
+    const std::array<float, 3>& corner = key[1] == 'i' ? box.min : box.max;
+    out[key] = {short_decimal(corner[0]), short_decimal(corner[1]), short_decimal(corner[2])};
+  }
+  return out;
 }
 
 LodBox union_of(const LodSet& set, int first, int count) {
@@ -308,7 +326,7 @@ std::string LodSet::file_path(int file) const {
 LodSet read_lod_set(const std::string& path) {
   const fs::path meta_path = path_kind(path) == PathKind::folder ? fs::path(path) / "lod-meta.json" : fs::path(path);
   const std::string name = meta_path.string();
-  const std::vector<char> bytes = read_regular_file(name, kMaxSogJsonBytes);
+  const std::vector<char> bytes = read_regular_file(name, kMaxLodMetaBytes);
   json root;
   try {
     root = json::parse(bytes.begin(), bytes.end());
