@@ -15,6 +15,8 @@ namespace {
 
 constexpr int kMaxBandSize = 7;   // band 3
 constexpr int kSampleDirections = 64;
+// Beyond these, moved positions and scales would leave the float range a renderer works in.
+constexpr double kMaxTranslation = 1e12, kMinScale = 1e-6, kMaxScale = 1e6;
 
 // Band l's coefficients c (2l+1 of them) of a function f become X c for the function
 // f'(d) = f(R^T d). Y_l(R^T d) = M Y_l(d) for one (2l+1)^2 matrix M, so X = M^T; it is fitted
@@ -138,8 +140,8 @@ const char* lod_instance_problem(const LodInstance& instance) {
     norm2 += v * v;
   }
   for (double v : instance.translation)
-    if (!std::isfinite(v)) return "its translation holds a value that is not a finite number";
-  if (!std::isfinite(instance.scale) || instance.scale <= 0) return "its scale is not a positive finite number";
+    if (!(std::fabs(v) <= kMaxTranslation)) return "its translation holds a value that is not a number within +-1e12";
+  if (!(instance.scale >= kMinScale && instance.scale <= kMaxScale)) return "its scale is not a number in 1e-6..1e6";
   if (std::fabs(std::sqrt(norm2) - 1.0) > 1e-3) return "its rotation is not a unit quaternion (w, x, y, z)";
   return "";
 }

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
-#include <cstdlib>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -141,6 +141,9 @@ std::vector<LodInstance> read_instances(const json& list, const std::string& nam
     }
     const std::string problem = lod_instance_problem(instance);
     if (!problem.empty()) fail(name, where + ": " + problem);
+    double norm = 0;  // within 1e-3 of 1: made exact, so that the Gaussians' quaternions stay unit
+    for (double v : instance.rotation) norm += v * v;
+    for (double& v : instance.rotation) v /= std::sqrt(norm);
     out.push_back(instance);
   }
   return out;

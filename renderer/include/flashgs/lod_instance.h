@@ -25,8 +25,9 @@ void transform_gaussians(Scene& scene, const LodInstance& instance);
 // The axis-aligned bound of `box` moved by `instance` (of its eight corners).
 LodBox transformed_bound(const LodBox& box, const LodInstance& instance);
 
-// Why `instance` cannot be used, or "" when it can: a non-finite value, a rotation that is
-// not a unit quaternion (|q| off 1 by more than 1e-3), a scale that is not positive.
+// Why `instance` cannot be used, or "" when it can: a rotation that is not a unit quaternion of
+// finite numbers (|q| off 1 by more than 1e-3), a translation beyond +-1e12 or not finite, a
+// scale outside 1e-6..1e6.
 const char* lod_instance_problem(const LodInstance& instance);
 
 }  // namespace flashgs
