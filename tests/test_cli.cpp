@@ -822,7 +822,8 @@ TEST(CliLodCity, ACityOfASetFliesOnTheCpuAndBadOptionsAreOneLine) {
   EXPECT_NE(city.output.find("level 0: 90000 Gaussians"), std::string::npos) << city.output;  // 3 x the demo's 30,000
   const CliResult fly = run_cli("lod fly " + dir + "/city --backend cpu -r 160x90 --steps 1 --fps 1000 --psnr-every 1");
   ASSERT_EQ(fly.exit_code, 0) << fly.output;
-  EXPECT_NE(fly.output.find("level 0 90000 Gaussians; path of 4 frames"), std::string::npos) << fly.output;
+  EXPECT_NE(fly.output.find("(3 instances), 5 levels, level 0 90000 Gaussians; path of 4 frames"), std::string::npos)
+      << fly.output;
   EXPECT_NE(fly.output.find("failed 0"), std::string::npos) << fly.output;
   EXPECT_NE(fly.output.find("PSNR against the full-detail scene"), std::string::npos) << fly.output;
 

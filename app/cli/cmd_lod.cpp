@@ -165,9 +165,10 @@ void run_fly(const FlyArgs& args) {
                   static_cast<int>(std::thread::hardware_concurrency()), &options.host_frame, &options.device_frame);
   LodStreamer streamer(std::move(set), options);
   const LodSet& lod = streamer.set();
-  std::printf("set %s: %zu leaves, %d levels, level 0 %llu Gaussians; path of %zu frames at %dx%d through %zu cameras\n",
-              lod.meta_path.c_str(), lod.leaves.size(), lod.level_count, static_cast<unsigned long long>(lod.gaussians(0)),
-              path.size(), size.width, size.height, cameras.size());
+  const std::string instances = lod.instances.empty() ? "" : " (" + std::to_string(lod.instances.size()) + " instances)";
+  std::printf("set %s: %zu leaves%s, %d levels, level 0 %llu Gaussians; path of %zu frames at %dx%d through %zu cameras\n",
+              lod.meta_path.c_str(), lod.leaves.size(), instances.c_str(), lod.level_count,
+              static_cast<unsigned long long>(lod.gaussians(0)), path.size(), size.width, size.height, cameras.size());
 
   RenderOptions render_options;
   Image image, reference;
