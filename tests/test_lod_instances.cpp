@@ -314,6 +314,22 @@ TEST(LodInstance, MalformedInstancesAreOneLineNamingTheFile) {
   }
 }
 
+// A base named by its bare lod-meta.json (its folder is the working directory) is linked too.
+TEST(LodCity, ABaseInTheWorkingFolderIsLinkedRelatively) {
+  const std::string out = fs::absolute(scratch("from_here")).string();
+  const fs::path before = fs::current_path();
+  fs::current_path(base_set());
+  LodCityOptions options;
+  options.blocks = 2;
+  options.up = "+y";
+  EXPECT_NO_THROW(write_lod_city("lod-meta.json", out, options));
+  fs::current_path(before);
+  EXPECT_TRUE(fs::is_symlink(out + "/base"));
+  EXPECT_FALSE(fs::read_symlink(out + "/base").is_absolute());
+  const LodSet set = read_lod_set(out);
+  EXPECT_EQ(read_sog_lod(set.meta_path, set.level_count - 1).size(), set.gaussians(set.level_count - 1));
+}
+
 TEST(LodCity, RefusesAnInstancedBaseABadUpAxisAndAFolderInUse) {
   const std::string city = city_of(2, "refusals");
   LodCityOptions options;

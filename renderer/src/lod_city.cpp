@@ -134,10 +134,11 @@ LodCityReport write_lod_city(const std::string& base, const std::string& out_fol
     report.written_bytes = materialize_lod_set(city, out_folder, options.chunk_format);
     report.files = static_cast<int>(city.files.size());
   } else {
-    prepare_lod_folder(out_folder);
     std::error_code error;
-    const fs::path target = fs::relative(fs::absolute(set.folder), fs::absolute(out), error);
-    if (error || target.empty()) fail(set.folder, "cannot be reached from " + out_folder + " by a relative path");
+    const fs::path base_folder = fs::absolute(set.folder.empty() ? fs::path(".") : fs::path(set.folder), error);
+    const fs::path target = error ? fs::path() : fs::relative(base_folder, fs::absolute(out, error), error);
+    if (error || target.empty()) fail(set.meta_path, "its folder cannot be reached from " + out_folder + " by a relative path");
+    prepare_lod_folder(out_folder);
     fs::create_directory_symlink(target, out / kBaseLink, error);
     if (error) fail((out / kBaseLink).string(), "cannot create the link to the base set: " + error.message());
     for (std::string& file : city.files) file = (fs::path(kBaseLink) / file).string();
