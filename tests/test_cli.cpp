@@ -810,5 +810,41 @@ TEST(CliTuning, ReportSweepsAKnobAndRecordsTheValuesUsed) {
   EXPECT_NE(md.str().find("settings of --tuning"), std::string::npos) << md.str();
 }
 
+// `lod city` on a built set: the city streams on the CPU along its own path; bad options, an
+// instanced base and a folder in use are one line each, with nothing written.
+TEST(CliLodCity, ACityOfASetFliesOnTheCpuAndBadOptionsAreOneLine) {
+  const std::string dir = scratch_dir("lod_city");
+  const CliResult build = run_cli("lod build " + demo_scene_path() + " " + dir + "/base --leaf-size 4096 --file-size 16384");
+  ASSERT_EQ(build.exit_code, 0) << build.output;
+  const CliResult city = run_cli("lod city " + dir + "/base " + dir + "/city --blocks 3 --up +y --cameras 4");
+  ASSERT_EQ(city.exit_code, 0) << city.output;
+  EXPECT_NE(city.output.find("city " + dir + "/city: 3 blocks"), std::string::npos) << city.output;
+  EXPECT_NE(city.output.find("level 0: 90000 Gaussians"), std::string::npos) << city.output;  // 3 x the demo's 30,000
+  const CliResult fly = run_cli("lod fly " + dir + "/city --backend cpu -r 160x90 --steps 1 --fps 1000 --psnr-every 1");
+  ASSERT_EQ(fly.exit_code, 0) << fly.output;
+  EXPECT_NE(fly.output.find("(3 instances), 5 levels, level 0 90000 Gaussians; path of 4 frames"), std::string::npos)
+      << fly.output;
+  EXPECT_NE(fly.output.find("failed 0"), std::string::npos) << fly.output;
+  EXPECT_NE(fly.output.find("PSNR against the full-detail scene"), std::string::npos) << fly.output;
+
+  const std::string base = " " + dir + "/base " + dir + "/refused";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"lod city" + base + " --blocks 0", "--blocks"},
+      {"lod city" + base + " --blocks two", "--blocks"},
+      {"lod city" + base, "--blocks is required"},
+      {"lod city" + base + " --blocks 2 --up +w", "--up"},
+      {"lod city" + base + " --blocks 2 --spacing nan", "--spacing"},
+      {"lod city" + base + " --blocks 2 --spacing -1", "--spacing"},
+      {"lod city" + base + " --blocks 2 --cameras 1", "--cameras"},
+      {"lod city" + base + " --blocks 2 --chunk-format sog", "--chunk-format requires --materialize"},
+      {"lod city" + base + " --blocks 2 --materialize --chunk-format webp", "--chunk-format"},
+      {"lod city " + dir + "/city " + dir + "/refused --blocks 2", "already an instanced set"},
+      {"lod city " + dir + "/nothing " + dir + "/refused --blocks 2", dir + "/nothing"},
+      {"lod city " + dir + "/base " + dir + "/city --blocks 2", "is not empty"},
+  };
+  for (const auto& [arguments, fragment] : cases) expect_one_line_error(run_cli(arguments), fragment, arguments);
+  EXPECT_FALSE(fs::exists(dir + "/refused"));
+}
+
 }  // namespace
 }  // namespace flashgs

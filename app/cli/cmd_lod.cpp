@@ -1,5 +1,6 @@
-// `flashgs lod build IN OUT`: a scene turned into a streamed LOD set; `flashgs lod fly SET`: the
-// set streamed along a camera path under memory caps, with frame times, stalls and memory.
+// `flashgs lod build IN OUT`: a scene turned into a streamed LOD set; `flashgs lod city BASE OUT`:
+// a city of instances of a set; `flashgs lod fly SET`: a set streamed along a camera path under
+// memory caps, with frame times, stalls and memory.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include "flashgs/error.h"
 #include "flashgs/io.h"
 #include "flashgs/lod_build.h"
+#include "flashgs/lod_city.h"
 #include "flashgs/lod_stream.h"
 #include "flashgs/parse.h"
 #include "flashgs/percentile.h"
@@ -70,6 +72,28 @@ void run_build(const BuildArgs& args) {
               args.output.c_str(), input.c_str(), static_cast<unsigned long long>(r.gaussians),
               r.streamed ? "streamed from the disk" : "read whole", r.leaves, r.levels, r.files,
               static_cast<double>(r.bytes_written) / 1e6, seconds);
+  for (std::size_t level = 0; level < r.level_gaussians.size(); ++level)
+    std::printf("level %zu: %llu Gaussians\n", level, static_cast<unsigned long long>(r.level_gaussians[level]));
+}
+
+struct CityArgs {
+  std::string base, output;
+  LodCityOptions options;
+  std::string chunk_format = "ply";
+};
+
+void run_city(CityArgs args) {
+  args.options.chunk_format = args.chunk_format == "sog" ? LodChunkFormat::sog : LodChunkFormat::ply;
+  const auto t0 = Clock::now();
+  const LodCityReport r = write_lod_city(args.base, args.output, args.options);
+  const double seconds = ms_between(t0, Clock::now()) / 1000.0;
+  const float* lo = r.bound.min.data();
+  const float* hi = r.bound.max.data();
+  std::printf("city %s: %d blocks of %s (%d per row, %.2f apart), %.1f x %.1f x %.1f scene units; %d chunk files %s, "
+              "%.1f MB of chunks as streamed, %.2f MB written, %.2f s\n",
+              args.output.c_str(), r.blocks, args.base.c_str(), r.side, r.spacing, hi[0] - lo[0], hi[1] - lo[1],
+              hi[2] - lo[2], r.files, args.options.materialize ? "written moved (a plain set)" : "named through the link base/",
+              static_cast<double>(r.chunk_bytes) / 1e6, static_cast<double>(r.written_bytes) / 1e6, seconds);
   for (std::size_t level = 0; level < r.level_gaussians.size(); ++level)
     std::printf("level %zu: %llu Gaussians\n", level, static_cast<unsigned long long>(r.level_gaussians[level]));
 }
@@ -141,9 +165,10 @@ void run_fly(const FlyArgs& args) {
                   static_cast<int>(std::thread::hardware_concurrency()), &options.host_frame, &options.device_frame);
   LodStreamer streamer(std::move(set), options);
   const LodSet& lod = streamer.set();
-  std::printf("set %s: %zu leaves, %d levels, level 0 %llu Gaussians; path of %zu frames at %dx%d through %zu cameras\n",
-              lod.meta_path.c_str(), lod.leaves.size(), lod.level_count, static_cast<unsigned long long>(lod.gaussians(0)),
-              path.size(), size.width, size.height, cameras.size());
+  const std::string instances = lod.instances.empty() ? "" : " (" + std::to_string(lod.instances.size()) + " instances)";
+  std::printf("set %s: %zu leaves%s, %d levels, level 0 %llu Gaussians; path of %zu frames at %dx%d through %zu cameras\n",
+              lod.meta_path.c_str(), lod.leaves.size(), instances.c_str(), lod.level_count,
+              static_cast<unsigned long long>(lod.gaussians(0)), path.size(), size.width, size.height, cameras.size());
 
   RenderOptions render_options;
   Image image, reference;
@@ -237,7 +262,7 @@ void run_fly(const FlyArgs& args) {
 }  // namespace
 
 void register_lod(CLI::App& app) {
-  CLI::App* lod = app.add_subcommand("lod", "build a streamed level-of-detail set, or fly through one");
+  CLI::App* lod = app.add_subcommand("lod", "build a streamed level-of-detail set, lay out a city of one, or fly through one");
   lod->require_subcommand(1);
 
   auto build = std::make_shared<BuildArgs>();
@@ -256,6 +281,32 @@ void register_lod(CLI::App& app) {
                  "which PlayCanvas's viewers stream")
       ->check(CLI::IsMember({"ply", "sog"}));
   b->callback([build] { run_build(*build); });
+
+  auto city = std::make_shared<CityArgs>();
+  CLI::App* c = lod->add_subcommand("city", "lay out a city of instances of a LOD set in seconds (the base's chunk files "
+                                            "are named, not copied)");
+  c->add_option("BASE", city->base, "the base set's lod-meta.json or its folder (a plain set)")->required();
+  c->add_option("OUT", city->output, "the folder to write the city's lod-meta.json and cameras.json into (new or empty)")
+      ->required();
+  c->add_option("--blocks,-n", city->options.blocks, "blocks of the city, each an instance of the base")
+      ->required()
+      ->check(whole_number())
+      ->check(CLI::Range(1, 65536));
+  c->add_option("--spacing", city->options.spacing, "between block centres, in scene units (default: 1.1 x the base's width)")
+      ->check(finite_in(1e-6, 1e9));
+  c->add_option("--up", city->options.up, "the base's up axis (default +z)")
+      ->check(CLI::IsMember({"+x", "-x", "+y", "-y", "+z", "-z"}));
+  c->add_option("--cameras", city->options.path_cameras, "cameras of the fly-through written to cameras.json (default 60)")
+      ->check(whole_number())
+      ->check(CLI::Range(2, 10000));
+  CLI::Option* materialize = c->add_flag(
+      "--materialize", city->options.materialize,
+      "write each block's chunks moved for real: a plain set without our instance keys, blocks x the base's bytes");
+  c->add_option("--chunk-format", city->chunk_format,
+                "with --materialize: ply (default) or sog (SOG chunk folders, which PlayCanvas's viewers stream)")
+      ->check(CLI::IsMember({"ply", "sog"}))
+      ->needs(materialize);
+  c->callback([city] { run_city(*city); });
 
   auto fly = std::make_shared<FlyArgs>();
   CLI::App* f = lod->add_subcommand("fly", "stream a LOD set along a camera path and report frame times, stalls and memory");

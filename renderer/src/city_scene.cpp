@@ -43,37 +43,6 @@ float quantile(std::vector<float> values, double fraction) {
   return values[k];
 }
 
-// A source turned up: its centre (middle of the 2%-98% range across, ground at 2% of the
-// height) and its width across (the diagonal of that range, which any heading fits in).
-struct Placed {
-  double align[9];
-  double centre[3];
-  double width = 0;
-};
-
-Placed place(const CitySource& source) {
-  if (source.scene.size() == 0) throw Error(source.name + ": holds no Gaussians");
-  Placed p;
-  up_to_z(source.up, source.name, p.align);
-  std::vector<float> axis[3];
-  for (auto& a : axis) a.reserve(source.scene.size());
-  for (std::size_t i = 0; i < source.scene.size(); ++i) {
-    const double v[3] = {source.scene.positions[i * 3], source.scene.positions[i * 3 + 1], source.scene.positions[i * 3 + 2]};
-    double u[3];
-    apply(p.align, v, u);
-    for (int k = 0; k < 3; ++k) axis[k].push_back(static_cast<float>(u[k]));
-  }
-  double span2 = 0;
-  for (int k = 0; k < 2; ++k) {
-    const double lo = quantile(axis[k], 0.02), hi = quantile(axis[k], 0.98);
-    p.centre[k] = 0.5 * (lo + hi);
-    span2 += (hi - lo) * (hi - lo);
-  }
-  p.centre[2] = quantile(axis[2], 0.02);
-  p.width = std::sqrt(span2);
-  return p;
-}
-
 // The camera at `eye` looking at `target`, world up +z (OpenCV axes: x right, y down, z forward).
 Camera look_at(const double eye[3], const double target[3], int width, int height) {
   double f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
@@ -93,19 +62,83 @@ Camera look_at(const double eye[3], const double target[3], int width, int heigh
 
 }  // namespace
 
+CityPlacement place_city_source(const Scene& scene, const std::string& up, const std::string& name) {
+  if (scene.size() == 0) throw Error(name + ": holds no Gaussians");
+  CityPlacement p;
+  up_to_z(up, name, p.align);
+  std::vector<float> axis[3];
+  for (auto& a : axis) a.reserve(scene.size());
+  for (std::size_t i = 0; i < scene.size(); ++i) {
+    const double v[3] = {scene.positions[i * 3], scene.positions[i * 3 + 1], scene.positions[i * 3 + 2]};
+    double u[3];
+    apply(p.align, v, u);
+    for (int k = 0; k < 3; ++k) axis[k].push_back(static_cast<float>(u[k]));
+  }
+  double span2 = 0;
+  for (int k = 0; k < 2; ++k) {
+    const double lo = quantile(axis[k], 0.02), hi = quantile(axis[k], 0.98);
+    p.centre[k] = 0.5 * (lo + hi);
+    span2 += (hi - lo) * (hi - lo);
+  }
+  p.centre[2] = quantile(axis[2], 0.02);
+  p.width = std::sqrt(span2);
+  return p;
+}
+
+int city_side(int blocks) { return static_cast<int>(std::ceil(std::sqrt(static_cast<double>(std::max(1, blocks))))); }
+
+void city_block_transform(const CityPlacement& placement, int block, int side, double block_size, double rotation[9],
+                          double translation[3]) {
+  const double heading = block * kHeadingStep * kPi / 180.0;
+  const double turn[9] = {std::cos(heading), -std::sin(heading), 0, std::sin(heading), std::cos(heading), 0, 0, 0, 1};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      rotation[r * 3 + c] = turn[r * 3] * placement.align[c] + turn[r * 3 + 1] * placement.align[3 + c] +
+                            turn[r * 3 + 2] * placement.align[6 + c];
+  // turn (align p - centre) + cell = turn align p + (cell - turn centre)
+  double turned_centre[3];
+  apply(turn, placement.centre, turned_centre);
+  const double cell[3] = {(block % side) * block_size, (block / side) * block_size, 0.0};
+  for (int k = 0; k < 3; ++k) translation[k] = cell[k] - turned_centre[k];
+}
+
+std::vector<Camera> city_camera_path(int side, double block_size, int count, int width, int height) {
+  // From eye height along the first row of blocks, then up and back to see the whole city.
+  const double size = block_size, extent = side * size;
+  const double eye_height = 0.02 * size;
+  const int street = std::max(1, count / 2);
+  std::vector<Camera> path;
+  for (int i = 0; i < count; ++i) {
+    double eye[3], target[3];
+    if (i < street) {
+      const double t = static_cast<double>(i) / street;
+      eye[0] = -0.5 * size + t * extent, eye[1] = -0.5 * size, eye[2] = eye_height;
+      target[0] = eye[0] + size, target[1] = -0.2 * size, target[2] = eye_height;  // along the street, towards the blocks
+    } else {
+      const double t = static_cast<double>(i - street + 1) / (count - street);
+      eye[0] = (1 - t) * (extent - 0.5 * size) + t * (-0.5 * size);
+      eye[1] = (1 - t) * (-0.5 * size) + t * (-0.7 * extent);
+      eye[2] = (1 - t) * eye_height + t * 0.9 * extent;
+      target[0] = 0.5 * (extent - size), target[1] = 0.5 * (extent - size), target[2] = 0.0;
+    }
+    path.push_back(look_at(eye, target, width, height));
+  }
+  return path;
+}
+
 CityReport write_city_scene(const std::vector<CitySource>& sources, int blocks, const std::string& ply_path,
                             int path_cameras, int width, int height, std::vector<Camera>* path) {
   if (sources.empty()) throw Error(ply_path + ": a city needs at least one source scene");
   if (blocks < 1) throw Error(ply_path + ": a city needs at least one block");
-  std::vector<Placed> placed;
+  std::vector<CityPlacement> placed;
   CityReport report;
   report.blocks = blocks;
   for (const CitySource& s : sources) {
-    placed.push_back(place(s));
+    placed.push_back(place_city_source(s.scene, s.up, s.name));
     report.block_size = std::max(report.block_size, static_cast<float>(1.1 * placed.back().width));
     report.dropped_sh |= s.scene.sh_degree > 0;
   }
-  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(blocks))));
+  const int side = city_side(blocks);
   for (int b = 0; b < blocks; ++b) report.gaussians += sources[static_cast<std::size_t>(b) % sources.size()].scene.size();
 
   Scene like;  // the header's layout: SH degree 0, no kernel mark unless every source has the same
@@ -116,28 +149,19 @@ CityReport write_city_scene(const std::vector<CitySource>& sources, int blocks, 
     file.write(inria_ply_header(like, report.gaussians));
     for (int b = 0; b < blocks; ++b) {
       const CitySource& source = sources[static_cast<std::size_t>(b) % sources.size()];
-      const Placed& p = placed[static_cast<std::size_t>(b) % sources.size()];
-      const double heading = b * kHeadingStep * kPi / 180.0;
-      const double turn[9] = {std::cos(heading), -std::sin(heading), 0, std::sin(heading), std::cos(heading), 0, 0, 0, 1};
-      double m[9];  // turn * align
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-          m[r * 3 + c] = turn[r * 3] * p.align[c] + turn[r * 3 + 1] * p.align[3 + c] + turn[r * 3 + 2] * p.align[6 + c];
-      double qm[4];
+      double m[9], t[3], qm[4];
+      city_block_transform(placed[static_cast<std::size_t>(b) % sources.size()], b, side, report.block_size, m, t);
       quaternion_from_matrix(m, qm);
-      const double offset[3] = {(b % side) * double(report.block_size), (b / side) * double(report.block_size), 0.0};
       const Scene& in = source.scene;
       for (std::size_t first = 0; first < in.size(); first += kBatch) {
         const std::size_t n = std::min(kBatch, in.size() - first);
         Scene out;
         out.reserve(n);
         for (std::size_t i = first; i < first + n; ++i) {
-          double v[3], a[3], u[3];
+          double v[3], u[3];
           for (int k = 0; k < 3; ++k) v[k] = in.positions[i * 3 + k];
-          apply(p.align, v, a);
-          for (int k = 0; k < 3; ++k) a[k] -= p.centre[k];
-          apply(turn, a, u);
-          for (int k = 0; k < 3; ++k) out.positions.push_back(static_cast<float>(u[k] + offset[k]));
+          apply(m, v, u);
+          for (int k = 0; k < 3; ++k) out.positions.push_back(static_cast<float>(u[k] + t[k]));
           const double q[4] = {in.rotations[i * 4], in.rotations[i * 4 + 1], in.rotations[i * 4 + 2], in.rotations[i * 4 + 3]};
           double rotated[4];
           multiply_quaternions(qm, q, rotated);
@@ -151,29 +175,7 @@ CityReport write_city_scene(const std::vector<CitySource>& sources, int blocks, 
     }
   });
   report.bytes = report.gaussians * 17 * sizeof(float);
-
-  if (path && path_cameras > 0) {
-    // From eye height along the first row of blocks, then up and back to see the whole city.
-    const double size = report.block_size, extent = side * size;
-    const double eye_height = 0.02 * size;
-    const int street = std::max(1, path_cameras / 2);
-    path->clear();
-    for (int i = 0; i < path_cameras; ++i) {
-      double eye[3], target[3];
-      if (i < street) {
-        const double t = static_cast<double>(i) / street;
-        eye[0] = -0.5 * size + t * extent, eye[1] = -0.5 * size, eye[2] = eye_height;
-        target[0] = eye[0] + size, target[1] = -0.2 * size, target[2] = eye_height;  // along the street, towards the blocks
-      } else {
-        const double t = static_cast<double>(i - street + 1) / (path_cameras - street);
-        eye[0] = (1 - t) * (extent - 0.5 * size) + t * (-0.5 * size);
-        eye[1] = (1 - t) * (-0.5 * size) + t * (-0.7 * extent);
-        eye[2] = (1 - t) * eye_height + t * 0.9 * extent;
-        target[0] = 0.5 * (extent - size), target[1] = 0.5 * (extent - size), target[2] = 0.0;
-      }
-      path->push_back(look_at(eye, target, width, height));
-    }
-  }
+  if (path && path_cameras > 0) *path = city_camera_path(side, report.block_size, path_cameras, width, height);
   return report;
 }
 

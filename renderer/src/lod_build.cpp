@@ -239,21 +239,12 @@ class LevelWriter {
     if (m_file >= 0) write_file();
     m_file = static_cast<int>(m_set.files.size());
     const std::string name = std::to_string(m_level) + "_" + std::to_string(m_next_name++);
-    m_set.files.push_back(m_format == LodChunkFormat::sog ? name + "/meta.json" : name + ".ply");
+    m_set.files.push_back(lod_chunk_name(name, m_format));
     m_pending = Scene{};
   }
   void write_file() {
     const fs::path path = m_folder / m_set.files[static_cast<std::size_t>(m_file)];
-    std::error_code error;
-    if (m_format == LodChunkFormat::sog) {
-      if (!fs::create_directory(path.parent_path(), error) && error)
-        fail(path.parent_path().string(), "cannot create the chunk folder: " + error.message());
-      save_sog_folder(m_pending, path.string(), SceneWriteOptions{});
-      for (const auto& e : fs::directory_iterator(path.parent_path(), error)) m_report.bytes_written += e.file_size(error);
-    } else {
-      save_ply(m_pending, path.string());
-      m_report.bytes_written += fs::file_size(path, error);
-    }
+    m_report.bytes_written += write_lod_chunk(m_pending, path.string(), m_format);
     ++m_report.files;
     m_pending = Scene{};
   }
@@ -276,18 +267,6 @@ struct TemporaryFolder {
     fs::remove_all(path, ignored);
   }
 };
-
-void prepare_output(const fs::path& folder) {
-  std::error_code error;
-  const fs::file_status status = fs::status(folder, error);
-  if (fs::exists(status)) {
-    if (!fs::is_directory(status)) fail(folder.string(), "exists and is not a folder");
-    if (!fs::is_empty(folder, error)) fail(folder.string(), "is not empty: name a new or empty folder for the LOD set");
-    return;
-  }
-  if (!fs::create_directories(folder, error) || error)
-    fail(folder.string(), "cannot create the folder: " + error.message());
-}
 
 LodBox bound_of(const Scene& scene) {
   LodBox box;
@@ -350,6 +329,39 @@ int emit_tree(const std::vector<KdNode>& kd, int node, const std::vector<int>& n
 
 }  // namespace
 
+std::string lod_chunk_name(const std::string& stem, LodChunkFormat format) {
+  return format == LodChunkFormat::sog ? stem + "/meta.json" : stem + ".ply";
+}
+
+std::uint64_t write_lod_chunk(const Scene& scene, const std::string& path_name, LodChunkFormat format) {
+  const fs::path path(path_name);
+  std::error_code error;
+  std::uint64_t bytes = 0;
+  if (format == LodChunkFormat::sog) {
+    if (!fs::create_directory(path.parent_path(), error) && error)
+      fail(path.parent_path().string(), "cannot create the chunk folder: " + error.message());
+    save_sog_folder(scene, path.string(), SceneWriteOptions{});
+    for (const auto& e : fs::directory_iterator(path.parent_path(), error)) bytes += e.file_size(error);
+  } else {
+    save_ply(scene, path.string());
+    bytes = fs::file_size(path, error);
+  }
+  return bytes;
+}
+
+void prepare_lod_folder(const std::string& folder_name) {
+  const fs::path folder(folder_name);
+  std::error_code error;
+  const fs::file_status status = fs::status(folder, error);
+  if (fs::exists(status)) {
+    if (!fs::is_directory(status)) fail(folder.string(), "exists and is not a folder");
+    if (!fs::is_empty(folder, error)) fail(folder.string(), "is not empty: name a new or empty folder for the LOD set");
+    return;
+  }
+  if (!fs::create_directories(folder, error) || error)
+    fail(folder.string(), "cannot create the folder: " + error.message());
+}
+
 LodBuildReport build_lod_set(const std::string& input, const std::string& out_folder, const LodBuildOptions& options) {
   if (options.leaf_gaussians < 1) fail(out_folder, "the leaf size must be at least 1 Gaussian");
   if (options.file_gaussians < 1) fail(out_folder, "the chunk file size must be at least 1 Gaussian");
@@ -358,7 +370,7 @@ LodBuildReport build_lod_set(const std::string& input, const std::string& out_fo
   };
   GaussianBatches source(input);
   const fs::path folder(out_folder);
-  prepare_output(folder);
+  prepare_lod_folder(folder.string());
   TemporaryFolder temporary{folder / ".lod-build-tmp"};
   std::error_code error;
   if (!fs::create_directory(temporary.path, error)) fail(temporary.path.string(), "cannot create: " + error.message());

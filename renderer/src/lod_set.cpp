@@ -2,11 +2,15 @@
 #include "flashgs/lod_set.h"
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <map>
 #include <string>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -27,6 +31,10 @@ constexpr int kMaxLevels = 32;
 // Deeper trees than this are not a spatial hierarchy but a hostile file.
 constexpr int kMaxTreeDepth = 64;
 constexpr std::size_t kMaxFileNameBytes = 1024;
+constexpr std::size_t kMaxInstances = 1 << 20;
+// lod-meta.json grows with the leaves (about 500 bytes each with 7 levels): a city of 1,000
+// blocks of 256 leaves (3 billion Gaussians) is about 130 MB, which parses into several times that.
+constexpr std::size_t kMaxLodMetaBytes = std::size_t{256} << 20;
 
 // The name may come from a file (a chunk named in JSON) or a user's argument.
 [[noreturn]] void fail(const std::string& name, const std::string& problem) {
@@ -94,7 +102,69 @@ void walk(const json& node, const LodBox& parent_bound, int depth, LodSet& set, 
     range.offset = whole(entry.at("offset"), kMaxSogCount, "a leaf's offset", name);
     range.count = whole(entry.at("count"), kMaxSogCount, "a leaf's count", name);
   }
+  if (node.contains("instance")) {
+    if (set.instances.empty()) fail(name, "a tree leaf names an instance but the set has no \"instances\"");
+    leaf.instance = static_cast<int>(whole(node.at("instance"), set.instances.size() - 1, "a leaf's instance index", name));
+  }
   set.leaves.push_back(std::move(leaf));
+}
+
+template <std::size_t N>
+std::array<double, N> numbers(const json& value, const std::string& where, const std::string& name) {
+  if (!value.is_array() || value.size() != N) fail(name, where + " must be an array of " + std::to_string(N) + " numbers");
+  std::array<double, N> out{};
+  for (std::size_t k = 0; k < N; ++k) {
+    if (!value[k].is_number() || !std::isfinite(value[k].get<double>()))
+      fail(name, where + " holds a value that is not a finite number");
+    out[k] = value[k].get<double>();
+  }
+  return out;
+}
+
+// "instances": [{"rotation": [w, x, y, z], "translation": [x, y, z], "scale": s}, ...]; the
+// scale may be left out (1).
+std::vector<LodInstance> read_instances(const json& list, const std::string& name) {
+  if (!list.is_array() || list.empty() || list.size() > kMaxInstances)
+    fail(name, "\"instances\" must be an array of 1.." + std::to_string(kMaxInstances) + " objects");
+  std::vector<LodInstance> out;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where = "instances[" + std::to_string(i) + "]";
+    const json& entry = list[i];
+    if (!entry.is_object() || !entry.contains("rotation") || !entry.contains("translation"))
+      fail(name, where + " must be an object with rotation and translation");
+    LodInstance instance;
+    instance.rotation = numbers<4>(entry.at("rotation"), where + ".rotation", name);
+    instance.translation = numbers<3>(entry.at("translation"), where + ".translation", name);
+    if (entry.contains("scale")) {
+      if (!entry.at("scale").is_number()) fail(name, where + ".scale is not a number");
+      instance.scale = entry.at("scale").get<double>();
+    }
+    const std::string problem = lod_instance_problem(instance);
+    if (!problem.empty()) fail(name, where + ": " + problem);
+    double norm = 0;  // within 1e-3 of 1: made exact, so that the Gaussians' quaternions stay unit
+    for (double v : instance.rotation) norm += v * v;
+    for (double& v : instance.rotation) v /= std::sqrt(norm);
+    out.push_back(instance);
+  }
+  return out;
+}
+
+// An instanced set's files become one entry per (file, instance) its leaves name, in order of
+// first use, so that each instance's copy of a chunk is a chunk of its own downstream.
+void split_files_by_instance(LodSet& set) {
+  std::map<std::pair<int, int>, int> entry_of;
+  std::vector<std::string> files;
+  for (LodLeaf& leaf : set.leaves)
+    for (LodRange& r : leaf.levels) {
+      if (r.file < 0) continue;
+      const auto [it, fresh] = entry_of.emplace(std::make_pair(r.file, leaf.instance), static_cast<int>(files.size()));
+      if (fresh) {
+        files.push_back(set.files[static_cast<std::size_t>(r.file)]);
+        set.file_instance.push_back(leaf.instance);
+      }
+      r.file = it->second;
+    }
+  set.files = std::move(files);
 }
 
 // A set's chunks are SOG chunks (meta.json, as PlayCanvas writes them) or scene files of any
@@ -148,8 +218,21 @@ Scene read_chunk_internal(const std::string& path, LoadReport* report, LoadProgr
   return is_sog_chunk(path) ? read_sog_chunk(path, report, progress) : load_scene_file(path, report, progress);
 }
 
+// The double whose shortest decimal is the float's (at most 9 digits, where the float widened
+// to double prints 17): a city's tree holds tens of thousands of bounds. It reads back as `v`.
+double short_decimal(float v) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof(text), v).ptr;
+  return std::strtod(std::string(text, end).c_str(), nullptr);
+}
+
 json box_json(const LodBox& box) {
-  return json{{"min", {box.min[0], box.min[1], box.min[2]}}, {"max", {box.max[0], box.max[1], box.max[2]}}};
+  json out = json::object();
+  for (const char* key : {"min", "max"}) {
+    const std::array<float, 3>& corner = key[1] == 'i' ? box.min : box.max;
+    out[key] = {short_decimal(corner[0]), short_decimal(corner[1]), short_decimal(corner[2])};
+  }
+  return out;
 }
 
 LodBox union_of(const LodSet& set, int first, int count) {
@@ -164,20 +247,24 @@ LodBox union_of(const LodSet& set, int first, int count) {
   return box;
 }
 
-json node_json(const LodSet& set, const std::vector<LodTreeNode>& nodes, int index) {
+// `file_names`: per entry of set.files, its index in the written filenames.
+json node_json(const LodSet& set, const std::vector<int>& file_names, const std::vector<LodTreeNode>& nodes, int index) {
   const LodTreeNode& node = nodes.at(static_cast<std::size_t>(index));
   json out{{"bound", box_json(union_of(set, node.first_leaf, node.leaf_count))}};
   if (node.children[0] >= 0) {
-    out["children"] = json::array({node_json(set, nodes, node.children[0]), node_json(set, nodes, node.children[1])});
+    out["children"] = json::array(
+        {node_json(set, file_names, nodes, node.children[0]), node_json(set, file_names, nodes, node.children[1])});
     return out;
   }
   json lods = json::object();
   const LodLeaf& leaf = set.leaves.at(static_cast<std::size_t>(node.first_leaf));
   for (std::size_t level = 0; level < leaf.levels.size(); ++level) {
     const LodRange& r = leaf.levels[level];
-    if (r.file >= 0) lods[std::to_string(level)] = {{"file", r.file}, {"offset", r.offset}, {"count", r.count}};
+    if (r.file >= 0)
+      lods[std::to_string(level)] = {{"file", file_names.at(static_cast<std::size_t>(r.file))}, {"offset", r.offset}, {"count", r.count}};
   }
   out["lods"] = lods;
+  if (leaf.instance >= 0) out["instance"] = leaf.instance;
   return out;
 }
 
@@ -190,6 +277,13 @@ Scene read_lod_chunk(const std::string& path, LoadReport* report, LoadProgress* 
 }
 
 std::uint64_t lod_chunk_gaussians(const std::string& path) { return chunk_gaussians(path); }
+
+Scene read_lod_set_chunk(const LodSet& set, int file, LoadReport* report, LoadProgress* progress) {
+  Scene scene = read_chunk_internal(set.file_path(file), report, progress);
+  const int instance = set.file_instance.empty() ? -1 : set.file_instance.at(static_cast<std::size_t>(file));
+  if (instance >= 0) transform_gaussians(scene, set.instances.at(static_cast<std::size_t>(instance)));
+  return scene;
+}
 
 void check_lod_ranges(const LodSet& set, int level) {
   std::map<int, std::vector<LodRange>> by_file;
@@ -235,7 +329,7 @@ std::string LodSet::file_path(int file) const {
 LodSet read_lod_set(const std::string& path) {
   const fs::path meta_path = path_kind(path) == PathKind::folder ? fs::path(path) / "lod-meta.json" : fs::path(path);
   const std::string name = meta_path.string();
-  const std::vector<char> bytes = read_regular_file(name, kMaxSogJsonBytes);
+  const std::vector<char> bytes = read_regular_file(name, kMaxLodMetaBytes);
   json root;
   try {
     root = json::parse(bytes.begin(), bytes.end());
@@ -253,16 +347,36 @@ LodSet read_lod_set(const std::string& path) {
   if (!filenames.is_array() || filenames.empty()) fail(name, "filenames must be a non-empty array");
   for (std::size_t i = 0; i < filenames.size(); ++i)
     set.files.push_back(chunk_file(filenames[i], "filenames[" + std::to_string(i) + "]", name));
+  if (root.contains("instances")) set.instances = read_instances(root.at("instances"), name);
   set.bound = read_bound(root.at("tree"), LodBox{}, name);
   walk(root.at("tree"), set.bound, 0, set, name);
+  if (!set.instances.empty()) split_files_by_instance(set);
   for (int level = 0; level < set.level_count; ++level)
     if (set.gaussians(level) == 0) fail(name, "level " + std::to_string(level) + " has no Gaussians in the tree");
   return set;
 }
 
 void write_lod_meta(const LodSet& set, const std::vector<LodTreeNode>& nodes, const std::string& path) {
-  json root{{"lodLevels", set.level_count}, {"environment", nullptr}, {"filenames", set.files},
-            {"tree", node_json(set, nodes, static_cast<int>(nodes.size()) - 1)}};
+  // An instanced set names a file once however many instances draw it.
+  std::vector<std::string> names;
+  std::vector<int> file_names;
+  std::map<std::string, int> index_of;
+  for (const std::string& file : set.files) {
+    const auto [it, fresh] = index_of.emplace(file, static_cast<int>(names.size()));
+    if (fresh) names.push_back(file);
+    file_names.push_back(it->second);
+  }
+  json root{{"lodLevels", set.level_count}, {"environment", nullptr}, {"filenames", names},
+            {"tree", node_json(set, file_names, nodes, static_cast<int>(nodes.size()) - 1)}};
+  if (!set.instances.empty()) {
+    json list = json::array();
+    for (const LodInstance& i : set.instances) {
+      json entry{{"rotation", i.rotation}, {"translation", i.translation}};
+      if (i.scale != 1) entry["scale"] = i.scale;
+      list.push_back(entry);
+    }
+    root["instances"] = list;
+  }
   const std::string text = root.dump();
   write_file_atomically(path, [&](OutputFile& file) { file.write(text); });
 }

@@ -159,7 +159,7 @@ void LodStreamer::load_loop() {
     std::string problem;
     const std::string path = m_set.file_path(file);
     try {
-      scene = std::make_shared<Scene>(read_lod_chunk(path));
+      scene = std::make_shared<Scene>(read_lod_set_chunk(m_set, file));
       if (scene->size() < m_file_gaussians[static_cast<std::size_t>(file)])
         problem = printable_file_text(path, kMaxPrintedPathBytes) + ": holds " + std::to_string(scene->size()) +
                   " Gaussians but the set's tree takes " + std::to_string(m_file_gaussians[static_cast<std::size_t>(file)]) +

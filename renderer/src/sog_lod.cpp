@@ -113,7 +113,7 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
     for (int file : level_files(ranges)) {
       const std::string chunk_name = meta.file_path(file);
       LoadReport chunk_report;
-      const Scene chunk = read_lod_chunk(chunk_name, &chunk_report, progress);
+      const Scene chunk = read_lod_set_chunk(meta, file, &chunk_report, progress);
       if (chunk_report.dropped_non_finite)
         fail(chunk_name, "Gaussians with non-finite values: the level's ranges would no longer line up");
       if (!first && chunk.sh_degree != scene.sh_degree)

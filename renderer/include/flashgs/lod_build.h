@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "flashgs/scene.h"
+
 namespace flashgs {
 
 // How the chunk files are written: INRIA PLY at full precision (L_K.ply, any 3DGS tool reads
@@ -35,6 +37,16 @@ struct LodBuildReport {
 
 // Builds the set in `out_folder` (created; it must be empty or absent) from the scene file
 // `input`. Throws flashgs::Error with one line naming the file or folder and the problem.
+// A chunk's file name in its set's folder: STEM.ply, or STEM/meta.json for a SOG chunk folder.
+std::string lod_chunk_name(const std::string& stem, LodChunkFormat format);
+// Writes `scene` as a chunk at `path` (named by lod_chunk_name; a SOG chunk's folder is
+// created) and returns the bytes written.
+std::uint64_t write_lod_chunk(const Scene& scene, const std::string& path, LodChunkFormat format);
+
+// Makes `folder` ready for a new LOD set: created, or kept when it is an empty folder; throws
+// flashgs::Error naming it otherwise.
+void prepare_lod_folder(const std::string& folder);
+
 LodBuildReport build_lod_set(const std::string& input, const std::string& out_folder, const LodBuildOptions& options);
 
 }  // namespace flashgs
