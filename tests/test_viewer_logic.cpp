@@ -858,23 +858,36 @@ TEST(ViewerGuides, FrustumsProjectWhereTheCamerasAreAndAClickPicksOne) {
 }
 
 // The centres view: a dot at each Gaussian's projected centre, in its base colour; those
-// behind the view or outside the image are left out, and a cap thins a large scene evenly.
+// behind the view or outside the image are left out, and a cap thins a large scene evenly; a
+// streamed cut's parts give the dots of the scene they make up.
 TEST(ViewerGuides, CentresAreDotsWhereTheGaussiansProject) {
-  flashgs::Scene scene;
+  auto shared = std::make_shared<flashgs::Scene>();
+  flashgs::Scene& scene = *shared;
   const float positions[] = {0, 0, 5, 1, 0, 5, 0, 0, -5, 100, 0, 5};  // the third behind, the fourth off-image
   scene.positions.assign(std::begin(positions), std::end(positions));
   scene.sh_dc = {1.0f, 0, -1.0f, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   scene.opacities = {1, 1, 1, 1};
   const float eye[3] = {0, 0, 0}, target[3] = {0, 0, 1}, up[3] = {0, -1, 0};
   const flashgs::Camera view = flashgs::look_at_camera(eye, target, up, 200, 100, 90.0f);
-  const auto dots = fv::centre_marks(scene, view, 100);
+  const std::vector<flashgs::ScenePart> whole = {{0, shared, 0, 4}};
+  const auto dots = fv::centre_marks(whole, view, 100);
   ASSERT_EQ(dots.size(), 2u);
   EXPECT_NEAR(0.5f * (dots[0].x0 + dots[0].x1), view.cx, 1e-3f);
   EXPECT_NEAR(dots[0].y0, view.cy, 1e-3f);
   EXPECT_NEAR(dots[0].rgba[0], 0.5f + 0.2820948f, 1e-5f);
   EXPECT_NEAR(dots[0].rgba[2], 0.5f - 0.2820948f, 1e-5f);
   EXPECT_NEAR(std::abs(0.5f * (dots[1].x0 + dots[1].x1) - view.cx), 0.2f * view.fx, 1e-2f);
-  EXPECT_EQ(fv::centre_marks(scene, view, 2).size(), 1u) << "every second Gaussian: the first and the third";
+  EXPECT_EQ(fv::centre_marks(whole, view, 2).size(), 1u) << "every second Gaussian: the first and the third";
+  // The same Gaussians as parts, out of the source's order: the second, then the fourth, third and first.
+  const std::vector<flashgs::ScenePart> parts = {{7, shared, 1, 1}, {8, shared, 3, 1}, {9, shared, 2, 1}, {10, shared, 0, 1}};
+  const auto part_dots = fv::centre_marks(parts, view, 100);
+  ASSERT_EQ(part_dots.size(), 2u);
+  EXPECT_EQ(part_dots[0].x0, dots[1].x0) << "the second Gaussian comes first";
+  EXPECT_EQ(part_dots[1].x0, dots[0].x0);
+  // Every second of the four drawn: the first part's and the third part's (behind the view).
+  const auto thinned = fv::centre_marks(parts, view, 2);
+  ASSERT_EQ(thinned.size(), 1u);
+  EXPECT_EQ(thinned[0].x0, dots[1].x0);
 }
 
 // After N or a snap in a window of another shape than the camera's images (16:10 vs 16:9),

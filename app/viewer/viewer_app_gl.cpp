@@ -200,6 +200,7 @@ void ViewerApp::use_cpu_path(const std::string& why) {
   m_have_request = false;
   std::fprintf(stderr, "flashgs-viewer: frame path: %s (%s)\n", m_path->name().c_str(), why.c_str());
   if (m_scene.scene) m_path->set_scene(m_scene.scene);
+  m_stream.hand_over_again();  // a streamed cut goes to the new path at the next frame
 }
 
 void ViewerApp::select_frame_path() {
@@ -526,7 +527,7 @@ void ViewerApp::draw_guides(int fb_w, int fb_h) {
   key_guides(world);
   std::vector<ScreenSegment> screen = project_segments(world, m_last_camera, 1e-3f * m_scene.extent);
   if (m_settings.show_centres && m_scene.scene) {
-    const std::vector<ScreenSegment> dots = centre_marks(*m_scene.scene, m_last_camera, kMaxCentreMarks);
+    const std::vector<ScreenSegment> dots = centre_marks(drawn_parts(), m_last_camera, kMaxCentreMarks);
     screen.insert(screen.end(), dots.begin(), dots.end());
   }
   m_lines->draw(screen, m_last_camera.width, m_last_camera.height, fb_w, fb_h);
@@ -983,8 +984,9 @@ UiModel ViewerApp::panel_model(int fb_w, int fb_h) {
   model.frame_path_note = m_path_note;
   model.backend = m_path_is_cpu ? Backend::cpu : Backend::cuda;
   model.scene_path = m_scene.path;
-  model.gaussians = m_scene.scene ? m_scene.scene->size() : 0;
-  model.sh_degree = m_scene.scene ? m_scene.scene->sh_degree : 0;
+  const std::vector<ScenePart> drawn = drawn_parts();
+  model.gaussians = scene_parts_size(drawn);
+  model.sh_degree = drawn.empty() ? 0 : drawn.front().source->sh_degree;
   model.trained = m_scene.scene ? m_scene.scene->trained_kernel.kernel : SplatKernel::classic();
   model.trained_kernel = m_scene.scene ? kernel_summary(m_scene.scene->trained_kernel) : std::string();
   model.lod_gaussians = m_scene.lod_gaussians.empty() ? nullptr : &m_scene.lod_gaussians;
