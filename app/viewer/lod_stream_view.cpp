@@ -84,7 +84,7 @@ std::string LodStreamView::summary() const {
   char text[400];
   std::snprintf(text, sizeof text,
                 "%s drawn (levels %s), %d chunks in memory, %d coming%s, %.0f MB (high %.0f MB), %zu parts handed over "
-                "(%llu times, %zu new)",
+                "(hand-over %llu: %zu new)",
                 human_count(double(s.drawn_gaussians)).c_str(), levels.empty() ? "none" : levels.c_str(), s.files_resident,
                 s.files_queued, s.files_failed ? (", " + std::to_string(s.files_failed) + " unreadable").c_str() : "",
                 static_cast<double>(s.host_bytes) / 1e6, static_cast<double>(s.host_high_water) / 1e6, f.parts,

@@ -51,7 +51,7 @@ class LodStreamView {
   // Chunks are on their way: the window keeps drawing so that they show as they arrive.
   bool loading() const;
   // "1.2M drawn (levels 0:.. 1:..), 14 chunks in memory, 3 coming, 512 MB (high 600 MB), 14 parts
-  // handed over (3 times, 2 new)"
+  // handed over (hand-over 3: 2 new)"
   std::string summary() const;
   std::vector<std::string> take_errors();
 
