@@ -38,6 +38,9 @@ class InteropPath final : public FramePath {
   void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) override {
     m_renderer->set_scene_parts(parts, resident_bytes);
   }
+  std::string scene_parts_refusal(const RenderOptions& options) const override {
+    return m_renderer->scene_parts_refusal(options);
+  }
 
   int texture_count() const override { return kTextures; }
 

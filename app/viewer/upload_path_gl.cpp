@@ -15,6 +15,9 @@ class UploadPath final : public FramePath {
   void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) override {
     m_renderer->set_scene_parts(parts, resident_bytes);
   }
+  std::string scene_parts_refusal(const RenderOptions& options) const override {
+    return m_renderer->scene_parts_refusal(options);
+  }
   void attach_textures(const unsigned*, int, int) override {}
   void release_textures() override {}
 

@@ -423,6 +423,7 @@ void ViewerApp::start_comparison() {
   job.left = compare_choice_options(m_settings.compare_left, m_settings.options);
   job.right = compare_choice_options(m_settings.compare_right, m_settings.options);
   job.rounds = m_args.compare_rounds;
+  if (!assemble_stream_for({job.left, job.right})) return;  // the GPU's pool draws neither baseline nor fp16
   m_compare = {};  // the last comparison's images are of another view: the frame shows meanwhile
   m_compare_camera = m_last_camera;
   m_compare_options = m_last_options;
@@ -600,7 +601,7 @@ void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
   request.options.collect_tile_counts = m_settings.heatmap;  // counts cost a copy: only when shown
   request.options.collect_pixel_planes = m_settings.view != FrameView::colour;
   request.reduced = reduced;
-  const bool streamed = m_stream.active() && update_stream(request.camera);
+  const bool streamed = m_stream.active() && update_stream(request.camera, request.options);
   const bool changed = streamed || !m_have_request || !same_camera(request.camera, m_requested.camera) ||
                        request.options != m_requested.options;
   const bool again = m_scripted || (m_settings.continuous && !m_path->busy());

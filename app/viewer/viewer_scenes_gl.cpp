@@ -113,7 +113,7 @@ void ViewerApp::start_stream() {
                settings.host_bytes ? (std::to_string(m_args.host_memory_mb) + " MiB").c_str() : "none");
 }
 
-bool ViewerApp::update_stream(const Camera& camera) {
+bool ViewerApp::update_stream(const Camera& camera, const RenderOptions& options) {
   StreamSettings wanted = m_stream.settings();
   wanted.max_error_px = m_settings.stream_max_error_px;
   wanted.budget = static_cast<std::uint64_t>(double(m_settings.stream_budget_millions) * 1e6);
@@ -132,11 +132,20 @@ bool ViewerApp::update_stream(const Camera& camera) {
     m_stream.set_level_overlay(m_settings.lod_overlay);
     std::fprintf(stderr, "flashgs-viewer: level overlay %s\n", m_settings.lod_overlay ? "on" : "off");
   }
-  // The cut goes to the frame path as parts: the GPU keeps them and uploads only new ones.
+  // The cut goes to the frame path as parts: the GPU keeps them and uploads only new ones. Its
+  // pool draws fewer configurations than a whole scene: for the others, the cut assembled.
+  const std::string refusal = m_path->scene_parts_refusal(options);
+  if (refusal.empty() == m_stream_assembled) {
+    m_stream_assembled = !refusal.empty();
+    m_stream.hand_over_again();
+    std::fprintf(stderr, "flashgs-viewer: the streamed cut goes to the renderer %s%s\n",
+                 m_stream_assembled ? "assembled: " : "as parts", refusal.c_str());
+  }
   bool refused = false;
   const auto hand_over = [&](const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) {
     try {
-      m_path->set_scene_parts(parts, resident_bytes);
+      if (m_stream_assembled) m_path->set_scene(assemble_scene_parts(parts));
+      else m_path->set_scene_parts(parts, resident_bytes);
     } catch (...) {
       refused = true;
       throw;
@@ -165,6 +174,23 @@ bool ViewerApp::update_stream(const Camera& camera) {
     std::fprintf(stderr, "flashgs-viewer: stream settled: %s\n", m_stream.summary().c_str());
   m_stream_was_loading = loading;
   return handed;
+}
+
+bool ViewerApp::assemble_stream_for(const std::vector<RenderOptions>& options) {
+  if (m_stream_assembled || m_stream.drawn_parts().empty()) return true;
+  std::string refusal;
+  for (const RenderOptions& o : options)
+    if (refusal.empty()) refusal = m_path->scene_parts_refusal(o);
+  if (refusal.empty()) return true;
+  try {
+    m_path->set_scene(assemble_scene_parts(m_stream.drawn_parts()));
+  } catch (const std::exception& e) {
+    set_notice("the streamed cut could not be assembled: " + error_text(e));
+    return false;
+  }
+  std::fprintf(stderr, "flashgs-viewer: the streamed cut goes to the renderer assembled: %s\n", refusal.c_str());
+  m_stream.hand_over_again();
+  return true;
 }
 
 std::vector<ScenePart> ViewerApp::drawn_parts() const {
