@@ -602,8 +602,8 @@ TEST(LodFeed, HandsTheCutOverAsPartsWhenItChanges) {
   EXPECT_EQ(renderer.scenes, 4) << "the default set_scene_parts assembles the parts for set_scene";
 }
 
-// The host cap counts the scene a host renderer assembles from the parts (the drawn one and the
-// next), and none where the renderer keeps them on the GPU.
+// The host's count holds the scene a host renderer assembles from the parts, and none where the
+// renderer keeps them on the GPU. No cap: the same chunks in memory, whatever the loads' timing.
 TEST(LodStream, TheHostCapCountsTheScenePartsAreAssembledInto) {
   const std::uint64_t scene_bytes = 4 * (14 + 9);  // the demo scene is SH degree 1
   const Camera camera = test::load_demo_cameras()[5].resized(160, 90);
@@ -611,7 +611,6 @@ TEST(LodStream, TheHostCapCountsTheScenePartsAreAssembledInto) {
   for (const bool on_device : {false, true}) {
     LodStreamOptions options;
     options.cut.max_error_px = 0.0f;
-    options.host_bytes = 4u << 20;
     options.parts_on_device = on_device;
     lod_frame_costs(BackendKind::cpu, 160, 90, 2, &options.host_frame, &options.device_frame);
     LodStreamer streamer(read_lod_set(demo_set()), options);
@@ -622,7 +621,6 @@ TEST(LodStream, TheHostCapCountsTheScenePartsAreAssembledInto) {
     ASSERT_GT(drawn, 0u);
     EXPECT_GE(s.host_bytes, options.host_frame.fixed + drawn * options.host_frame.per_gaussian);
     EXPECT_GE(s.host_high_water, s.host_bytes) << "the high-water mark is below what is held now";
-    EXPECT_LE(s.host_high_water, options.host_bytes);
     held[on_device] = s.host_bytes;
     drawn_of[on_device] = drawn;
   }
