@@ -1355,6 +1355,7 @@ TEST(Viewer, StreamingALodSetAtFullDetailShowsTheSourceScenesFrame) {
   const std::string parts = std::to_string(built.leaves) + " parts handed over (hand-over 1: " +
                             std::to_string(built.leaves) + " new)";
   EXPECT_NE(streamed.output.find(parts), std::string::npos) << "wanted \"" << parts << "\"\n" << streamed.output;
+  EXPECT_EQ(streamed.output.find("goes to the renderer assembled"), std::string::npos) << streamed.output;
   const RunResult whole = run(common + "--screenshot " + dir + "/whole.pfm");
   ASSERT_EQ(whole.exit_code, 0) << whole.output;
   const flashgs::ImageDifference d =
