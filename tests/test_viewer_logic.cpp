@@ -26,6 +26,9 @@
 #include "flashgs/io.h"
 #include "key_script.h"
 #include "lod_cache.h"
+#include "lod_stream_view.h"
+#include "flashgs/lod_build.h"
+#include "flashgs/lod_tint.h"
 #include "flashgs/frame_memory.h"
 #include "heatmap_legend.h"
 #include "memory_budget.h"
@@ -1123,4 +1126,106 @@ TEST(ViewerLodCache, TheKeyFollowsTheFileAndTheBuildSizes) {
   fs::last_write_time(file, touched);
   EXPECT_NE(fv::lod_cache_folders(file, options).beside, after_touch) << "another size";
   EXPECT_THROW(fv::lod_cache_folders(dir + "/absent.ply", options), flashgs::Error);
+}
+
+namespace {
+
+// A frame path that holds parts as the GPU's pool does: it refuses to draw them with the
+// baseline, and records what it was given (and can refuse the next parts, as a full GPU would).
+class PoolLikePath final : public fv::FramePath {
+ public:
+  std::string name() const override { return "pool-like"; }
+  void set_scene(std::shared_ptr<const flashgs::Scene> scene) override {
+    ++scenes;
+    scene_size = scene->size();
+  }
+  void set_scene_parts(const std::vector<flashgs::ScenePart>& parts, std::uint64_t resident) override {
+    if (refuse_parts) throw flashgs::Error("out of GPU memory");
+    ++part_sets;
+    last_parts = parts;
+    resident_bytes = resident;
+  }
+  std::string scene_parts_refusal(const flashgs::RenderOptions& options) const override {
+    return options.is_baseline() ? "not by the baseline" : "";
+  }
+  void attach_textures(const unsigned*, int, int) override {}
+  void release_textures() override {}
+  void render_to_texture(const flashgs::Camera&, const flashgs::RenderOptions&, flashgs::FrameStats*) override {}
+  void render_image(const flashgs::Camera&, const flashgs::RenderOptions&, flashgs::Image&, flashgs::FrameStats*,
+                    const std::atomic<bool>*) override {}
+  void tile_counts(const flashgs::FrameStats&, std::vector<std::uint32_t>&) override {}
+
+  int scenes = 0, part_sets = 0;
+  std::size_t scene_size = 0;
+  bool refuse_parts = false;
+  std::vector<flashgs::ScenePart> last_parts;
+  std::uint64_t resident_bytes = 0;
+};
+
+}  // namespace
+
+// The viewer's streamed cut reaches a GPU-like path as parts under the GPU cap, assembled while
+// the view's configuration is one the path cannot draw parts with (and for a comparison's side),
+// as parts again after; a refused hand-over is tried again; the overlay hands tinted parts.
+TEST(ViewerStream, TheCutGoesAsPartsOrAssembledWhereThePathCannotDrawParts) {
+  const std::string set = scratch_dir("stream_parts") + "/set";
+  flashgs::LodBuildOptions build;
+  build.leaf_gaussians = 2048;
+  flashgs::build_lod_set(flashgs::demo_scene_path(), set, build);
+  fv::StreamSettings settings;
+  settings.max_error_px = 8.0f;
+  settings.device_bytes = 64u << 20;
+  settings.parts_on_device = true;
+  fv::LodStreamView stream;
+  stream.start(set + "/lod-meta.json", settings);
+  const flashgs::Camera camera = flashgs::load_cameras(flashgs::demo_cameras_path())[3].resized(320, 180);
+  const flashgs::RenderOptions flash, baseline = flashgs::RenderOptions::baseline();
+  PoolLikePath path;
+
+  fv::StreamUpdate u = stream.update(camera, flash, true, 0.0, path);
+  ASSERT_TRUE(u.handed);
+  EXPECT_FALSE(u.assembled_changed);
+  EXPECT_EQ(path.part_sets, 1);
+  EXPECT_EQ(path.scenes, 0);
+  EXPECT_GT(path.resident_bytes, 0u) << "the GPU cap did not reach the path";
+  const std::uint64_t drawn = flashgs::scene_parts_size(path.last_parts);
+  EXPECT_EQ(drawn, stream.stats().drawn_gaussians);
+  EXPECT_FALSE(stream.update(camera, flash, false, 0.0, path).handed) << "the same cut was handed over again";
+
+  u = stream.update(camera, baseline, false, 0.0, path);
+  EXPECT_TRUE(u.handed && u.assembled_changed);
+  EXPECT_EQ(stream.assembled_because(), "not by the baseline");
+  EXPECT_EQ(path.scenes, 1);
+  EXPECT_EQ(path.scene_size, drawn);
+  EXPECT_FALSE(stream.update(camera, baseline, false, 0.0, path).handed);
+  u = stream.update(camera, flash, false, 0.0, path);
+  EXPECT_TRUE(u.handed && u.assembled_changed);
+  EXPECT_EQ(path.part_sets, 2);
+
+  // A comparison of the baseline with flash: the cut assembled for it, parts at the next frame.
+  EXPECT_EQ(stream.assemble_for({baseline, flash}, path), "not by the baseline");
+  EXPECT_EQ(path.scenes, 2);
+  EXPECT_EQ(stream.assemble_for({flash}, path), "");
+  EXPECT_TRUE(stream.update(camera, flash, false, 0.0, path).handed);
+  EXPECT_EQ(path.part_sets, 3);
+
+  path.refuse_parts = true;
+  stream.hand_over_again();
+  u = stream.update(camera, flash, false, 0.0, path);
+  EXPECT_FALSE(u.handed);
+  EXPECT_EQ(u.path_error, "out of GPU memory");
+  path.refuse_parts = false;
+  EXPECT_TRUE(stream.update(camera, flash, false, 0.0, path).handed) << "a refused cut was not handed over again";
+
+  stream.set_level_overlay(true);
+  ASSERT_TRUE(stream.update(camera, flash, false, 0.0, path).handed);
+  EXPECT_EQ(flashgs::scene_parts_size(path.last_parts), drawn);
+  for (const flashgs::ScenePart& p : path.last_parts) {
+    ASSERT_NE(p.key & flashgs::kTintedPartKeyBit, 0u);
+    EXPECT_EQ(p.source->sh_degree, 0);
+  }
+  EXPECT_EQ(stream.drawn_parts().size(), path.last_parts.size());
+  EXPECT_NE(stream.summary().find(std::to_string(path.last_parts.size()) + " parts handed over (hand-over 6: "),
+            std::string::npos)
+      << stream.summary();
 }

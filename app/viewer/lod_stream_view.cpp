@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "count_text.h"
+#include "flashgs/error.h"
 #include "flashgs/lod_set.h"
 
 namespace flashgs::viewer {
@@ -37,18 +38,62 @@ void LodStreamView::start(const std::string& meta_path, const StreamSettings& se
 void LodStreamView::stop() {
   m_feed.reset();
   m_streamer.reset();
+  m_assembled_because.clear();
   m_read_rates.clear();
 }
 
-bool LodStreamView::update(const Camera& camera, bool settle, double now_s, const LodCutFeed::HandOver& hand_over) {
-  if (!m_streamer) return false;
+StreamUpdate LodStreamView::update(const Camera& camera, const RenderOptions& options, bool settle, double now_s,
+                                   FramePath& path) {
+  StreamUpdate out;
+  if (!m_streamer) return out;
+  const std::string refusal = path.scene_parts_refusal(options);
+  if (refusal.empty() != m_assembled_because.empty()) {
+    m_feed->hand_over_again();
+    out.assembled_changed = true;
+  }
+  m_assembled_because = refusal;
   if (settle) {
     m_streamer->update_parts(camera, nullptr);
     m_streamer->wait_until_idle();
   }
-  const bool handed = m_feed->update(camera, hand_over);
+  bool path_failed = false;
+  const auto hand_over = [&](const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) {
+    try {
+      if (m_assembled_because.empty()) path.set_scene_parts(parts, resident_bytes);
+      else path.set_scene(assemble_scene_parts(parts));
+    } catch (...) {
+      path_failed = true;
+      throw;
+    }
+  };
+  try {
+    out.handed = m_feed->update(camera, hand_over);
+  } catch (const std::exception& e) {
+    if (path_failed || !m_overlay) {
+      out.path_error = error_text(e);
+    } else {  // the overlay's copies: the scene's own colours instead
+      out.overlay_error = error_text(e);
+      set_level_overlay(false);
+      try {
+        out.handed = m_feed->update(camera, hand_over);
+      } catch (const std::exception& again) {
+        out.path_error = error_text(again);
+      }
+    }
+  }
   m_read_rates.observe(now_s, m_streamer->stats().bytes_read);
-  return handed;
+  return out;
+}
+
+std::string LodStreamView::assemble_for(const std::vector<RenderOptions>& options, FramePath& path) {
+  if (!m_feed || m_feed->handed_parts().empty() || !m_assembled_because.empty()) return "";
+  std::string refusal;
+  for (const RenderOptions& o : options)
+    if (refusal.empty()) refusal = path.scene_parts_refusal(o);
+  if (refusal.empty()) return "";
+  path.set_scene(assemble_scene_parts(m_feed->handed_parts()));
+  m_feed->hand_over_again();
+  return refusal;
 }
 
 void LodStreamView::hand_over_again() {

@@ -423,7 +423,14 @@ void ViewerApp::start_comparison() {
   job.left = compare_choice_options(m_settings.compare_left, m_settings.options);
   job.right = compare_choice_options(m_settings.compare_right, m_settings.options);
   job.rounds = m_args.compare_rounds;
-  if (!assemble_stream_for({job.left, job.right})) return;  // the GPU's pool draws neither baseline nor fp16
+  try {  // the GPU's pool draws neither the baseline nor fp16 storage: the cut assembled for them
+    const std::string assembled = m_stream.assemble_for({job.left, job.right}, *m_path);
+    if (!assembled.empty())
+      std::fprintf(stderr, "flashgs-viewer: the streamed cut goes to the renderer assembled: %s\n", assembled.c_str());
+  } catch (const std::exception& e) {
+    set_notice("comparison refused: the streamed cut could not be assembled: " + error_text(e));
+    return;
+  }
   m_compare = {};  // the last comparison's images are of another view: the frame shows meanwhile
   m_compare_camera = m_last_camera;
   m_compare_options = m_last_options;

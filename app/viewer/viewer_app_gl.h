@@ -68,10 +68,6 @@ class ViewerApp {
   // Hands the streamed cut for this view to the frame path as parts (assembled where the path
   // cannot draw parts with `options`); true when what is drawn changed (a new frame is needed).
   bool update_stream(const Camera& camera, const RenderOptions& options);
-  // Gives the frame path the streamed cut assembled into one scene when it cannot draw the parts
-  // with one of `options` (the GPU's pool and the baseline); the next frame hands parts again.
-  // False (a notice says why) when the scene could not be set.
-  bool assemble_stream_for(const std::vector<RenderOptions>& options);
   // What the frame path draws: the streamed cut's parts once one was handed over, else the scene as one part.
   std::vector<ScenePart> drawn_parts() const;
   void finish_pending_load();
@@ -172,7 +168,6 @@ class ViewerApp {
   LoadedScene m_scene;
   LodStreamView m_stream;       // --stream: the set drawn at the detail each view needs
   bool m_stream_was_loading = false;
-  bool m_stream_assembled = false;  // the path cannot draw the cut's parts with the view's options
   std::string m_load_error;  // the last failed load and what is shown instead
   SceneLoader m_loader;
   bool m_first_load_pending = false;  // the first scene loads in the background

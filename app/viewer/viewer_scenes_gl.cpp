@@ -134,63 +134,21 @@ bool ViewerApp::update_stream(const Camera& camera, const RenderOptions& options
   }
   // The cut goes to the frame path as parts: the GPU keeps them and uploads only new ones. Its
   // pool draws fewer configurations than a whole scene: for the others, the cut assembled.
-  const std::string refusal = m_path->scene_parts_refusal(options);
-  if (refusal.empty() == m_stream_assembled) {
-    m_stream_assembled = !refusal.empty();
-    m_stream.hand_over_again();
+  const StreamUpdate u = m_stream.update(camera, options, m_scripted, ms_since_start() / 1000.0, *m_path);
+  if (u.assembled_changed)
     std::fprintf(stderr, "flashgs-viewer: the streamed cut goes to the renderer %s%s\n",
-                 m_stream_assembled ? "assembled: " : "as parts", refusal.c_str());
+                 m_stream.assembled_because().empty() ? "as parts" : "assembled: ", m_stream.assembled_because().c_str());
+  if (!u.overlay_error.empty()) {  // no memory for the overlay's copies: the scene's own colours
+    set_notice("level overlay off: " + u.overlay_error);
+    m_settings.lod_overlay = false;
   }
-  bool refused = false;
-  const auto hand_over = [&](const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) {
-    try {
-      if (m_stream_assembled) m_path->set_scene(assemble_scene_parts(parts));
-      else m_path->set_scene_parts(parts, resident_bytes);
-    } catch (...) {
-      refused = true;
-      throw;
-    }
-  };
-  bool handed = false;
-  try {
-    handed = m_stream.update(camera, m_scripted, ms_since_start() / 1000.0, hand_over);
-  } catch (const std::exception& e) {
-    if (refused) {  // out of GPU memory: handed over again next frame
-      set_notice("streamed scene refused: " + error_text(e));
-    } else {  // no memory for the overlay's copies: the scene's own colours
-      set_notice("level overlay off: " + error_text(e));
-      m_settings.lod_overlay = false;
-      m_stream.set_level_overlay(false);
-      try {
-        handed = m_stream.update(camera, false, ms_since_start() / 1000.0, hand_over);
-      } catch (const std::exception& again) {
-        set_notice("streamed scene refused: " + error_text(again));
-      }
-    }
-  }
+  if (!u.path_error.empty()) set_notice("streamed scene refused: " + u.path_error);  // out of GPU memory: again next frame
   for (const std::string& line : m_stream.take_errors()) set_notice(line);
   const bool loading = m_stream.loading();
   if (m_stream_was_loading && !loading)  // tests and users see when the view's chunks are all in
     std::fprintf(stderr, "flashgs-viewer: stream settled: %s\n", m_stream.summary().c_str());
   m_stream_was_loading = loading;
-  return handed;
-}
-
-bool ViewerApp::assemble_stream_for(const std::vector<RenderOptions>& options) {
-  if (m_stream_assembled || m_stream.drawn_parts().empty()) return true;
-  std::string refusal;
-  for (const RenderOptions& o : options)
-    if (refusal.empty()) refusal = m_path->scene_parts_refusal(o);
-  if (refusal.empty()) return true;
-  try {
-    m_path->set_scene(assemble_scene_parts(m_stream.drawn_parts()));
-  } catch (const std::exception& e) {
-    set_notice("the streamed cut could not be assembled: " + error_text(e));
-    return false;
-  }
-  std::fprintf(stderr, "flashgs-viewer: the streamed cut goes to the renderer assembled: %s\n", refusal.c_str());
-  m_stream.hand_over_again();
-  return true;
+  return u.handed;
 }
 
 std::vector<ScenePart> ViewerApp::drawn_parts() const {
