@@ -1220,13 +1220,16 @@ TEST(CudaSceneParts, DrawTheFrameOfTheAssembledScene) {
 }
 
 // A pooled scene is drawn through its page list, which only flash with fused emission in full
-// precision reads: other configurations are refused with a line saying so, and a scene set
-// whole afterwards renders as in a fresh renderer.
+// precision reads: other configurations are refused with a line saying so (which
+// scene_parts_refusal tells beforehand), and a scene set whole afterwards renders as in a fresh
+// renderer.
 TEST(CudaSceneParts, RefuseTheBaselineAndGiveWayToAWholeScene) {
   FLASHGS_REQUIRE_CUDA();
   const auto scene = test::load_demo_scene();
   const Camera camera = test::load_demo_cameras()[3].resized(333, 211);
   auto gpu = make_cuda_renderer();
+  EXPECT_EQ(gpu->scene_parts_refusal(RenderOptions{}), "");
+  EXPECT_NE(gpu->scene_parts_refusal(RenderOptions::baseline()).find("not by the baseline"), std::string::npos);
   gpu->set_scene_parts(uneven_parts(scene), 0);
   Image image;
   try {

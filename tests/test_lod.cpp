@@ -18,6 +18,7 @@
 #include "flashgs/io.h"
 #include "flashgs/lod_build.h"
 #include "flashgs/lod_cut.h"
+#include "flashgs/lod_feed.h"
 #include "flashgs/lod_stream.h"
 #include "flashgs/lod_tint.h"
 #include "flashgs/model_constants.h"
@@ -385,9 +386,10 @@ TEST(LodStream, ACorruptChunkIsOneLineAndTheRestKeepsRendering) {
   EXPECT_EQ(streamer.stats().files_failed, 1);
 }
 
-// The level overlay: every Gaussian takes its run's level colour, the geometry stays, and runs
-// that do not cover the scene are refused.
-TEST(LodTint, EachGaussianTakesItsLevelsColourAndTheGeometryStays) {
+// The level overlay of a cut's parts: every Gaussian takes its run's level colour, the geometry
+// stays, each copy is keyed apart from its part and made once while cuts keep the part, and runs
+// that do not fit the parts are refused.
+TEST(LodTint, EachPartsGaussiansTakeTheirLevelsColourAndTheGeometryStays) {
   Scene scene = two_gaussians(0.5f, 1.0f);
   scene.append(two_gaussians(0.8f, 2.0f));
   scene.append(two_gaussians(0.3f, 3.0f));  // six Gaussians
@@ -399,8 +401,19 @@ TEST(LodTint, EachGaussianTakesItsLevelsColourAndTheGeometryStays) {
   with_sh.opacities = scene.opacities;
   with_sh.sh_dc = scene.sh_dc;
   with_sh.sh_rest.assign(scene.size() * 9, 0.25f);
+  const auto source = std::make_shared<const Scene>(with_sh);
+  const std::vector<ScenePart> parts = {{10, source, 0, 2}, {20, source, 2, 3}, {30, source, 5, 1}};
   const std::vector<LodLevelRun> runs = {{0, 2}, {3, 3}, {0, 1}};
-  const Scene tinted = tint_by_level(with_sh, runs);
+  TintedParts copies;
+  const std::vector<ScenePart> tinted_parts = tint_parts_by_level(parts, runs, copies);
+  ASSERT_EQ(tinted_parts.size(), parts.size());
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    EXPECT_EQ(tinted_parts[p].key, parts[p].key | kTintedPartKeyBit);
+    EXPECT_EQ(tinted_parts[p].count, parts[p].count);
+    EXPECT_NE(tinted_parts[p].source, source) << "the overlay changed the source scene";
+  }
+  EXPECT_EQ(copies.size(), 3u);
+  const Scene tinted = *assemble_scene_parts(tinted_parts);
   ASSERT_EQ(tinted.size(), with_sh.size());
   EXPECT_EQ(tinted.sh_degree, 0);
   EXPECT_TRUE(tinted.sh_rest.empty());
@@ -416,8 +429,21 @@ TEST(LodTint, EachGaussianTakesItsLevelsColourAndTheGeometryStays) {
   }
   EXPECT_NE(lod_level_colour(0), lod_level_colour(3));
   EXPECT_EQ(lod_level_colour(lod_palette_size() + 2), lod_level_colour(2));
-  EXPECT_THROW(tint_by_level(with_sh, {{0, 2}, {1, 3}}), Error);
-  EXPECT_THROW(tint_by_level(with_sh, {{0, 7}}), Error);
+  EXPECT_EQ(source->sh_rest, std::vector<float>(scene.size() * 9, 0.25f));
+
+  // The next cut keeps the second part and adds a fourth: the kept copy is the same one, the
+  // dropped parts' copies leave the cache.
+  const std::vector<ScenePart> next = {{20, source, 2, 3}, {40, source, 0, 1}};
+  const std::vector<ScenePart> tinted_next = tint_parts_by_level(next, {{3, 3}, {1, 1}}, copies);
+  EXPECT_EQ(tinted_next[0].source, tinted_parts[1].source);
+  EXPECT_EQ(copies.size(), 2u);
+  EXPECT_EQ(copies.count(10 | kTintedPartKeyBit), 0u);
+
+  TintedParts fresh;
+  EXPECT_THROW(tint_parts_by_level(parts, {{0, 2}, {1, 3}}, fresh), Error);          // do not cover the parts
+  EXPECT_THROW(tint_parts_by_level(parts, {{0, 7}}, fresh), Error);                  // beyond them
+  EXPECT_THROW(tint_parts_by_level(parts, {{0, 1}, {3, 4}, {0, 1}}, fresh), Error);  // a part across two runs
+  EXPECT_THROW(tint_parts_by_level(tinted_parts, runs, fresh), Error);               // tinted twice
 }
 
 // A drawn scene's ranges become runs of levels by the chunk file each range is in.
@@ -442,7 +468,8 @@ TEST(LodTint, RangesBecomeRunsByTheirFilesLevel) {
 }
 
 // The streamer says which level each drawn Gaussian came from: the runs cover the drawn scene
-// and add up to its per-level counts; the overlay colours each run by its level.
+// (the assembled one and the parts alike) and add up to its per-level counts; the overlay
+// colours each run of the parts by its level.
 TEST(LodStream, TheLevelRunsFollowTheDrawnScene) {
   const LodSet set = read_lod_set(demo_set());
   LodStreamOptions options;
@@ -465,13 +492,140 @@ TEST(LodStream, TheLevelRunsFollowTheDrawnScene) {
   EXPECT_EQ(per_level, streamer.stats().drawn_per_level);
   EXPECT_GE(std::count_if(per_level.begin(), per_level.end(), [](std::uint64_t n) { return n > 0; }), 2)
       << "the view should mix levels at 8 px";
-  const Scene tinted = tint_by_level(*scene, runs);
+  const std::vector<ScenePart> parts = streamer.update_parts(camera, nullptr);
+  const std::vector<LodLevelRun> part_runs = lod_level_runs(set, streamer.drawn_ranges());
+  ASSERT_EQ(part_runs.size(), runs.size());
+  TintedParts copies;
+  const Scene tinted = *assemble_scene_parts(tint_parts_by_level(parts, part_runs, copies));
+  ASSERT_EQ(tinted.size(), scene->size());
   std::size_t at = 0;
-  for (const LodLevelRun& r : runs) {
+  for (const LodLevelRun& r : part_runs) {
     const std::array<float, 3> want = lod_level_colour(r.level);
-    EXPECT_NEAR(0.5 + model::kShC0 * tinted.sh_dc[at * 3], want[0], 1e-6);
-    at += r.count;
+    for (std::uint64_t i = 0; i < r.count; ++i, ++at)
+      ASSERT_NEAR(0.5 + model::kShC0 * tinted.sh_dc[at * 3], want[0], 1e-6) << "Gaussian " << at;
   }
+  EXPECT_EQ(tinted.positions, scene->positions);
+}
+
+// A renderer that counts what it is handed and draws with the CPU backend.
+class HandOverCounter final : public Renderer {
+ public:
+  std::string name() const override { return "counting cpu"; }
+  void set_scene(std::shared_ptr<const Scene> scene) override {
+    ++scenes;
+    m_cpu->set_scene(std::move(scene));
+  }
+  void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident) override {
+    if (refuse) throw Error("refused");
+    ++part_sets;
+    last_parts = parts;
+    resident_bytes = resident;
+    Renderer::set_scene_parts(parts, resident);  // assembled, through set_scene
+  }
+  void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override {
+    m_cpu->render(camera, options, out, stats);
+  }
+  int scenes = 0, part_sets = 0;
+  bool refuse = false;
+  std::vector<ScenePart> last_parts;
+  std::uint64_t resident_bytes = 0;
+
+ private:
+  std::unique_ptr<Renderer> m_cpu = make_cpu_renderer(2);
+};
+
+// The feed hands the cut over as parts, under the streamer's GPU cap, only when it changed (or
+// when asked to, or the overlay changed); never an empty cut; a refused hand-over is tried again;
+// the frame is the assembled cut's; with the overlay the parts are the tinted copies.
+TEST(LodFeed, HandsTheCutOverAsPartsWhenItChanges) {
+  const LodSet set = read_lod_set(demo_set());
+  LodStreamOptions options;
+  options.cut.max_error_px = 8.0f;
+  options.device_bytes = 64u << 20;
+  options.parts_on_device = true;
+  LodStreamer streamer(set, options);
+  LodStreamer reference(set, options);
+  LodCutFeed feed(streamer);
+  HandOverCounter renderer;
+  const Camera camera = test::load_demo_cameras()[3].resized(320, 180);
+  EXPECT_FALSE(feed.update(camera, renderer)) << "nothing is in memory before the first update";
+  EXPECT_EQ(feed.cut_gaussians(), 0u);
+  EXPECT_EQ(renderer.part_sets, 0);
+  streamer.wait_until_idle();
+  ASSERT_TRUE(feed.update(camera, renderer));
+  EXPECT_EQ(renderer.part_sets, 1);
+  EXPECT_EQ(renderer.resident_bytes, streamer.device_resident_bytes());
+  EXPECT_GT(renderer.resident_bytes, 0u);
+  EXPECT_EQ(feed.stats().hand_overs, 1u);
+  EXPECT_EQ(feed.stats().parts, renderer.last_parts.size());
+  EXPECT_EQ(feed.stats().new_parts, renderer.last_parts.size());
+  EXPECT_EQ(feed.handed_parts().size(), renderer.last_parts.size());
+  EXPECT_EQ(feed.cut_gaussians(), scene_parts_size(renderer.last_parts));
+
+  reference.update(camera);
+  reference.wait_until_idle();
+  const std::shared_ptr<const Scene> whole = reference.update(camera);
+  auto cpu = make_cpu_renderer(2);
+  cpu->set_scene(whole);
+  Image from_parts, from_scene;
+  renderer.render(camera, RenderOptions{}, from_parts, nullptr);
+  cpu->render(camera, RenderOptions{}, from_scene, nullptr);
+  EXPECT_EQ(from_parts.rgb, from_scene.rgb);
+
+  EXPECT_FALSE(feed.update(camera, renderer)) << "the same cut was handed over again";
+  feed.hand_over_again();
+  EXPECT_TRUE(feed.update(camera, renderer));
+  EXPECT_EQ(feed.stats().new_parts, 0u);
+  EXPECT_EQ(renderer.part_sets, 2);
+
+  feed.set_level_overlay(true);
+  ASSERT_TRUE(feed.update(camera, renderer));
+  for (const ScenePart& p : renderer.last_parts) ASSERT_NE(p.key & kTintedPartKeyBit, 0u);
+  EXPECT_EQ(feed.stats().new_parts, renderer.last_parts.size()) << "a tinted part shares a key with an untinted one";
+  const std::vector<LodLevelRun> runs = lod_level_runs(set, streamer.drawn_ranges());
+  const std::shared_ptr<const Scene> tinted = assemble_scene_parts(renderer.last_parts);
+  std::size_t at = 0;
+  for (const LodLevelRun& r : runs)
+    for (std::uint64_t i = 0; i < r.count; ++i, ++at)
+      ASSERT_NEAR(0.5 + model::kShC0 * tinted->sh_dc[at * 3 + 1], lod_level_colour(r.level)[1], 1e-6) << "Gaussian " << at;
+  EXPECT_EQ(at, tinted->size());
+  EXPECT_FALSE(feed.update(camera, renderer));
+
+  feed.set_level_overlay(false);
+  renderer.refuse = true;
+  EXPECT_THROW(feed.update(camera, renderer), Error);
+  renderer.refuse = false;
+  ASSERT_TRUE(feed.update(camera, renderer)) << "a refused cut was not handed over again";
+  for (const ScenePart& p : renderer.last_parts) ASSERT_EQ(p.key & kTintedPartKeyBit, 0u);
+  EXPECT_EQ(renderer.part_sets, 4);
+  EXPECT_EQ(feed.stats().hand_overs, 4u);
+  EXPECT_EQ(renderer.scenes, 4) << "the default set_scene_parts assembles the parts for set_scene";
+}
+
+// The host's count holds the scene a host renderer assembles from the parts, and none where the
+// renderer keeps them on the GPU. No cap: the same chunks in memory, whatever the loads' timing.
+TEST(LodStream, TheHostCapCountsTheScenePartsAreAssembledInto) {
+  const std::uint64_t scene_bytes = 4 * (14 + 9);  // the demo scene is SH degree 1
+  const Camera camera = test::load_demo_cameras()[5].resized(160, 90);
+  std::uint64_t held[2] = {0, 0}, drawn_of[2] = {0, 0};
+  for (const bool on_device : {false, true}) {
+    LodStreamOptions options;
+    options.cut.max_error_px = 0.0f;
+    options.parts_on_device = on_device;
+    lod_frame_costs(BackendKind::cpu, 160, 90, 2, &options.host_frame, &options.device_frame);
+    LodStreamer streamer(read_lod_set(demo_set()), options);
+    streamer.update_parts(camera, nullptr);
+    streamer.wait_until_idle();
+    const std::uint64_t drawn = scene_parts_size(streamer.update_parts(camera, nullptr));
+    const LodStreamStats s = streamer.stats();
+    ASSERT_GT(drawn, 0u);
+    EXPECT_GE(s.host_bytes, options.host_frame.fixed + drawn * options.host_frame.per_gaussian);
+    EXPECT_GE(s.host_high_water, s.host_bytes) << "the high-water mark is below what is held now";
+    held[on_device] = s.host_bytes;
+    drawn_of[on_device] = drawn;
+  }
+  ASSERT_EQ(drawn_of[0], drawn_of[1]);
+  EXPECT_EQ(held[0] - held[1], drawn_of[0] * scene_bytes) << "the assembled scene is not what differs";
 }
 
 // A set built with SOG chunks (L_K/meta.json, as PlayCanvas's tools write them) streams the

@@ -1335,21 +1335,27 @@ TEST(Viewer, TheLodOptionOpensThatLevelAndABadOneIsNamed) {
 }
 
 // --stream draws a LOD set at the detail each view needs: with a zero error bound that is every
-// cell at level 0, the frame of the scene the set was built from; a scene that is no LOD set is
-// drawn whole, with one line saying so.
+// cell at level 0, the frame of the scene the set was built from, handed to the renderer as one
+// part per leaf (set_scene_parts), once, as the scripted view settles before it; a scene that is
+// no LOD set is drawn whole, with one line saying so.
 TEST(Viewer, StreamingALodSetAtFullDetailShowsTheSourceScenesFrame) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir(), set = dir + "/stream_demo_set";
   std::filesystem::remove_all(set);
   flashgs::LodBuildOptions options;
   options.leaf_gaussians = 2048;
-  flashgs::build_lod_set(flashgs::demo_scene_path(), set, options);
+  const flashgs::LodBuildReport built = flashgs::build_lod_set(flashgs::demo_scene_path(), set, options);
+  ASSERT_GT(built.leaves, 1);
   std::filesystem::copy_file(flashgs::demo_cameras_path(), set + "/cameras.json");
   const std::string common = prefix + viewer() + " --backend cpu --size 320x180 --camera 7 --frames 2 --exit ";
   const RunResult streamed = run(common + "'" + set + "' --stream --max-error-px 0 --screenshot " + dir + "/streamed.pfm");
   ASSERT_EQ(streamed.exit_code, 0) << streamed.output;
   EXPECT_NE(streamed.output.find("streaming " + set + "/lod-meta.json by view"), std::string::npos) << streamed.output;
   EXPECT_NE(streamed.output.find("stream settled: 30.0k drawn (levels 0:30.0k)"), std::string::npos) << streamed.output;
+  const std::string parts = std::to_string(built.leaves) + " parts handed over (hand-over 1: " +
+                            std::to_string(built.leaves) + " new)";
+  EXPECT_NE(streamed.output.find(parts), std::string::npos) << "wanted \"" << parts << "\"\n" << streamed.output;
+  EXPECT_EQ(streamed.output.find("goes to the renderer assembled"), std::string::npos) << streamed.output;
   const RunResult whole = run(common + "--screenshot " + dir + "/whole.pfm");
   ASSERT_EQ(whole.exit_code, 0) << whole.output;
   const flashgs::ImageDifference d =
@@ -1387,7 +1393,8 @@ double palette_share(const flashgs::Image& image, int levels) {
 }  // namespace
 
 // --lod-overlay draws each Gaussian in its level's colour: the streamed image's colours come
-// from the palette (the scene's own colours do not).
+// from the palette (the scene's own colours do not). The overlay's frame is drawn from parts
+// (tinted copies of the cut's parts), handed over as the plain cut is.
 TEST(Viewer, TheLevelOverlayColoursTheStreamedImageByLevel) {
   REQUIRE_DISPLAY(prefix);
   const std::string dir = out_dir(), set = dir + "/overlay_demo_set";
@@ -1403,6 +1410,14 @@ TEST(Viewer, TheLevelOverlayColoursTheStreamedImageByLevel) {
   EXPECT_NE(tinted.output.find("level overlay on"), std::string::npos) << tinted.output;
   const RunResult plain = run(common + "--screenshot " + dir + "/no_overlay.pfm");
   ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  // The same cut, as many parts with the overlay as without: one per leaf drawn.
+  const auto handed_parts = [](const std::string& output) {
+    const std::size_t at = output.find(" parts handed over (hand-over 1: ");
+    const std::size_t start = output.rfind(' ', at == std::string::npos ? 0 : at - 1);
+    return at == std::string::npos || start == std::string::npos ? -1 : std::stoi(output.substr(start + 1, at - start - 1));
+  };
+  EXPECT_GT(handed_parts(tinted.output), 0) << tinted.output;
+  EXPECT_EQ(handed_parts(tinted.output), handed_parts(plain.output)) << tinted.output << plain.output;
   const double with = palette_share(flashgs::read_image(dir + "/overlay.pfm"), built.levels);
   const double without = palette_share(flashgs::read_image(dir + "/no_overlay.pfm"), built.levels);
   std::printf("lit pixels in a palette colour: %.3f with the overlay, %.3f without\n", with, without);

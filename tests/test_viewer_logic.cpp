@@ -26,6 +26,9 @@
 #include "flashgs/io.h"
 #include "key_script.h"
 #include "lod_cache.h"
+#include "lod_stream_view.h"
+#include "flashgs/lod_build.h"
+#include "flashgs/lod_tint.h"
 #include "flashgs/frame_memory.h"
 #include "heatmap_legend.h"
 #include "memory_budget.h"
@@ -858,23 +861,36 @@ TEST(ViewerGuides, FrustumsProjectWhereTheCamerasAreAndAClickPicksOne) {
 }
 
 // The centres view: a dot at each Gaussian's projected centre, in its base colour; those
-// behind the view or outside the image are left out, and a cap thins a large scene evenly.
+// behind the view or outside the image are left out, and a cap thins a large scene evenly; a
+// streamed cut's parts give the dots of the scene they make up.
 TEST(ViewerGuides, CentresAreDotsWhereTheGaussiansProject) {
-  flashgs::Scene scene;
+  auto shared = std::make_shared<flashgs::Scene>();
+  flashgs::Scene& scene = *shared;
   const float positions[] = {0, 0, 5, 1, 0, 5, 0, 0, -5, 100, 0, 5};  // the third behind, the fourth off-image
   scene.positions.assign(std::begin(positions), std::end(positions));
   scene.sh_dc = {1.0f, 0, -1.0f, 0, 0, 0, 0, 0, 0, 0, 0, 0};
   scene.opacities = {1, 1, 1, 1};
   const float eye[3] = {0, 0, 0}, target[3] = {0, 0, 1}, up[3] = {0, -1, 0};
   const flashgs::Camera view = flashgs::look_at_camera(eye, target, up, 200, 100, 90.0f);
-  const auto dots = fv::centre_marks(scene, view, 100);
+  const std::vector<flashgs::ScenePart> whole = {{0, shared, 0, 4}};
+  const auto dots = fv::centre_marks(whole, view, 100);
   ASSERT_EQ(dots.size(), 2u);
   EXPECT_NEAR(0.5f * (dots[0].x0 + dots[0].x1), view.cx, 1e-3f);
   EXPECT_NEAR(dots[0].y0, view.cy, 1e-3f);
   EXPECT_NEAR(dots[0].rgba[0], 0.5f + 0.2820948f, 1e-5f);
   EXPECT_NEAR(dots[0].rgba[2], 0.5f - 0.2820948f, 1e-5f);
   EXPECT_NEAR(std::abs(0.5f * (dots[1].x0 + dots[1].x1) - view.cx), 0.2f * view.fx, 1e-2f);
-  EXPECT_EQ(fv::centre_marks(scene, view, 2).size(), 1u) << "every second Gaussian: the first and the third";
+  EXPECT_EQ(fv::centre_marks(whole, view, 2).size(), 1u) << "every second Gaussian: the first and the third";
+  // The same Gaussians as parts, out of the source's order: the second, then the fourth, third and first.
+  const std::vector<flashgs::ScenePart> parts = {{7, shared, 1, 1}, {8, shared, 3, 1}, {9, shared, 2, 1}, {10, shared, 0, 1}};
+  const auto part_dots = fv::centre_marks(parts, view, 100);
+  ASSERT_EQ(part_dots.size(), 2u);
+  EXPECT_EQ(part_dots[0].x0, dots[1].x0) << "the second Gaussian comes first";
+  EXPECT_EQ(part_dots[1].x0, dots[0].x0);
+  // Every second of the four drawn: the first part's and the third part's (behind the view).
+  const auto thinned = fv::centre_marks(parts, view, 2);
+  ASSERT_EQ(thinned.size(), 1u);
+  EXPECT_EQ(thinned[0].x0, dots[1].x0);
 }
 
 // After N or a snap in a window of another shape than the camera's images (16:10 vs 16:9),
@@ -1110,4 +1126,106 @@ TEST(ViewerLodCache, TheKeyFollowsTheFileAndTheBuildSizes) {
   fs::last_write_time(file, touched);
   EXPECT_NE(fv::lod_cache_folders(file, options).beside, after_touch) << "another size";
   EXPECT_THROW(fv::lod_cache_folders(dir + "/absent.ply", options), flashgs::Error);
+}
+
+namespace {
+
+// A frame path that holds parts as the GPU's pool does: it refuses to draw them with the
+// baseline, and records what it was given (and can refuse the next parts, as a full GPU would).
+class PoolLikePath final : public fv::FramePath {
+ public:
+  std::string name() const override { return "pool-like"; }
+  void set_scene(std::shared_ptr<const flashgs::Scene> scene) override {
+    ++scenes;
+    scene_size = scene->size();
+  }
+  void set_scene_parts(const std::vector<flashgs::ScenePart>& parts, std::uint64_t resident) override {
+    if (refuse_parts) throw flashgs::Error("out of GPU memory");
+    ++part_sets;
+    last_parts = parts;
+    resident_bytes = resident;
+  }
+  std::string scene_parts_refusal(const flashgs::RenderOptions& options) const override {
+    return options.is_baseline() ? "not by the baseline" : "";
+  }
+  void attach_textures(const unsigned*, int, int) override {}
+  void release_textures() override {}
+  void render_to_texture(const flashgs::Camera&, const flashgs::RenderOptions&, flashgs::FrameStats*) override {}
+  void render_image(const flashgs::Camera&, const flashgs::RenderOptions&, flashgs::Image&, flashgs::FrameStats*,
+                    const std::atomic<bool>*) override {}
+  void tile_counts(const flashgs::FrameStats&, std::vector<std::uint32_t>&) override {}
+
+  int scenes = 0, part_sets = 0;
+  std::size_t scene_size = 0;
+  bool refuse_parts = false;
+  std::vector<flashgs::ScenePart> last_parts;
+  std::uint64_t resident_bytes = 0;
+};
+
+}  // namespace
+
+// The viewer's streamed cut reaches a GPU-like path as parts under the GPU cap, assembled while
+// the view's configuration is one the path cannot draw parts with (and for a comparison's side),
+// as parts again after; a refused hand-over is tried again; the overlay hands tinted parts.
+TEST(ViewerStream, TheCutGoesAsPartsOrAssembledWhereThePathCannotDrawParts) {
+  const std::string set = scratch_dir("stream_parts") + "/set";
+  flashgs::LodBuildOptions build;
+  build.leaf_gaussians = 2048;
+  flashgs::build_lod_set(flashgs::demo_scene_path(), set, build);
+  fv::StreamSettings settings;
+  settings.max_error_px = 8.0f;
+  settings.device_bytes = 64u << 20;
+  settings.parts_on_device = true;
+  fv::LodStreamView stream;
+  stream.start(set + "/lod-meta.json", settings);
+  const flashgs::Camera camera = flashgs::load_cameras(flashgs::demo_cameras_path())[3].resized(320, 180);
+  const flashgs::RenderOptions flash, baseline = flashgs::RenderOptions::baseline();
+  PoolLikePath path;
+
+  fv::StreamUpdate u = stream.update(camera, flash, true, 0.0, path);
+  ASSERT_TRUE(u.handed);
+  EXPECT_FALSE(u.assembled_changed);
+  EXPECT_EQ(path.part_sets, 1);
+  EXPECT_EQ(path.scenes, 0);
+  EXPECT_GT(path.resident_bytes, 0u) << "the GPU cap did not reach the path";
+  const std::uint64_t drawn = flashgs::scene_parts_size(path.last_parts);
+  EXPECT_EQ(drawn, stream.stats().drawn_gaussians);
+  EXPECT_FALSE(stream.update(camera, flash, false, 0.0, path).handed) << "the same cut was handed over again";
+
+  u = stream.update(camera, baseline, false, 0.0, path);
+  EXPECT_TRUE(u.handed && u.assembled_changed);
+  EXPECT_EQ(stream.assembled_because(), "not by the baseline");
+  EXPECT_EQ(path.scenes, 1);
+  EXPECT_EQ(path.scene_size, drawn);
+  EXPECT_FALSE(stream.update(camera, baseline, false, 0.0, path).handed);
+  u = stream.update(camera, flash, false, 0.0, path);
+  EXPECT_TRUE(u.handed && u.assembled_changed);
+  EXPECT_EQ(path.part_sets, 2);
+
+  // A comparison of the baseline with flash: the cut assembled for it, parts at the next frame.
+  EXPECT_EQ(stream.assemble_for({baseline, flash}, path), "not by the baseline");
+  EXPECT_EQ(path.scenes, 2);
+  EXPECT_EQ(stream.assemble_for({flash}, path), "");
+  EXPECT_TRUE(stream.update(camera, flash, false, 0.0, path).handed);
+  EXPECT_EQ(path.part_sets, 3);
+
+  path.refuse_parts = true;
+  stream.hand_over_again();
+  u = stream.update(camera, flash, false, 0.0, path);
+  EXPECT_FALSE(u.handed);
+  EXPECT_EQ(u.path_error, "out of GPU memory");
+  path.refuse_parts = false;
+  EXPECT_TRUE(stream.update(camera, flash, false, 0.0, path).handed) << "a refused cut was not handed over again";
+
+  stream.set_level_overlay(true);
+  ASSERT_TRUE(stream.update(camera, flash, false, 0.0, path).handed);
+  EXPECT_EQ(flashgs::scene_parts_size(path.last_parts), drawn);
+  for (const flashgs::ScenePart& p : path.last_parts) {
+    ASSERT_NE(p.key & flashgs::kTintedPartKeyBit, 0u);
+    EXPECT_EQ(p.source->sh_degree, 0);
+  }
+  EXPECT_EQ(stream.drawn_parts().size(), path.last_parts.size());
+  EXPECT_NE(stream.summary().find(std::to_string(path.last_parts.size()) + " parts handed over (hand-over 6: "),
+            std::string::npos)
+      << stream.summary();
 }

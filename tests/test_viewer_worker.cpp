@@ -79,6 +79,7 @@ class WorkerPath final : public fv::FramePath {
       : m_worker(std::move(renderer), nullptr), m_background(background) {}
   std::string name() const override { return "worker path"; }
   void set_scene(std::shared_ptr<const flashgs::Scene>) override {}
+  void set_scene_parts(const std::vector<flashgs::ScenePart>&, std::uint64_t) override {}
   void attach_textures(const unsigned*, int, int) override {}
   void release_textures() override {}
   void render_to_texture(const flashgs::Camera&, const flashgs::RenderOptions&, flashgs::FrameStats*) override {}
@@ -113,6 +114,7 @@ class TimedPath final : public fv::FramePath {
   explicit TimedPath(std::function<double(int, bool)> ms_of) : m_ms_of(std::move(ms_of)) {}
   std::string name() const override { return "timed path"; }
   void set_scene(std::shared_ptr<const flashgs::Scene>) override {}
+  void set_scene_parts(const std::vector<flashgs::ScenePart>&, std::uint64_t) override {}
   void attach_textures(const unsigned*, int, int) override {}
   void release_textures() override {}
   void render_to_texture(const flashgs::Camera&, const flashgs::RenderOptions&, flashgs::FrameStats*) override {}
@@ -319,6 +321,53 @@ TEST(ViewerRenderWorker, ANewSceneDoesNotWaitForTheFrameInFlight) {
   ASSERT_TRUE(worker.take(&frame));
   EXPECT_EQ(frame.image.width, 6);
   EXPECT_EQ(frame.image.height, 3) << "rendered with the new scene";
+}
+
+// A streamed cut's parts reach the worker's renderer as parts (set_scene_parts, with the GPU
+// cap), before the next frame, and a later scene replaces parts not yet set.
+TEST(ViewerRenderWorker, PartsReachTheRendererAsPartsBeforeTheNextFrame) {
+  class PartsRecorder final : public flashgs::Renderer {
+   public:
+    std::string name() const override { return "parts"; }
+    void set_scene(std::shared_ptr<const flashgs::Scene> scene) override { drawn = scene ? scene->size() : 0; }
+    void set_scene_parts(const std::vector<flashgs::ScenePart>& parts, std::uint64_t resident) override {
+      part_sets++;
+      last_count = parts.size();
+      resident_bytes = resident;
+      drawn = flashgs::scene_parts_size(parts);
+    }
+    void render(const flashgs::Camera& camera, const flashgs::RenderOptions&, flashgs::Image& out,
+                flashgs::FrameStats*) override {
+      out.resize(camera.width, int(drawn));
+    }
+    std::atomic<int> part_sets{0};
+    std::size_t last_count = 0, drawn = 0;
+    std::uint64_t resident_bytes = 0;
+  };
+  auto owned = std::make_unique<PartsRecorder>();
+  PartsRecorder* recorder = owned.get();
+  fv::RenderWorker worker(std::move(owned), nullptr);
+  auto source = std::make_shared<flashgs::Scene>();
+  source->opacities.resize(10);
+  worker.set_scene_parts({{1, source, 0, 4}, {2, source, 6, 3}}, 12345);
+  worker.request(request_of_width(5));
+  worker.wait_until_idle();
+  fv::FinishedFrame frame;
+  ASSERT_TRUE(worker.take(&frame));
+  EXPECT_EQ(recorder->part_sets, 1);
+  EXPECT_EQ(recorder->last_count, 2u);
+  EXPECT_EQ(recorder->resident_bytes, 12345u);
+  EXPECT_EQ(frame.image.height, 7) << "not rendered with the parts";
+  // Parts, then a scene before the worker ran: the scene wins, the parts are never set.
+  worker.with_renderer([&](flashgs::Renderer&) {
+    worker.set_scene_parts({{3, source, 0, 1}}, 0);
+    worker.set_scene(source);
+  });
+  worker.request(request_of_width(5));
+  worker.wait_until_idle();
+  ASSERT_TRUE(worker.take(&frame));
+  EXPECT_EQ(recorder->part_sets, 1);
+  EXPECT_EQ(frame.image.height, 10);
 }
 
 // The caller's flag stops a render made through with_renderer (the comparison's renders on

@@ -19,6 +19,7 @@
 #include "flashgs/io.h"
 #include "flashgs/lod_build.h"
 #include "flashgs/lod_city.h"
+#include "flashgs/lod_feed.h"
 #include "flashgs/lod_stream.h"
 #include "flashgs/parse.h"
 #include "flashgs/percentile.h"
@@ -163,7 +164,13 @@ void run_fly(const FlyArgs& args) {
   const bool cpu = renderer->name().rfind("cpu", 0) == 0;
   lod_frame_costs(cpu ? BackendKind::cpu : BackendKind::cuda, size.width, size.height,
                   static_cast<int>(std::thread::hardware_concurrency()), &options.host_frame, &options.device_frame);
+  // A GPU backend keeps the cut's parts in device memory and uploads only new ones; its frames
+  // are queued and waited for, as the viewer shows them without a copy to the host. The CPU
+  // backend assembles the parts into one scene.
+  const bool gpu_parts = can_queue_frames(*renderer);
+  options.parts_on_device = gpu_parts;
   LodStreamer streamer(std::move(set), options);
+  LodCutFeed feed(streamer);
   const LodSet& lod = streamer.set();
   const std::string instances = lod.instances.empty() ? "" : " (" + std::to_string(lod.instances.size()) + " instances)";
   std::printf("set %s: %zu leaves%s, %d levels, level 0 %llu Gaussians; path of %zu frames at %dx%d through %zu cameras\n",
@@ -174,15 +181,10 @@ void run_fly(const FlyArgs& args) {
   Image image, reference;
   std::vector<double> frame_ms, psnrs;
   std::vector<std::uint64_t> drawn;
-  std::shared_ptr<const Scene> shown;
-  // A GPU backend keeps the cut's parts in device memory and uploads only new ones
-  // (Renderer::set_scene_parts); its frames are queued and waited for, as the viewer shows them
-  // without a copy to the host. The CPU backend draws the assembled cut.
-  const bool gpu_parts = can_queue_frames(*renderer);
   std::uint64_t gpu_high_water = 0;  // the drawn parts' pool and the frame's buffers
   // The first view waits for its chunks, as a viewer shows its load progress; later frames never wait.
   const auto open_start = Clock::now();
-  streamer.update(path.front());
+  streamer.update_parts(path.front(), nullptr);
   streamer.wait_until_idle();
   std::printf("first view ready after %.2f s\n", ms_between(open_start, Clock::now()) / 1000.0);
   const auto start = Clock::now();
@@ -192,30 +194,15 @@ void run_fly(const FlyArgs& args) {
     std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
                                               std::chrono::duration<double>(static_cast<double>(i) / args.fps)));
     const auto t0 = Clock::now();
-    std::uint64_t drawn_now = 0;
-    if (gpu_parts) {
-      bool changed = false;
-      const std::vector<ScenePart>& parts = streamer.update_parts(path[i], &changed);
-      if (changed) {
-        renderer->set_scene_parts(parts, streamer.device_resident_bytes());
-        ++swaps;
-      }
-      drawn_now = scene_parts_size(parts);
-      if (drawn_now > 0) {
-        FrameStats frame_stats;
-        render_queued(*renderer, path[i], render_options, &frame_stats);
-        finish_queued_frames(*renderer);
-        gpu_high_water = std::max(gpu_high_water, frame_stats.scene_device_bytes + frame_stats.device_memory_bytes);
-      }
-    } else {
-      std::shared_ptr<const Scene> scene = streamer.update(path[i]);
-      if (scene != shown) {
-        renderer->set_scene(scene);
-        shown = scene;
-        ++swaps;
-      }
-      drawn_now = scene->size();
-      if (drawn_now > 0) renderer->render(path[i], render_options, image, nullptr);
+    if (feed.update(path[i], *renderer)) ++swaps;
+    const std::uint64_t drawn_now = feed.cut_gaussians();
+    if (drawn_now > 0 && gpu_parts) {
+      FrameStats frame_stats;
+      render_queued(*renderer, path[i], render_options, &frame_stats);
+      finish_queued_frames(*renderer);
+      gpu_high_water = std::max(gpu_high_water, frame_stats.scene_device_bytes + frame_stats.device_memory_bytes);
+    } else if (drawn_now > 0) {
+      renderer->render(path[i], render_options, image, nullptr);
     }
     const auto t1 = Clock::now();
     const double ms = ms_between(t0, t1);

@@ -25,6 +25,15 @@ class FramePath {
   virtual std::string name() const = 0;
   // Throws flashgs::Error when the scene cannot be held (the previous one then stays).
   virtual void set_scene(std::shared_ptr<const Scene> scene) = 0;
+  // The parts of a streamed cut as the scene (Renderer::set_scene_parts: the CUDA backend keeps
+  // them on the GPU under `resident_bytes`, the CPU backend assembles them). Failures as set_scene's.
+  virtual void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) = 0;
+  // Why parts set here cannot be rendered with `options` (Renderer::scene_parts_refusal; empty:
+  // they can). By default they can: a host renderer assembles them.
+  virtual std::string scene_parts_refusal(const RenderOptions& options) const {
+    (void)options;
+    return {};
+  }
   // How many frame textures the path writes in turn: 2 when it renders the next frame into
   // one while the window shows the other.
   virtual int texture_count() const { return 1; }

@@ -34,6 +34,13 @@ class InteropPath final : public FramePath {
 
   std::string name() const override { return "CUDA-GL interop (" + m_device + ")"; }
   void set_scene(std::shared_ptr<const Scene> scene) override { m_renderer->set_scene(std::move(scene)); }
+  // Only the parts the backend's pool lacks go up (scene_pool.h).
+  void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) override {
+    m_renderer->set_scene_parts(parts, resident_bytes);
+  }
+  std::string scene_parts_refusal(const RenderOptions& options) const override {
+    return m_renderer->scene_parts_refusal(options);
+  }
 
   int texture_count() const override { return kTextures; }
 

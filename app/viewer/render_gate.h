@@ -22,6 +22,12 @@ class FileGatedRenderer final : public Renderer {
 
   std::string name() const override { return m_inner->name(); }
   void set_scene(std::shared_ptr<const Scene> scene) override { m_inner->set_scene(std::move(scene)); }
+  void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) override {
+    m_inner->set_scene_parts(parts, resident_bytes);
+  }
+  std::string scene_parts_refusal(const RenderOptions& options) const override {
+    return m_inner->scene_parts_refusal(options);
+  }
   void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats) override;
   // A render waits at the closed gate now (tests wait for it before they open it).
   bool waiting() const { return m_waiting; }

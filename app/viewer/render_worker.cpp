@@ -62,9 +62,17 @@ void RenderWorker::wait_until_idle() {
 }
 
 void RenderWorker::set_scene(std::shared_ptr<const Scene> scene) {
+  set_pending_scene([scene = std::move(scene)](Renderer& r) { r.set_scene(scene); });
+}
+
+void RenderWorker::set_scene_parts(std::vector<ScenePart> parts, std::uint64_t resident_bytes) {
+  set_pending_scene([parts = std::move(parts), resident_bytes](Renderer& r) { r.set_scene_parts(parts, resident_bytes); });
+}
+
+void RenderWorker::set_pending_scene(std::function<void(Renderer&)> set) {
   {
     std::lock_guard<std::mutex> lock(m_mutex);
-    m_pending_scene = std::move(scene);
+    m_pending_scene = std::move(set);  // replaces one not yet set
     if (m_rendering) m_cancel = true;  // a frame of the old scene is not worth finishing
   }
   m_wake.notify_all();
@@ -121,13 +129,13 @@ void RenderWorker::loop() {
       if (m_stop) return;
       if (m_waiting_users > 0) continue;  // with_renderer came first: after it
       if (m_pending_scene) {  // a new scene before any further frame
-        std::shared_ptr<const Scene> scene = std::move(m_pending_scene);
-        m_pending_scene.reset();
+        std::function<void(Renderer&)> set_scene = std::move(m_pending_scene);
+        m_pending_scene = nullptr;
         m_rendering = true;  // busy meanwhile
         lock.unlock();
         std::string error;
         try {
-          m_renderer->set_scene(std::move(scene));
+          set_scene(*m_renderer);
         } catch (const std::exception& e) {
           error = error_text(e);
         }

@@ -62,6 +62,9 @@ class RenderWorker {
   // stops (where the backend can), the worker sets the scene, then renders what is pending.
   // A failure comes back from take() as a frame with `error` set.
   void set_scene(std::shared_ptr<const Scene> scene);
+  // The same for a streamed cut's parts (Renderer::set_scene_parts, on the worker: the CPU
+  // backend assembles them there, not on the caller's thread).
+  void set_scene_parts(std::vector<ScenePart> parts, std::uint64_t resident_bytes);
   // Runs `fn` with the renderer on the calling thread once no frame renders: the one in flight
   // is cancelled and requested again afterwards. Thread-safe (set_scene from the UI thread,
   // the comparison's renders from a task thread); exceptions from `fn` propagate. The renders
@@ -78,7 +81,9 @@ class RenderWorker {
   std::condition_variable m_wake, m_idle;
   bool m_stop = false;
   bool m_has_pending = false;
-  std::shared_ptr<const Scene> m_pending_scene;  // set before the next frame
+  void set_pending_scene(std::function<void(Renderer&)> set);
+
+  std::function<void(Renderer&)> m_pending_scene;  // sets the new scene before the next frame
   FrameRequest m_pending;
   std::uint64_t m_pending_id = 0, m_next_id = 1;
   bool m_rendering = false;  // a frame of the worker's own is in flight

@@ -102,21 +102,28 @@ std::vector<ScreenSegment> project_segments(const std::vector<WorldSegment>& seg
   return out;
 }
 
-std::vector<ScreenSegment> centre_marks(const Scene& scene, const Camera& view, std::size_t max_marks) {
+std::vector<ScreenSegment> centre_marks(const std::vector<ScenePart>& parts, const Camera& view, std::size_t max_marks) {
   std::vector<ScreenSegment> out;
-  const std::size_t n = scene.size();
+  const std::size_t n = static_cast<std::size_t>(scene_parts_size(parts));
   if (n == 0 || max_marks == 0) return out;
   const std::size_t stride = (n + max_marks - 1) / max_marks;
   out.reserve(n / stride + 1);
   const float sh_c0 = static_cast<float>(model::kShC0);
-  for (std::size_t i = 0; i < n; i += stride) {
-    const glm::vec3 v = to_view(view, glm::vec3(scene.positions[3 * i], scene.positions[3 * i + 1], scene.positions[3 * i + 2]));
-    if (v.z <= 0.0f) continue;
-    const glm::vec2 p = to_pixels(view, v);
-    if (!(p.x >= 0 && p.y >= 0 && p.x < float(view.width) && p.y < float(view.height))) continue;
-    std::array<float, 4> rgba{1, 1, 1, 1};
-    for (int c = 0; c < 3; ++c) rgba[c] = std::clamp(0.5f + sh_c0 * scene.sh_dc[3 * i + c], 0.0f, 1.0f);
-    out.push_back({p.x - 1.0f, p.y, p.x + 1.0f, p.y, rgba});
+  std::size_t part_start = 0;  // the first Gaussian of the part below, counted over all parts
+  for (const ScenePart& part : parts) {
+    const Scene& scene = *part.source;
+    // Every stride-th Gaussian over all parts: the first of this part at or after part_start.
+    for (std::size_t at = (part_start + stride - 1) / stride * stride; at < part_start + part.count; at += stride) {
+      const std::size_t i = part.first + (at - part_start);
+      const glm::vec3 v = to_view(view, glm::vec3(scene.positions[3 * i], scene.positions[3 * i + 1], scene.positions[3 * i + 2]));
+      if (v.z <= 0.0f) continue;
+      const glm::vec2 p = to_pixels(view, v);
+      if (!(p.x >= 0 && p.y >= 0 && p.x < float(view.width) && p.y < float(view.height))) continue;
+      std::array<float, 4> rgba{1, 1, 1, 1};
+      for (int c = 0; c < 3; ++c) rgba[c] = std::clamp(0.5f + sh_c0 * scene.sh_dc[3 * i + c], 0.0f, 1.0f);
+      out.push_back({p.x - 1.0f, p.y, p.x + 1.0f, p.y, rgba});
+    }
+    part_start += part.count;
   }
   return out;
 }

@@ -7,7 +7,7 @@
 #include <glm/glm.hpp>
 
 #include "flashgs/camera.h"
-#include "flashgs/scene.h"
+#include "flashgs/scene_parts.h"
 
 namespace flashgs::viewer {
 
@@ -35,10 +35,11 @@ std::vector<WorldSegment> camera_frustums(const std::vector<Camera>& cameras, fl
 std::vector<ScreenSegment> project_segments(const std::vector<WorldSegment>& segments, const Camera& view,
                                             float near_depth);
 
-// The Gaussians' centres seen by `view` as short dashes (2 pixels) in their base colour (the
-// SH DC term), for the "centres" debug view: at most `max_marks` of them, every k-th where the
-// scene has more (a dash per Gaussian of a 3.5M scene would cost more than the frame).
-std::vector<ScreenSegment> centre_marks(const Scene& scene, const Camera& view, std::size_t max_marks);
+// The centres of the drawn Gaussians (the parts one after another: a streamed cut, or a scene
+// as one part) seen by `view` as short dashes (2 pixels) in their base colour (the SH DC term),
+// for the "centres" debug view: at most `max_marks` of them, every k-th where there are more (a
+// dash per Gaussian of a 3.5M scene would cost more than the frame).
+std::vector<ScreenSegment> centre_marks(const std::vector<ScenePart>& parts, const Camera& view, std::size_t max_marks);
 
 // The camera whose frustum, as camera_frustums draws it at `depth`, is under (x, y) in
 // `view`'s image: inside its projected body or within `radius` pixels of an edge or its

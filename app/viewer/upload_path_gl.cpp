@@ -12,6 +12,12 @@ class UploadPath final : public FramePath {
 
   std::string name() const override { return m_label; }
   void set_scene(std::shared_ptr<const Scene> scene) override { m_renderer->set_scene(std::move(scene)); }
+  void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) override {
+    m_renderer->set_scene_parts(parts, resident_bytes);
+  }
+  std::string scene_parts_refusal(const RenderOptions& options) const override {
+    return m_renderer->scene_parts_refusal(options);
+  }
   void attach_textures(const unsigned*, int, int) override {}
   void release_textures() override {}
 
@@ -43,6 +49,9 @@ class BackgroundUploadPath final : public FramePath {
   std::string name() const override { return m_label; }
   // Never waits for a frame of the old scene: the worker switches before its next frame.
   void set_scene(std::shared_ptr<const Scene> scene) override { m_worker.set_scene(std::move(scene)); }
+  void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes) override {
+    m_worker.set_scene_parts(parts, resident_bytes);
+  }
   void attach_textures(const unsigned*, int, int) override {}
   void release_textures() override {}
 

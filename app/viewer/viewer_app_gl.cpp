@@ -200,6 +200,7 @@ void ViewerApp::use_cpu_path(const std::string& why) {
   m_have_request = false;
   std::fprintf(stderr, "flashgs-viewer: frame path: %s (%s)\n", m_path->name().c_str(), why.c_str());
   if (m_scene.scene) m_path->set_scene(m_scene.scene);
+  m_stream.hand_over_again();  // a streamed cut goes to the new path at the next frame
 }
 
 void ViewerApp::select_frame_path() {
@@ -422,6 +423,14 @@ void ViewerApp::start_comparison() {
   job.left = compare_choice_options(m_settings.compare_left, m_settings.options);
   job.right = compare_choice_options(m_settings.compare_right, m_settings.options);
   job.rounds = m_args.compare_rounds;
+  try {  // the GPU's pool draws neither the baseline nor fp16 storage: the cut assembled for them
+    const std::string assembled = m_stream.assemble_for({job.left, job.right}, *m_path);
+    if (!assembled.empty())
+      std::fprintf(stderr, "flashgs-viewer: the streamed cut goes to the renderer assembled: %s\n", assembled.c_str());
+  } catch (const std::exception& e) {
+    set_notice("comparison refused: the streamed cut could not be assembled: " + error_text(e));
+    return;
+  }
   m_compare = {};  // the last comparison's images are of another view: the frame shows meanwhile
   m_compare_camera = m_last_camera;
   m_compare_options = m_last_options;
@@ -526,7 +535,7 @@ void ViewerApp::draw_guides(int fb_w, int fb_h) {
   key_guides(world);
   std::vector<ScreenSegment> screen = project_segments(world, m_last_camera, 1e-3f * m_scene.extent);
   if (m_settings.show_centres && m_scene.scene) {
-    const std::vector<ScreenSegment> dots = centre_marks(*m_scene.scene, m_last_camera, kMaxCentreMarks);
+    const std::vector<ScreenSegment> dots = centre_marks(drawn_parts(), m_last_camera, kMaxCentreMarks);
     screen.insert(screen.end(), dots.begin(), dots.end());
   }
   m_lines->draw(screen, m_last_camera.width, m_last_camera.height, fb_w, fb_h);
@@ -599,7 +608,7 @@ void ViewerApp::request_frame(int fb_w, int fb_h, bool moving) {
   request.options.collect_tile_counts = m_settings.heatmap;  // counts cost a copy: only when shown
   request.options.collect_pixel_planes = m_settings.view != FrameView::colour;
   request.reduced = reduced;
-  const bool streamed = m_stream.active() && update_stream(request.camera);
+  const bool streamed = m_stream.active() && update_stream(request.camera, request.options);
   const bool changed = streamed || !m_have_request || !same_camera(request.camera, m_requested.camera) ||
                        request.options != m_requested.options;
   const bool again = m_scripted || (m_settings.continuous && !m_path->busy());
@@ -983,8 +992,9 @@ UiModel ViewerApp::panel_model(int fb_w, int fb_h) {
   model.frame_path_note = m_path_note;
   model.backend = m_path_is_cpu ? Backend::cpu : Backend::cuda;
   model.scene_path = m_scene.path;
-  model.gaussians = m_scene.scene ? m_scene.scene->size() : 0;
-  model.sh_degree = m_scene.scene ? m_scene.scene->sh_degree : 0;
+  const std::vector<ScenePart> drawn = drawn_parts();
+  model.gaussians = scene_parts_size(drawn);
+  model.sh_degree = drawn.empty() ? 0 : drawn.front().source->sh_degree;
   model.trained = m_scene.scene ? m_scene.scene->trained_kernel.kernel : SplatKernel::classic();
   model.trained_kernel = m_scene.scene ? kernel_summary(m_scene.scene->trained_kernel) : std::string();
   model.lod_gaussians = m_scene.lod_gaussians.empty() ? nullptr : &m_scene.lod_gaussians;

@@ -63,10 +63,13 @@ class ViewerApp {
   bool apply_start_options();  // --tile (scripted), --render-size, --camera; false: a scripted run must stop
   bool open_scene(const std::string& path);  // loads now; false (error kept) on failure
   void request_open(const std::string& path);  // loads in the background (interactive runs)
-  void request_lod_level(int level);
+  void request_lod_level(int level);  // another level of the SOG LOD set shown, loaded like a new file
   void start_stream();  // --stream, for the scene just installed
-  // The streamed scene for this view; true when what is drawn changed (a new frame is needed).
-  bool update_stream(const Camera& camera);  // another level of the SOG LOD set shown, loaded like a new file
+  // Hands the streamed cut for this view to the frame path as parts (assembled where the path
+  // cannot draw parts with `options`); true when what is drawn changed (a new frame is needed).
+  bool update_stream(const Camera& camera, const RenderOptions& options);
+  // What the frame path draws: the streamed cut's parts once one was handed over, else the scene as one part.
+  std::vector<ScenePart> drawn_parts() const;
   void finish_pending_load();
   void report_failed_load(const std::string& error);
   void install_scene(LoadedScene scene);

@@ -92,6 +92,7 @@ void ViewerApp::start_stream() {
   settings.max_error_px = m_args.stream_max_error_px;
   settings.host_bytes = m_args.host_memory_mb << 20;
   settings.device_bytes = m_path_is_cpu ? 0 : m_args.gpu_memory_mb << 20;
+  settings.parts_on_device = !m_path_is_cpu;
   int width = 0, height = 0;  // the frames' cost beside the scene, at the window's size
   m_window->framebuffer_size(&width, &height);
   lod_frame_costs(m_path_is_cpu ? BackendKind::cpu : BackendKind::cuda, std::max(width, 1), std::max(height, 1),
@@ -112,7 +113,7 @@ void ViewerApp::start_stream() {
                settings.host_bytes ? (std::to_string(m_args.host_memory_mb) + " MiB").c_str() : "none");
 }
 
-bool ViewerApp::update_stream(const Camera& camera) {
+bool ViewerApp::update_stream(const Camera& camera, const RenderOptions& options) {
   StreamSettings wanted = m_stream.settings();
   wanted.max_error_px = m_settings.stream_max_error_px;
   wanted.budget = static_cast<std::uint64_t>(double(m_settings.stream_budget_millions) * 1e6);
@@ -120,6 +121,10 @@ bool ViewerApp::update_stream(const Camera& camera) {
     m_stream.change(wanted);
   } catch (const std::exception& e) {  // the set's files went away: the stream stops, the last cut stays
     set_notice("streaming stopped: " + error_text(e));
+    try {  // as the scene: what the panel counts and a new frame path is given
+      if (!m_stream.drawn_parts().empty()) m_scene.scene = assemble_scene_parts(m_stream.drawn_parts());
+    } catch (const std::exception&) {  // no memory for it: the level loaded first
+    }
     m_stream.stop();
     return false;
   }
@@ -127,29 +132,29 @@ bool ViewerApp::update_stream(const Camera& camera) {
     m_stream.set_level_overlay(m_settings.lod_overlay);
     std::fprintf(stderr, "flashgs-viewer: level overlay %s\n", m_settings.lod_overlay ? "on" : "off");
   }
-  std::shared_ptr<const Scene> scene;
-  try {
-    scene = m_stream.update(camera, m_scripted, ms_since_start() / 1000.0);
-  } catch (const std::exception& e) {  // no memory for the overlay's copy: the scene's own colours
-    set_notice("level overlay off: " + error_text(e));
+  // The cut goes to the frame path as parts: the GPU keeps them and uploads only new ones. Its
+  // pool draws fewer configurations than a whole scene: for the others, the cut assembled.
+  const StreamUpdate u = m_stream.update(camera, options, m_scripted, ms_since_start() / 1000.0, *m_path);
+  if (u.assembled_changed)
+    std::fprintf(stderr, "flashgs-viewer: the streamed cut goes to the renderer %s%s\n",
+                 m_stream.assembled_because().empty() ? "as parts" : "assembled: ", m_stream.assembled_because().c_str());
+  if (!u.overlay_error.empty()) {  // no memory for the overlay's copies: the scene's own colours
+    set_notice("level overlay off: " + u.overlay_error);
     m_settings.lod_overlay = false;
-    m_stream.set_level_overlay(false);
-    scene = m_stream.update(camera, false, ms_since_start() / 1000.0);
   }
+  if (!u.path_error.empty()) set_notice("streamed scene refused: " + u.path_error);  // out of GPU memory: again next frame
   for (const std::string& line : m_stream.take_errors()) set_notice(line);
   const bool loading = m_stream.loading();
   if (m_stream_was_loading && !loading)  // tests and users see when the view's chunks are all in
     std::fprintf(stderr, "flashgs-viewer: stream settled: %s\n", m_stream.summary().c_str());
   m_stream_was_loading = loading;
-  if (!scene || scene == m_scene.scene || scene->size() == 0) return false;
-  try {
-    m_path->set_scene(scene);
-  } catch (const std::exception& e) {  // out of GPU memory: the last drawn scene stays
-    set_notice("streamed scene refused: " + error_text(e));
-    return false;
-  }
-  m_scene.scene = scene;
-  return true;
+  return u.handed;
+}
+
+std::vector<ScenePart> ViewerApp::drawn_parts() const {
+  if (!m_stream.drawn_parts().empty()) return m_stream.drawn_parts();
+  if (!m_scene.scene) return {};
+  return {ScenePart{0, m_scene.scene, 0, m_scene.scene->size()}};
 }
 
 void ViewerApp::report_failed_load(const std::string& error) {

@@ -465,15 +465,19 @@ class CudaRendererImpl final : public CudaRenderer {
 
   // A pooled scene is drawn through its page list, which only fused emission reads, from its
   // pages of floats.
-  static void check_pooled_options(const RenderOptions& options) {
+  std::string scene_parts_refusal(const RenderOptions& options) const override {
     const char* off = options.is_baseline() ? "the baseline"
                       : !options.fused_emit ? "flash without fused emission"
                       : options.fp16_sh     ? "fp16 SH"
                       : options.fp16_shape  ? "fp16 shapes"
                                             : nullptr;
-    if (off)
-      throw Error(std::string("cuda renderer: a streamed scene (scene parts) is drawn by flash with fused emission in "
-                              "full precision, not by ") + off);
+    return off ? std::string("a streamed scene (scene parts) is drawn by flash with fused emission in full precision, "
+                             "not by ") + off
+               : std::string();
+  }
+  void check_pooled_options(const RenderOptions& options) const {
+    const std::string refusal = scene_parts_refusal(options);
+    if (!refusal.empty()) throw Error("cuda renderer: " + refusal);
   }
 
   double distance_to_bounds_centre(const gm::CameraParams& cam) const {

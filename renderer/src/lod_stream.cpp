@@ -309,9 +309,13 @@ const std::vector<ScenePart>& LodStreamer::update_parts(const Camera& camera, bo
   if (differ) {
     m_parts = as_parts(drawn);
     m_drawn = std::move(drawn.ranges);
-    m_scene.reset();  // the renderer holds the parts: no drawn scene on the host
+    m_scene.reset();  // the renderer holds the parts
+    const std::uint64_t total = scene_parts_size(m_parts);
+    // The scene a host renderer assembles, made beside the one it draws now; none on the GPU's.
+    const std::uint64_t scene_bytes = m_options.parts_on_device ? 0 : total * m_bytes_per_gaussian;
     std::lock_guard<std::mutex> lock(m_mutex);
-    m_drawn_bytes = scene_parts_size(m_parts) * m_options.host_frame.per_gaussian + m_options.host_frame.fixed;
+    m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes + scene_bytes);
+    m_drawn_bytes = scene_bytes + total * m_options.host_frame.per_gaussian + m_options.host_frame.fixed;
     m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
   }
   m_stats.drawn_gaussians = scene_parts_size(m_parts);

@@ -1,4 +1,4 @@
-// The level overlay: a per-level palette and a drawn scene recoloured by it.
+// The level overlay: a per-level palette and a drawn cut's parts recoloured by it.
 #include "flashgs/lod_tint.h"
 
 #include <string>
@@ -18,6 +18,22 @@ constexpr std::array<std::array<float, 3>, 8> kPalette = {{{0.90f, 0.15f, 0.15f}
                                                            {0.20f, 0.30f, 0.95f},
                                                            {0.65f, 0.25f, 0.95f},
                                                            {0.95f, 0.40f, 0.75f}}};
+
+// Appends Gaussians [first, first + count) of `from` to `out` (SH degree 0) in `level`'s colour.
+void append_tinted(const Scene& from, std::size_t first, std::size_t count, int level, Scene& out) {
+  const auto append = [&](std::vector<float>& to, const std::vector<float>& values, std::size_t per_gaussian) {
+    to.insert(to.end(), values.begin() + static_cast<std::ptrdiff_t>(first * per_gaussian),
+              values.begin() + static_cast<std::ptrdiff_t>((first + count) * per_gaussian));
+  };
+  append(out.positions, from.positions, 3);
+  append(out.scales, from.scales, 3);
+  append(out.rotations, from.rotations, 4);
+  append(out.opacities, from.opacities, 1);
+  const std::array<float, 3> colour = lod_level_colour(level);
+  float dc[3];  // the renderer's colour is 0.5 + C0 * dc
+  for (int k = 0; k < 3; ++k) dc[k] = static_cast<float>((colour[static_cast<std::size_t>(k)] - 0.5) / model::kShC0);
+  for (std::size_t i = 0; i < count; ++i) out.sh_dc.insert(out.sh_dc.end(), dc, dc + 3);
+}
 
 }  // namespace
 
@@ -53,29 +69,42 @@ std::vector<LodLevelRun> lod_level_runs(const LodSet& set, const std::vector<Lod
   return runs;
 }
 
-Scene tint_by_level(const Scene& scene, const std::vector<LodLevelRun>& runs) {
+std::vector<ScenePart> tint_parts_by_level(const std::vector<ScenePart>& parts, const std::vector<LodLevelRun>& runs,
+                                           TintedParts& copies) {
   std::uint64_t covered = 0;
   for (const LodLevelRun& r : runs) covered += r.count;
-  if (covered != scene.size())
-    throw Error("level overlay: the level runs cover " + std::to_string(covered) + " Gaussians, the drawn scene has " +
-                std::to_string(scene.size()));
-  Scene out;
-  out.sh_degree = 0;
-  out.trained_kernel = scene.trained_kernel;
-  out.positions = scene.positions;
-  out.scales = scene.scales;
-  out.rotations = scene.rotations;
-  out.opacities = scene.opacities;
-  out.sh_dc.resize(scene.sh_dc.size());
-  std::size_t at = 0;
-  for (const LodLevelRun& r : runs) {
-    const std::array<float, 3> colour = lod_level_colour(r.level);
-    float dc[3];  // the renderer's colour is 0.5 + C0 * dc
-    for (int k = 0; k < 3; ++k) dc[k] = static_cast<float>((colour[static_cast<std::size_t>(k)] - 0.5) / model::kShC0);
-    for (std::uint64_t i = 0; i < r.count; ++i, ++at)
-      for (int k = 0; k < 3; ++k) out.sh_dc[at * 3 + static_cast<std::size_t>(k)] = dc[k];
+  if (covered != scene_parts_size(parts))
+    throw Error("level overlay: the level runs cover " + std::to_string(covered) + " Gaussians, the drawn parts have " +
+                std::to_string(scene_parts_size(parts)));
+  std::vector<ScenePart> tinted;
+  tinted.reserve(parts.size());
+  TintedParts kept;
+  std::size_t run = 0;
+  std::uint64_t left_in_run = runs.empty() ? 0 : runs[0].count;
+  for (const ScenePart& part : parts) {
+    if (part.key & kTintedPartKeyBit) throw Error("level overlay: a part's key " + std::to_string(part.key) + " has the tint bit");
+    while (left_in_run == 0 && run + 1 < runs.size()) left_in_run = runs[++run].count;
+    if (part.count > left_in_run)
+      throw Error("level overlay: a part of " + std::to_string(part.count) + " Gaussians spans two levels' runs");
+    left_in_run -= part.count;
+    const std::uint64_t key = part.key | kTintedPartKeyBit;
+    std::shared_ptr<const Scene>& copy = kept[key];
+    if (!copy) {
+      const auto known = copies.find(key);
+      if (known != copies.end()) {
+        copy = known->second;
+      } else {
+        auto made = std::make_shared<Scene>();
+        made->trained_kernel = part.source->trained_kernel;
+        made->reserve(part.count);
+        append_tinted(*part.source, part.first, part.count, runs[run].level, *made);
+        copy = std::move(made);
+      }
+    }
+    tinted.push_back(ScenePart{key, copy, 0, part.count});
   }
-  return out;
+  copies = std::move(kept);
+  return tinted;
 }
 
 }  // namespace flashgs

@@ -5,8 +5,10 @@
 #
 # Usage, from the repository root through the device `run` tool, carrying .devgl:
 #   bash tools/device/viewer_fps.sh [SCENE...]
-# SCENE: a PLY file (cameras.json beside it), FILE@K for K tiled copies of it, or demo:N for the
-# procedural demo scene of N Gaussians (made in memory: nothing to carry). Default:
+# SCENE: a PLY file (cameras.json beside it), FILE@K for K tiled copies of it, demo:N for the
+# procedural demo scene of N Gaussians (made in memory: nothing to carry), or stream:SET for a LOD
+# set (lod-meta.json or its folder) streamed with --stream (its cut handed over as parts; the
+# scripted frames wait for each view's chunks). Default:
 # demo:3000000, the bundled demo scene, and pc_playbot when a copy is found under .deps/scenes
 # or /work/shared/scenes.
 # Knobs: FRAMES (timed frames, default 300), WARMUP (default 30), RESOLUTIONS (default
@@ -105,6 +107,7 @@ run_one() {  # scene-label render-size window-label viewer-args...
 for scene in "${scenes[@]}"; do
   case "$scene" in
     demo:*) args=(--generate-demo "${scene#demo:}") ;;
+    stream:*) args=("${scene#stream:}" --stream) ;;
     *@*) args=("${scene%@*}" --tile "${scene##*@}") ;;
     *) args=("$scene") ;;
   esac

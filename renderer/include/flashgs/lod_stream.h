@@ -38,6 +38,10 @@ struct LodStreamOptions {
   std::uint64_t host_bytes = 0;
   std::uint64_t device_bytes = 0;
   LodFrameCost host_frame, device_frame;
+  // Whether update_parts' renderer keeps the parts in GPU memory (the CUDA backend's pool);
+  // otherwise it assembles them into one scene in host memory (Renderer::set_scene_parts by
+  // default), which the host cap counts as it counts update()'s scene.
+  bool parts_on_device = false;
   int threads = 2;                 // chunk loaders
   bool prefetch = true;            // also load what the view will need if the camera keeps moving
 };
@@ -66,8 +70,9 @@ class LodStreamer {
   // the same pointer as before while nothing drawn changed. Never waits for a chunk.
   std::shared_ptr<const Scene> update(const Camera& camera);
   // The same cut as parts of the chunks in memory (ScenePart::key: the chunk file and offset)
-  // for a renderer that keeps parts on the GPU (Renderer::set_scene_parts); the host then
-  // holds no drawn scene. `changed`: whether they differ from the last call's.
+  // for Renderer::set_scene_parts; the streamer then holds no drawn scene (the renderer does,
+  // on the GPU or assembled: LodStreamOptions::parts_on_device). `changed`: whether they differ
+  // from the last call's.
   const std::vector<ScenePart>& update_parts(const Camera& camera, bool* changed);
   // What Renderer::set_scene_parts may keep on the GPU under the device cap: the cap less the
   // frame's memory at the budget (0: no cap).
@@ -78,7 +83,8 @@ class LodStreamer {
   // One line per chunk that could not be read since the last call (the rest keeps rendering).
   std::vector<std::string> take_errors();
   const LodSet& set() const { return m_set; }
-  // The ranges of the scene update() last returned, in its order (the level overlay's input).
+  // The ranges of the scene update() or the parts update_parts() last returned, in their order
+  // (the level overlay's input).
   const std::vector<LodRange>& drawn_ranges() const { return m_drawn; }
 
  private:

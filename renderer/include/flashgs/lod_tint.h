@@ -4,10 +4,13 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "flashgs/lod_set.h"
 #include "flashgs/scene.h"
+#include "flashgs/scene_parts.h"
 
 namespace flashgs {
 
@@ -27,9 +30,21 @@ std::vector<LodLevelRun> lod_level_runs(const LodSet& set, const std::vector<Lod
 std::array<float, 3> lod_level_colour(int level);
 int lod_palette_size();
 
-// A copy of `scene` whose Gaussians are coloured by their run's level: the DC colour becomes the
-// level's colour and the view-dependent SH is dropped (SH degree 0), so that every view shows
-// the palette. Throws flashgs::Error when the runs do not cover the scene exactly.
-Scene tint_by_level(const Scene& scene, const std::vector<LodLevelRun>& runs);
+// A tinted part's key: the untinted part's with the top bit set (LodStreamer's keys, a chunk
+// file below 2^23 shifted by 40, never have it), so that a renderer holding parts by key never
+// takes one for the other.
+constexpr std::uint64_t kTintedPartKeyBit = std::uint64_t{1} << 63;
+
+// Tinted copies of parts by tinted key: a part's copy is made once while cuts keep drawing it.
+using TintedParts = std::unordered_map<std::uint64_t, std::shared_ptr<const Scene>>;
+
+// The level overlay of a cut handed over as parts (LodStreamer::update_parts, whose drawn
+// ranges give the runs): each part as a copy coloured by its run's level, keyed with
+// kTintedPartKeyBit. A copy's DC colour is the level's colour and its view-dependent SH is
+// dropped (SH degree 0), so that every view shows the palette. Copies come from `copies` where there and are added to it; copies of parts
+// no longer in `parts` leave it. Throws flashgs::Error when the runs do not cover the parts
+// exactly, a part spans two runs or a part's key already has the bit.
+std::vector<ScenePart> tint_parts_by_level(const std::vector<ScenePart>& parts, const std::vector<LodLevelRun>& runs,
+                                           TintedParts& copies);
 
 }  // namespace flashgs

@@ -30,6 +30,13 @@ class Renderer {
   // hold, and keeps parts no longer drawn while they fit in `resident_bytes` (0: no limit) for
   // a later cut. By default the parts are assembled into one scene for set_scene.
   virtual void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t resident_bytes);
+  // Why a scene set as parts cannot be rendered with `options` (empty: it can). A backend that
+  // keeps the parts in a layout of its own (the CUDA pool) draws them with fewer options than a
+  // scene set whole; by default the parts are a scene like any other.
+  virtual std::string scene_parts_refusal(const RenderOptions& options) const {
+    (void)options;
+    return {};
+  }
   // Renders one frame. `stats` may be null.
   virtual void render(const Camera& camera, const RenderOptions& options, Image& out,
                       FrameStats* stats) = 0;
