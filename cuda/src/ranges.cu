@@ -19,33 +19,6 @@ namespace {
 
 constexpr int kBlock = 256;
 
-// The end of the run of `key` that reaches `from` in the sorted keys: a walk over the first
-// few, then galloping and a binary search, so that a run of thousands (a dense ground plane
-// in one depth bin) costs its finder a few dozen loads rather than one per pair.
-template <typename KEY>
-__device__ __forceinline__ std::uint64_t run_end(const KEY* __restrict__ keys, std::uint64_t from,
-                                                 std::uint64_t pairs, KEY key) {
-  const std::uint64_t walk_end = min(pairs, from + kSerialRunMax);
-  for (; from < walk_end; ++from)
-    if (keys[from] != key) return from;
-  if (from == pairs) return from;
-  // keys[from - 1] == key: find a step past the run, then the first key that differs.
-  std::uint64_t low = from - 1, step = kSerialRunMax;
-  std::uint64_t high = low + step;
-  while (high < pairs && keys[high] == key) {
-    low = high;
-    step *= 2;
-    high = low + step;
-  }
-  if (high > pairs) high = pairs;
-  while (high - low > 1) {  // keys[low] == key; keys[high] != key or high == pairs
-    const std::uint64_t mid = low + (high - low) / 2;
-    if (keys[mid] == key) low = mid;
-    else high = mid;
-  }
-  return high;
-}
-
 // KEY: std::uint64_t (tile << 32 | depth bits) or std::uint32_t (tile << depth_bits | bin).
 // A run of equal keys longer than kSerialRunMax goes to buf.long_runs for long_runs_kernel.
 template <typename KEY>
@@ -62,7 +35,8 @@ __global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, con
     tile_ranges[tile].y = static_cast<unsigned>(i + 1);
   const bool run_start = i == 0 || keys[i - 1] != key;
   if (run_start && i + 1 < pairs && keys[i + 1] == key) {
-    const std::uint64_t end = run_end(keys, i + 2, pairs, key);
+    std::uint64_t end = i + 2;
+    while (end < pairs && keys[end] == key) ++end;
     const unsigned length = static_cast<unsigned>(end - i);
     if (length > kSerialRunMax) {
       // At most pairs / (kSerialRunMax + 1) runs are this long: the list has room for all.
