@@ -509,29 +509,6 @@ TEST(CudaSortKeys, CompactKeysBlendInTheSameOrderAsFullKeys) {
   }
 }
 
-// Coarse depth bins (16-bit keys) leave runs of equal keys far longer than one thread sorts
-// (kSerialRunMax): a block sorts each, and the blend order is still the 64-bit keys' to the
-// byte, on the whole-frame sort's path (the bin sort off), at an odd size and at 4K.
-TEST(CudaSortKeys, LongRunsOfEqualKeysBlendInTheExactOrder) {
-  FLASHGS_REQUIRE_CUDA();
-  const auto scene = tiled_demo_scene();
-  BackendTuning coarse;
-  coarse.sort_key_bits = 16;
-  coarse.bin_sort = 0;
-  auto gpu = make_cuda_renderer(coarse);
-  gpu->set_scene(scene);
-  RenderOptions full_keys;
-  full_keys.minimal_sort_bits = false;
-  for (const Camera& base : chunk_cull_cameras(*scene))
-    for (const Camera& camera : {base, base.resized(3840, 2160)}) {
-      const Result compact = render(*gpu, camera, RenderOptions{});
-      const Result full = render(*gpu, camera, full_keys);
-      EXPECT_EQ(compact.stats.kv_pairs, full.stats.kv_pairs) << camera.name;
-      EXPECT_TRUE(compact.image.rgb == full.image.rgb)
-          << camera.name << " " << camera.width << "x" << camera.height << ": the long runs left the blend order";
-    }
-}
-
 // The blend's tile order (fullest tiles first) must change no byte: every tile blended once,
 // each by the same code. Another view is rendered in between, so that a tile the order missed
 // would show that view's pixels, not the same frame's.

@@ -405,7 +405,7 @@ class CudaRendererImpl final : public CudaRenderer {
 
   std::vector<DeviceBuffer*> working_buffers() {
     return {&counters_, &blend_, &record_ids_, &footprints_, &pair_counts_, &pair_offsets_, &keys_[0], &keys_[1], &values_[0],
-            &values_[1], &ranges_, &long_runs_, &tile_lists_, &bin_fill_, &bin_ready_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
+            &values_[1], &ranges_, &tile_lists_, &bin_fill_, &bin_ready_, &dense_bins_, &tile_order_, &tile_places_, &chunk_list_, &image_, &cub_temp_,
             &deferred_footprints_, &deferred_records_, &deferred_hits_, &deferred_items_, &pixel_depth_, &pixel_blended_};
   }
 
@@ -558,8 +558,6 @@ class CudaRendererImpl final : public CudaRenderer {
     b.deferred = deferred_list();
     b.tile_ranges = ranges_.as<uint2>();
     b.tile_capacity = ranges_.bytes() / sizeof(uint2);
-    b.long_runs = long_runs_.as<uint2>();
-    b.long_run_capacity = static_cast<std::uint32_t>(long_runs_.bytes() / sizeof(uint2));
     for (int k = 0; k < 2; ++k) b.tile_values[k] = keys_[k].as<std::uint32_t>();
     b.tile_lists = tile_lists_.as<uint2>();
     b.dense_bins = dense_bins_.as<std::uint32_t>();
@@ -584,8 +582,6 @@ class CudaRendererImpl final : public CudaRenderer {
       keys_[k].reserve(capacity * sizeof(std::uint64_t), "sort keys");
       values_[k].reserve(capacity * sizeof(std::uint32_t), "sort values");
     }
-    // A run of equal keys longer than kSerialRunMax has at least kSerialRunMax + 1 pairs.
-    long_runs_.reserve((capacity / (cuda::kSerialRunMax + 1) + 1) * sizeof(uint2), "long runs of equal keys");
     pair_capacity_ = capacity;
     grow_cub_temp();
   }
@@ -1227,7 +1223,7 @@ class CudaRendererImpl final : public CudaRenderer {
   bool pooled_ = false;
   std::uint64_t pool_bytes_ = 0, pool_peak_bytes_ = 0;
   // Working memory.
-  DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, long_runs_, tile_lists_, bin_fill_,
+  DeviceBuffer counters_, blend_, record_ids_, footprints_, pair_counts_, pair_offsets_, keys_[2], values_[2], ranges_, tile_lists_, bin_fill_,
       bin_ready_, dense_bins_, tile_order_, tile_places_, chunk_list_, image_,
       cub_temp_, deferred_footprints_, deferred_records_, deferred_hits_, deferred_items_;
   DeviceBuffer pixel_depth_, pixel_blended_;  // RenderOptions::collect_pixel_planes

@@ -130,11 +130,6 @@ constexpr int kMacroBinShift = 1;
 constexpr int kBinTileBitsShift = 28;                                  // up to 4 tile bits
 constexpr std::uint32_t kRecordMask = (1u << kBinTileBitsShift) - 1u;  // a binned value's record
 
-// Runs of equal sort keys of up to this many pairs are put in blend order by one thread; longer
-// ones (a dense bin of a large scene: the aerial garden at 1080p held runs of hundreds) by a
-// block each.
-constexpr unsigned kSerialRunMax = 16;
-
 // Tiles are ordered for the blend by the bit length of their pair count (launch_tile_order).
 constexpr int kTileClasses = 33;
 
@@ -159,7 +154,6 @@ struct FrameCounters {
   unsigned int records;            // blend records wanted (compact records: may exceed capacity)
   unsigned int dense_bins;         // bins listed in FrameBuffers::dense_bins (launch_tile_lists)
   unsigned int bin_count_blocks;   // blocks of the bin sort's counting pass done (launch_bin_pairs)
-  unsigned int long_runs;          // runs of equal keys listed in FrameBuffers::long_runs (launch_ranges)
 };
 
 // Gaussians whose emission the preprocess kernel leaves to a later kernel, so that their long
@@ -216,10 +210,6 @@ struct FrameBuffers {
   // Per bin: [start, end) of its pairs in the sorted list.
   uint2* tile_ranges = nullptr;  // [tile_capacity]
   std::uint64_t tile_capacity = 0;
-  // Runs of equal sort keys longer than kSerialRunMax (start, length), which the ranges pass
-  // leaves to a block each instead of one thread's serial sort.
-  uint2* long_runs = nullptr;  // [long_run_capacity]
-  std::uint32_t long_run_capacity = 0;
   // Binned frames: each tile's blend records, gathered once from its bin's values
   // (launch_tile_lists), so that the blend walks its own tile's list. They live in the key
   // buffers, which nothing reads after the ranges pass: bin [s, e)'s top tiles in

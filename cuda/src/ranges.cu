@@ -1,11 +1,8 @@
 // Stage `ranges`: each bin's [start, end) in the sorted pairs, the blend's bin order (fullest
 // first), and runs of equal keys put in (depth, Gaussian id) order, so the blend order is
 // exactly the CPU's whatever the key format: equal 64-bit keys share their depth (the atomics
-// of emission shuffled their records), equal compact keys share a quantised depth bin. Short
-// runs are sorted by the thread that finds them, long ones by a block each. (A
+// of emission shuffled their records), equal compact keys share a quantised depth bin. (A
 // bin is a tile, or 2x2 tiles with macro bins: pipeline.h, BinGrid.)
-#include <cub/block/block_radix_sort.cuh>
-
 #include <algorithm>
 
 #include "bins.cuh"
@@ -20,11 +17,10 @@ namespace {
 constexpr int kBlock = 256;
 
 // KEY: std::uint64_t (tile << 32 | depth bits) or std::uint32_t (tile << depth_bits | bin).
-// A run of equal keys longer than kSerialRunMax goes to buf.long_runs for long_runs_kernel.
 template <typename KEY>
 __global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, const KEY* __restrict__ keys,
                                                         int tile_shift, std::uint32_t* __restrict__ values,
-                                                        Records records, uint2* tile_ranges, FrameBuffers buf) {
+                                                        Records records, uint2* tile_ranges) {
   const std::uint64_t i = static_cast<std::uint64_t>(blockIdx.x) * kBlock + threadIdx.x;
   if (i >= pairs) return;
   const KEY key = keys[i];
@@ -37,75 +33,8 @@ __global__ void __launch_bounds__(kBlock) ranges_kernel(std::uint64_t pairs, con
   if (run_start && i + 1 < pairs && keys[i + 1] == key) {
     std::uint64_t end = i + 2;
     while (end < pairs && keys[end] == key) ++end;
-    const unsigned length = static_cast<unsigned>(end - i);
-    if (length > kSerialRunMax) {
-      // At most pairs / (kSerialRunMax + 1) runs are this long: the list has room for all.
-      const unsigned slot = atomicAdd(&buf.counters->long_runs, 1u);
-      if (slot < buf.long_run_capacity) {
-        buf.long_runs[slot] = make_uint2(static_cast<unsigned>(i), length);
-        return;
-      }
-    }
-    sort_run(values + i, length, records);
+    sort_run(values + i, static_cast<unsigned>(end - i), records);
   }
-}
-
-// A block per listed run (every gridDim-th): the run's pairs in blend order by a block radix
-// sort of their blend_order keys over the bits in which they differ; a run longer than a
-// block holds (not seen in real scenes) is sorted by one thread.
-constexpr int kRunBlock = 256;
-constexpr int kRunItems = 8;
-using RunSort = cub::BlockRadixSort<std::uint64_t, kRunBlock, kRunItems, std::uint32_t>;
-
-__global__ void __launch_bounds__(kRunBlock) long_runs_kernel(FrameBuffers buf, std::uint32_t* __restrict__ values,
-                                                              Records records) {
-  __shared__ typename RunSort::TempStorage storage;
-  __shared__ unsigned long long differ;
-  const unsigned count = min(buf.counters->long_runs, buf.long_run_capacity);
-  for (unsigned r = blockIdx.x; r < count; r += gridDim.x) {
-    const uint2 run = buf.long_runs[r];
-    std::uint32_t* v = values + run.x;
-    const unsigned n = run.y;
-    if (n > static_cast<unsigned>(kRunBlock * kRunItems)) {  // block-uniform
-      if (threadIdx.x == 0) sort_run(v, n, records);
-      __syncthreads();
-      continue;
-    }
-    if (threadIdx.x == 0) differ = 0;
-    __syncthreads();
-    const std::uint64_t first = blend_order(records, v[0]);
-    std::uint64_t keys[kRunItems];
-    std::uint32_t items[kRunItems];
-    unsigned long long bits = 0;
-#pragma unroll
-    for (int k = 0; k < kRunItems; ++k) {
-      const unsigned at = threadIdx.x * kRunItems + k;  // blocked: padding comes last and stays last
-      items[k] = at < n ? v[at] : 0u;
-      keys[k] = at < n ? blend_order(records, items[k]) : ~std::uint64_t{0};
-      if (at < n) bits |= keys[k] ^ first;
-    }
-    if (bits) atomicOr(&differ, bits);
-    __syncthreads();
-    const int end_bit = differ ? 64 - __clzll(static_cast<long long>(differ)) : 1;
-    RunSort(storage).Sort(keys, items, 0, end_bit);
-#pragma unroll
-    for (int k = 0; k < kRunItems; ++k) {
-      const unsigned at = threadIdx.x * kRunItems + k;
-      if (at < n) v[at] = items[k];
-    }
-    __syncthreads();  // the storage and `differ` are the next run's
-  }
-}
-
-// Blocks of long_runs_kernel: the runs' count is known on the device only.
-unsigned long_run_blocks() {
-  static const unsigned blocks = [] {
-    int device = 0, sms = 0;
-    check_cuda(cudaGetDevice(&device), "device query");
-    check_cuda(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "device query");
-    return static_cast<unsigned>(std::max(1, sms) * 4);
-  }();
-  return blocks;
 }
 
 // The largest end - start over the tiles and their sum: warp reductions, one atomic each per warp.
@@ -248,14 +177,10 @@ void launch_ranges(std::uint64_t pairs, std::uint64_t bins, const FrameBuffers& 
   const Records records = frame_records(b, b.bins.shift ? kRecordMask : ~0u);
   if (b.key_format.depth_bits > 0)
     ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, reinterpret_cast<const std::uint32_t*>(b.keys[which]),
-                                                 b.key_format.depth_bits, b.values[which], records, b.tile_ranges, b);
+                                                 b.key_format.depth_bits, b.values[which], records, b.tile_ranges);
   else
-    ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, b.keys[which], 32, b.values[which], records, b.tile_ranges, b);
+    ranges_kernel<<<blocks, kBlock, 0, stream>>>(pairs, b.keys[which], 32, b.values[which], records, b.tile_ranges);
   check_cuda(cudaGetLastError(), "ranges kernel launch");
-  if (b.long_run_capacity > 0) {
-    long_runs_kernel<<<long_run_blocks(), kRunBlock, 0, stream>>>(b, b.values[which], records);
-    check_cuda(cudaGetLastError(), "long runs kernel launch");
-  }
 }
 
 }  // namespace cuda
