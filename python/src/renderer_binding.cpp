@@ -35,15 +35,7 @@ class PyRenderer {
     check_fits(camera, scene.scene->size());
     Image image;
     FrameStats stats;
-    {
-      py::gil_scoped_release unlocked;
-      std::lock_guard<std::mutex> one_frame_at_a_time(m_mutex);
-      if (m_scene != scene.scene) {
-        m_renderer->set_scene(scene.scene);
-        m_scene = scene.scene;
-      }
-      m_renderer->render(camera, options, image, &stats);
-    }
+    on_scene(scene, [&] { m_renderer->render(camera, options, image, &stats); });
     const py::ssize_t h = image.height, w = image.width;
     return py::make_tuple(array_owning(std::move(image.rgb), {h, w, 3}), std::move(stats));
   }
@@ -55,19 +47,24 @@ class PyRenderer {
     const DeviceArray target = writable_cuda_array(out, "out", {camera.height, camera.width, 3});
     check_fits(camera, scene.scene->size());
     FrameStats stats;
-    {
-      py::gil_scoped_release unlocked;
-      std::lock_guard<std::mutex> one_frame_at_a_time(m_mutex);
-      if (m_scene != scene.scene) {
-        m_renderer->set_scene(scene.scene);
-        m_scene = scene.scene;
-      }
-      cli::render_to_device(*m_renderer, camera, options, target.data, target.stream, &stats, "out");
-    }
+    on_scene(scene, [&] { cli::render_to_device(*m_renderer, camera, options, target.data, target.stream, &stats, "out"); });
     return stats;
   }
 
  private:
+  // Runs `frame` with the GIL released, one frame at a time, once the renderer holds `scene`
+  // (uploaded only when it changed).
+  template <typename Frame>
+  void on_scene(const PyScene& scene, Frame frame) {
+    py::gil_scoped_release unlocked;
+    std::lock_guard<std::mutex> one_frame_at_a_time(m_mutex);
+    if (m_scene != scene.scene) {
+      m_renderer->set_scene(scene.scene);
+      m_scene = scene.scene;
+    }
+    frame();
+  }
+
   // Refuses a frame whose working memory this process cannot get, as `flashgs render` does.
   void check_fits(const Camera& camera, std::size_t gaussians) const {
     const bool cpu = m_renderer->name().rfind("cpu", 0) == 0;
