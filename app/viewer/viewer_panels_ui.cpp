@@ -834,7 +834,9 @@ void draw_panels(const UiModel& m, ViewerSettings& s, UiActions& a, std::string&
   if (scene_key != fitted_for && panel_width > 0) ImGui::SetNextWindowSize(ImVec2(panel_width, 0), ImGuiCond_Always);
   fitted_for = scene_key;
   ImGui::SetNextWindowBgAlpha(0.85f);
-  ImGui::Begin("flashgs-viewer");
+  // The scrollbar's room is always kept: a scrollbar that came and went with the open tab's
+  // height would rewrap the scene path and move every widget under the pointer.
+  ImGui::Begin("flashgs-viewer", nullptr, ImGuiWindowFlags_AlwaysVerticalScrollbar);
   keep_inside_viewport("panel corner");
   panel_width = ImGui::GetWindowSize().x;
   const float panel_right = ImGui::GetWindowPos().x + ImGui::GetWindowSize().x;
