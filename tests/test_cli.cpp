@@ -334,7 +334,7 @@ TEST(CliMemory, BaselineNeedlesAreRefusedWhereFlashRenders) {
 // keys' times are `render --eye/--look-at` at those poses; between them, neither.
 TEST(CliRender, ACameraPathRendersItsKeysAsTheExplicitCameraDoes) {
   const std::string dir = scratch_dir("camera_path");
-  const std::string ext = image_io_has_oiio() ? ".png" : ".ppm";
+  const std::string ext = image_io_writes_png() ? ".png" : ".ppm";
   const float up[3] = {0, -1, 0};
   const float eye0[3] = {0.2f, -0.3f, -3.0f}, eye1[3] = {2.0f, -0.5f, -2.0f}, target[3] = {0, 0, 0};
   KeyframePath path;

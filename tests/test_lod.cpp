@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <numeric>
 
 #include <unistd.h>
@@ -249,6 +250,41 @@ TEST(LodCut, IsDeterministicWithinItsBudgetAndFinerForASmallerError) {
   for (std::size_t leaf = 0; leaf < full.level.size(); ++leaf) EXPECT_LE(full.level[leaf], 0) << "leaf " << leaf;
 }
 
+// Given what each chunk file takes, a cut draws only from files that fit together, counting
+// each file once however many of its leaves use it, and the files always held from the start.
+TEST(LodCut, KeepsToTheFilesThatFitTheFileBudget) {
+  const LodSet set = read_lod_set(demo_set());
+  const Camera camera = test::load_demo_cameras()[3].resized(640, 360);
+  LodCutOptions options;
+  options.max_error_px = 0.0f;
+  LodFileBudget files;
+  for (std::size_t f = 0; f < set.files.size(); ++f) files.bytes.push_back(1000 + f);
+  files.always_held.assign(set.files.size(), false);
+  files.always_held[0] = true;
+  auto files_used = [&](const LodCut& cut) {
+    std::set<int> used = {0};
+    for (std::size_t leaf = 0; leaf < cut.level.size(); ++leaf)
+      if (cut.level[leaf] >= 0) used.insert(set.leaves[leaf].levels[static_cast<std::size_t>(cut.level[leaf])].file);
+    std::uint64_t bytes = 0;
+    for (int f : used) bytes += files.bytes[static_cast<std::size_t>(f)];
+    return std::make_pair(used.size(), bytes);
+  };
+  const LodCut free = choose_lod_cut(set, camera, options, nullptr, &files);
+  const auto [all_files, all_bytes] = files_used(free);
+  EXPECT_EQ(free.file_bytes, all_bytes);
+  EXPECT_FALSE(free.files_bound);
+  ASSERT_GT(all_files, 3u);
+  files.limit = all_bytes / 2;
+  const LodCut bound = choose_lod_cut(set, camera, options, nullptr, &files);
+  const auto [bound_files, bound_bytes] = files_used(bound);
+  EXPECT_TRUE(bound.files_bound);
+  EXPECT_LE(bound_bytes, files.limit);
+  EXPECT_EQ(bound.file_bytes, bound_bytes);
+  EXPECT_LT(bound_files, all_files);
+  EXPECT_LT(bound.gaussians, free.gaussians);
+  EXPECT_GT(bound.gaussians, 0u);
+}
+
 // Every leaf in view at level 0 is the whole scene; the frame must then be the in-memory one.
 TEST(LodStream, AtFullDetailTheFrameEqualsTheInMemoryRenderersFrame) {
   LodStreamOptions options;
@@ -342,6 +378,41 @@ TEST(LodStream, UnderATinyCapEveryFrameStillRendersAndTheCapHolds) {
   }
 }
 
+// A cap that holds the budget's Gaussians but not every chunk file they come from (a file holds
+// many leaves' ranges): the cut keeps to the files that fit beside each other, so a still view
+// settles and stops reading, and the drawn scene stays within the budget and the cap.
+TEST(LodStream, AStillViewSettlesUnderACapThatHoldsTheBudgetButNotItsFiles) {
+  const std::vector<Camera> cameras = test::load_demo_cameras();
+  for (std::uint64_t cap_mib : {3, 4, 6}) {
+    LodStreamOptions options;
+    options.cut.max_error_px = 0.0f;
+    options.host_bytes = cap_mib << 20;
+    options.prefetch = false;
+    LodStreamer streamer(read_lod_set(demo_set()), options);
+    for (int index : {5, 20}) {
+      const Camera camera = cameras[static_cast<std::size_t>(index)].resized(320, 180);
+      std::uint64_t settled_read = 0;
+      for (int frame = 0; frame < 16; ++frame) {
+        if (frame == 8) settled_read = streamer.stats().bytes_read;
+        const std::shared_ptr<const Scene> scene = streamer.update(camera);
+        streamer.wait_until_idle();
+        const LodStreamStats s = streamer.stats();
+        EXPECT_LE(scene->size(), s.budget) << cap_mib << " MiB, camera " << index;
+        EXPECT_LE(s.host_high_water, options.host_bytes) << cap_mib << " MiB, camera " << index;
+      }
+      const LodStreamStats s = streamer.stats();
+      std::printf("%llu MiB, camera %d: %llu Gaussians drawn of a budget of %llu, %d leaves coarser than the cut, %d files resident, "
+                  "%llu bytes read\n",
+                  static_cast<unsigned long long>(cap_mib), index, static_cast<unsigned long long>(s.drawn_gaussians),
+                  static_cast<unsigned long long>(s.budget), s.leaves_coarser, s.files_resident,
+                  static_cast<unsigned long long>(s.bytes_read));
+      EXPECT_EQ(s.bytes_read, settled_read) << cap_mib << " MiB, camera " << index << ": a still view kept reading";
+      EXPECT_EQ(s.leaves_missing, 0) << cap_mib << " MiB, camera " << index;
+      EXPECT_EQ(s.leaves_coarser, 0) << cap_mib << " MiB, camera " << index << ": the cut wants what cannot be in memory";
+    }
+  }
+}
+
 // The renderer's working memory counts against the cap: the budget leaves room for it.
 TEST(LodStream, TheFramesWorkingMemoryIsInsideTheCap) {
   LodStreamOptions options;
@@ -384,6 +455,45 @@ TEST(LodStream, ACorruptChunkIsOneLineAndTheRestKeepsRendering) {
   EXPECT_GT(scene->size(), 0u);
   EXPECT_GT(streamer.stats().leaves_coarser, 0) << "the broken chunk's leaves are drawn at a coarser level";
   EXPECT_EQ(streamer.stats().files_failed, 1);
+}
+
+// A leaf whose wanted and coarser levels are not in memory may be drawn at a finer level that
+// is: only while the drawn scene stays within the budget (the broken coarsest chunks here
+// leave many leaves nothing coarser).
+TEST(LodStream, FinerStandInsKeepTheDrawnSceneWithinTheBudget) {
+  const std::string dir = fresh_folder("no_coarsest_" + std::to_string(getpid()));
+  fs::copy(demo_set(), dir, fs::copy_options::recursive);
+  LodSet set = read_lod_set(dir);
+  std::set<int> coarsest;
+  for (const LodLeaf& leaf : set.leaves)
+    for (auto r = leaf.levels.rbegin(); r != leaf.levels.rend(); ++r)
+      if (r->file >= 0) {
+        coarsest.insert(r->file);
+        break;
+      }
+  for (int f : coarsest)
+    std::ofstream(set.file_path(f), std::ios::trunc | std::ios::binary) << "ply\nformat binary_little_endian 1.0\nend_header\n";
+  LodStreamOptions options;
+  options.cut.max_error_px = 0.0f;
+  options.cut.budget = 6000;
+  options.prefetch = false;
+  LodStreamer streamer(std::move(set), options);
+  const std::vector<Camera> cameras = test::load_demo_cameras();
+  std::uint64_t most = 0;
+  int leaves_missing = 0;
+  for (int index : {0, 3, 5, 20, 0}) {
+    const Camera camera = cameras[static_cast<std::size_t>(index)].resized(160, 90);
+    for (int frame = 0; frame < 3; ++frame) {
+      most = std::max<std::uint64_t>(most, streamer.update(camera)->size());
+      streamer.wait_until_idle();
+      leaves_missing = std::max(leaves_missing, streamer.stats().leaves_missing);
+    }
+  }
+  std::printf("most drawn %llu of a budget of %llu; leaves missing at most %d\n", static_cast<unsigned long long>(most),
+              static_cast<unsigned long long>(options.cut.budget), leaves_missing);
+  EXPECT_GT(most, 0u);
+  EXPECT_LE(most, options.cut.budget);
+  EXPECT_EQ(streamer.stats().files_failed, static_cast<int>(coarsest.size()));
 }
 
 // The level overlay of a cut's parts: every Gaussian takes its run's level colour, the geometry

@@ -8,7 +8,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 packages=(build-essential cmake ninja-build pkg-config
           libglm-dev libopenimageio-dev openimageio-tools libcli11-dev nlohmann-json3-dev libgtest-dev
           libglfw3-dev libimgui-dev libgl-dev libx11-dev libxtst-dev xvfb xauth libgl1-mesa-dri
-          libhwy-dev libwebp-dev zlib1g-dev libzstd-dev
+          libhwy-dev libwebp-dev libpng-dev zlib1g-dev libzstd-dev
           python3-dev python3-pybind11 python3-numpy python3-pytest python3-venv ${FLASHGS_EXTRA_PACKAGES:-})
 missing=()
 for p in "${packages[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done

@@ -113,7 +113,7 @@ struct RenderCommand {
     for (int i = 0; i < frames; ++i) {
       renderer->render(path.camera_at(path.frame_time(i), path.width, path.height), options, image, &stats);
       char name[32];  // PNG where OpenImageIO is built in, else PPM (the same 8-bit bytes)
-      std::snprintf(name, sizeof name, "/frame_%05d%s", i, image_io_has_oiio() ? ".png" : ".ppm");
+      std::snprintf(name, sizeof name, "/frame_%05d%s", i, image_io_writes_png() ? ".png" : ".ppm");
       write_image(image, output + name);
     }
     std::printf("wrote %d frames to %s\n", frames, output.c_str());

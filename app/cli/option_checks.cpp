@@ -66,7 +66,9 @@ void check_output_image(const std::string& option, const std::string& path) {
   check_output_file(option, path);
   if (!image_format_writable(path))
     throw Error(option + " " + path + ": unknown image format (the extension picks it: " +
-                (image_io_has_oiio() ? std::string(".png, .exr, .jpg, .tif, ") : std::string()) + ".ppm or .pfm)");
+                (image_io_has_oiio() ? std::string(".png, .exr, .jpg, .tif, ")
+                                     : image_io_writes_png() ? std::string(".png, ") : std::string()) +
+                ".ppm or .pfm)");
 }
 
 std::vector<std::string> check_output_folder(const std::string& option, const std::string& dir) {

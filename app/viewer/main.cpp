@@ -3,7 +3,6 @@
 #include <cstdlib>
 #include <exception>
 
-#include "flashgs/image_io.h"
 #include "scene_loader.h"
 
 #include "viewer_app_gl.h"
@@ -13,11 +12,9 @@ int main(int argc, char** argv) {
   flashgs::viewer::ViewerArgs args;
   const int parsed = flashgs::viewer::parse_viewer_args(argc, argv, &args);
   if (parsed >= 0) return parsed;
-  // OpenImageIO's module (PNG/EXR screenshots and exports) loads here, before the window opens
-  // and after --help and bad options have been answered: loaded later, at the first
-  // screenshot, one of its ~240 libraries left the window deaf to the next clicks
-  // (Viewer.TheUiAnswersWhileThePathExportsOnTheCpu).
-  flashgs::image_io_has_oiio();
+  // OpenImageIO's module is not loaded here: PNG screenshots and exports go through libpng.
+  // It loads at the first EXR (or other such format) a user names; loaded at a screenshot
+  // while the window was open, its ~260 libraries once left the window deaf to the next clicks.
   int code = 3;
   try {
     flashgs::viewer::ViewerApp app(args);

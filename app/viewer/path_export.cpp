@@ -14,7 +14,7 @@
 namespace flashgs::viewer {
 namespace {
 
-const char* frame_extension() { return image_io_has_oiio() ? ".png" : ".ppm"; }
+const char* frame_extension() { return image_io_writes_png() ? ".png" : ".ppm"; }
 
 }  // namespace
 

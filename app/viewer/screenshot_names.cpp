@@ -72,7 +72,7 @@ std::string timestamped_screenshot_path(const std::string& folder, const std::st
 
 std::string next_screenshot_path(const std::string& folder, const std::string& tag) {
   // PNG where OpenImageIO is built in, else the built-in PPM writer's format.
-  return timestamped_screenshot_path(folder, tag, std::time(nullptr), image_io_has_oiio() ? ".png" : ".ppm");
+  return timestamped_screenshot_path(folder, tag, std::time(nullptr), image_io_writes_png() ? ".png" : ".ppm");
 }
 
 }  // namespace flashgs::viewer

@@ -1,5 +1,5 @@
-// Image file IO: PNG/EXR/anything through the OpenImageIO module when built with it (loaded at
-// the first such read or write), with the built-in PPM/PFM formats always.
+// Image file IO: PNG written through libpng, EXR/anything else (and reading PNG) through the
+// OpenImageIO module when built with it (loaded at the first such use), PPM/PFM always.
 #include "flashgs/image_io.h"
 
 #include <dlfcn.h>
@@ -13,6 +13,9 @@
 #include "flashgs/file_write.h"
 #include "flashgs/netpbm.h"
 #include "image_oiio_module.h"
+#ifdef FLASHGS_HAVE_PNG
+#include "png_write.h"
+#endif
 
 namespace flashgs {
 namespace {
@@ -90,9 +93,20 @@ void write_with_oiio(const OiioModule& m, const Image& image, const std::string&
 
 bool image_io_has_oiio() { return oiio().why_not.empty(); }
 
+bool image_io_writes_png() {
+#ifdef FLASHGS_HAVE_PNG
+  return true;
+#else
+  return image_io_has_oiio();
+#endif
+}
+
 bool image_format_writable(const std::string& path) {
   const std::string ext = extension_of(path);
   if (ext == "ppm" || ext == "pfm") return true;
+#ifdef FLASHGS_HAVE_PNG
+  if (ext == "png") return true;
+#endif
   const OiioModule& m = oiio();
   return m.why_not.empty() && !ext.empty() && m.can_write(path.c_str()) != 0;
 }
@@ -101,6 +115,9 @@ void write_image(const Image& image, const std::string& path) {
   const std::string ext = extension_of(path);
   if (ext == "ppm") return write_ppm(image, path);
   if (ext == "pfm") return write_pfm(image, path);
+#ifdef FLASHGS_HAVE_PNG
+  if (ext == "png") return write_file_atomically(path, [&](OutputFile& file) { write_png(image, path, file); });
+#endif
   const OiioModule& m = oiio();
   if (!m.why_not.empty()) throw Error(path + ": ." + ext + " needs OpenImageIO: " + m.why_not + "; use .ppm or .pfm");
   write_file_atomically(path, [&](OutputFile& file) { write_with_oiio(m, image, path, ext, file); });

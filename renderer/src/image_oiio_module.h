@@ -1,4 +1,4 @@
-// The C interface of the OpenImageIO module (libflashgs_image_oiio.so), which image_io.cpp loads at the first PNG/EXR use (the viewer: before its window opens).
+// The C interface of the OpenImageIO module (libflashgs_image_oiio.so), which image_io.cpp loads at the first EXR/TIFF/JPEG write or PNG/EXR read.
 #pragma once
 
 #include <cstddef>

@@ -41,6 +41,45 @@ int coarsest_level(const LodLeaf& leaf) {
   return -1;
 }
 
+// The files a cut draws from, each counted once, against a file budget (none: no limit).
+class FileUse {
+ public:
+  FileUse(const LodFileBudget* budget, std::size_t files) : m_budget(budget) {
+    if (!m_budget) return;
+    m_users.assign(files, 0);
+    for (std::size_t f = 0; f < files && f < m_budget->always_held.size(); ++f)
+      if (m_budget->always_held[f]) m_bytes += bytes(static_cast<int>(f));
+  }
+  bool fits(int file) const {
+    if (!m_budget || m_budget->limit == 0 || counted(file)) return true;
+    return m_bytes + bytes(file) <= m_budget->limit;
+  }
+  void add(int file) {
+    if (!m_budget) return;
+    if (!counted(file)) m_bytes += bytes(file);
+    ++m_users[static_cast<std::size_t>(file)];
+  }
+  void remove(int file) {
+    if (!m_budget) return;
+    --m_users[static_cast<std::size_t>(file)];
+    if (!counted(file)) m_bytes -= bytes(file);
+  }
+  std::uint64_t total() const { return m_bytes; }
+
+ private:
+  bool held(int file) const {
+    return static_cast<std::size_t>(file) < m_budget->always_held.size() && m_budget->always_held[static_cast<std::size_t>(file)];
+  }
+  bool counted(int file) const { return held(file) || m_users[static_cast<std::size_t>(file)] > 0; }
+  std::uint64_t bytes(int file) const {
+    return static_cast<std::size_t>(file) < m_budget->bytes.size() ? m_budget->bytes[static_cast<std::size_t>(file)] : 0;
+  }
+
+  const LodFileBudget* m_budget;
+  std::vector<int> m_users;  // leaves of the cut drawing from each file
+  std::uint64_t m_bytes = 0;
+};
+
 }  // namespace
 
 float lod_leaf_error_px(const LodSet& set, int leaf, int level, const Camera& camera) {
@@ -79,9 +118,11 @@ bool lod_leaf_in_view(const LodSet& set, int leaf, const Camera& camera) {
   return std::none_of(outside, outside + 5, [](int n) { return n == 8; });
 }
 
-LodCut choose_lod_cut(const LodSet& set, const Camera& camera, const LodCutOptions& options, const LodCut* previous) {
+LodCut choose_lod_cut(const LodSet& set, const Camera& camera, const LodCutOptions& options, const LodCut* previous,
+                      const LodFileBudget* files) {
   const int leaves = static_cast<int>(set.leaves.size());
   LodCut cut;
+  FileUse used(files, set.files.size());
   cut.level.assign(static_cast<std::size_t>(leaves), -1);
   const std::uint64_t budget = options.budget ? options.budget : std::numeric_limits<std::uint64_t>::max();
   // The leaves in view at their coarsest level, the largest on screen first while the budget lasts.
@@ -96,6 +137,9 @@ LodCut choose_lod_cut(const LodSet& set, const Camera& camera, const LodCutOptio
   });
   auto count_at = [&](int leaf, int level) {
     return set.leaves[static_cast<std::size_t>(leaf)].levels[static_cast<std::size_t>(level)].count;
+  };
+  auto file_at = [&](int leaf, int level) {
+    return set.leaves[static_cast<std::size_t>(leaf)].levels[static_cast<std::size_t>(level)].file;
   };
   // Max-heap on (error, -leaf): equal errors refine the lower leaf index first.
   std::priority_queue<std::pair<float, int>> refine;
@@ -118,8 +162,13 @@ LodCut choose_lod_cut(const LodSet& set, const Camera& camera, const LodCutOptio
       cut.budget_bound = true;
       continue;
     }
+    if (!used.fits(file_at(leaf, coarse))) {
+      cut.files_bound = true;
+      continue;
+    }
     cut.level[static_cast<std::size_t>(leaf)] = coarse;
     cut.gaussians += count_at(leaf, coarse);
+    used.add(file_at(leaf, coarse));
   }
   for (int leaf = 0; leaf < leaves; ++leaf)
     if (cut.level[static_cast<std::size_t>(leaf)] >= 0) consider(leaf);
@@ -133,10 +182,17 @@ LodCut choose_lod_cut(const LodSet& set, const Camera& camera, const LodCutOptio
       cut.budget_bound = true;
       break;
     }
+    if (!used.fits(file_at(leaf, finer))) {  // the leaf stays; others may refine within their files
+      cut.files_bound = true;
+      continue;
+    }
+    used.add(file_at(leaf, finer));
+    used.remove(file_at(leaf, level));
     cut.gaussians = total;
     cut.level[static_cast<std::size_t>(leaf)] = finer;
     consider(leaf);
   }
+  cut.file_bytes = used.total();
   for (int leaf = 0; leaf < leaves; ++leaf)
     if (cut.level[static_cast<std::size_t>(leaf)] >= 0)
       cut.worst_error_px = std::max(cut.worst_error_px, lod_leaf_error_px(set, leaf, cut.level[static_cast<std::size_t>(leaf)], camera));

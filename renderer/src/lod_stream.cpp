@@ -96,6 +96,15 @@ LodStreamer::LodStreamer(LodSet set, LodStreamOptions options) : m_set(std::move
   if (options.host_bytes) {
     const std::uint64_t drawn = m_budget * drawn_per_gaussian + options.host_frame.fixed;
     m_chunk_cap = options.host_bytes - std::min(options.host_bytes, drawn);
+    // The cut keeps to files that fit the chunks' share beside one load in flight, which holds
+    // its file's bytes while it decodes: so every file the cut wants can be loaded, one at a
+    // time where there is no room for more (a load without room waits for the next frame).
+    std::uint64_t largest_file = 0;
+    for (const Chunk& c : m_chunks) largest_file = std::max(largest_file, c.file_bytes);
+    m_file_budget.limit = m_chunk_cap > largest_file ? m_chunk_cap - largest_file : 1;
+    m_file_budget.always_held = m_pinned;
+    for (int f = 0; f < files; ++f)
+      m_file_budget.bytes.push_back(m_file_gaussians[static_cast<std::size_t>(f)] * m_bytes_per_gaussian);
   }
   for (int t = 0; t < std::max(1, options.threads); ++t) m_threads.emplace_back([this] { load_loop(); });
 }
@@ -209,14 +218,14 @@ void LodStreamer::request(const std::vector<int>& files) {
 LodStreamer::Drawn LodStreamer::choose(const Camera& camera) {
   LodCutOptions cut_options = m_options.cut;
   cut_options.budget = m_budget == std::numeric_limits<std::uint64_t>::max() ? 0 : m_budget;
-  LodCut cut = choose_lod_cut(m_set, camera, cut_options, &m_cut);
+  LodCut cut = choose_lod_cut(m_set, camera, cut_options, &m_cut, &m_file_budget);
   // Where the camera will be if it keeps moving: its chunks are asked for after the cut's.
   LodCut ahead;
   if (m_options.prefetch && m_have_last_position) {
     Camera next = camera;
     for (int k = 0; k < 3; ++k) next.position[k] += kPrefetchFrames * (camera.position[k] - m_last_position[k]);
     if (next.position[0] != camera.position[0] || next.position[1] != camera.position[1] || next.position[2] != camera.position[2])
-      ahead = choose_lod_cut(m_set, next, cut_options, &cut);
+      ahead = choose_lod_cut(m_set, next, cut_options, &cut, &m_file_budget);
   }
   for (int k = 0; k < 3; ++k) m_last_position[k] = camera.position[k];
   m_have_last_position = true;
@@ -237,16 +246,38 @@ LodStreamer::Drawn LodStreamer::choose(const Camera& camera) {
     std::vector<std::pair<float, int>> wanted;  // (priority, file)
     for (std::size_t f = 0; f < m_chunks.size(); ++f)
       if (m_pinned[f]) wanted.emplace_back(std::numeric_limits<float>::infinity(), static_cast<int>(f));
+    // Each leaf of the cut at its level if in memory, else the nearest coarser one in memory.
+    // Where only a finer one is, that one while the budget still holds it (the cut's own
+    // Gaussians are within the budget; finer stand-ins must not push the drawn scene over it).
+    std::vector<int> draw_level(cut.level.size(), -1);
+    std::vector<std::pair<std::size_t, int>> finer_only;  // (leaf, the nearest finer level in memory)
+    std::uint64_t drawn_total = 0;
     for (std::size_t leaf = 0; leaf < cut.level.size(); ++leaf) {
       const int want = cut.level[leaf];
       if (want < 0) continue;
       const LodLeaf& l = m_set.leaves[leaf];
-      int draw = -1;
-      if (resident(l.levels[static_cast<std::size_t>(want)].file)) draw = want;
-      for (int c = want + 1; draw < 0 && c < levels; ++c)
-        if (resident(l.levels[static_cast<std::size_t>(c)].file)) draw = c;
-      for (int c = want - 1; draw < 0 && c >= 0; --c)
-        if (resident(l.levels[static_cast<std::size_t>(c)].file)) draw = c;
+      for (int c = want; draw_level[leaf] < 0 && c < levels; ++c)
+        if (resident(l.levels[static_cast<std::size_t>(c)].file)) draw_level[leaf] = c;
+      if (draw_level[leaf] >= 0) {
+        drawn_total += l.levels[static_cast<std::size_t>(draw_level[leaf])].count;
+        continue;
+      }
+      for (int c = want - 1; c >= 0; --c)
+        if (resident(l.levels[static_cast<std::size_t>(c)].file)) {
+          finer_only.emplace_back(leaf, c);
+          break;
+        }
+    }
+    for (const auto& [leaf, level] : finer_only) {
+      const std::uint64_t count = m_set.leaves[leaf].levels[static_cast<std::size_t>(level)].count;
+      if (drawn_total + count > cut_options.budget && cut_options.budget != 0) continue;
+      draw_level[leaf] = level;
+      drawn_total += count;
+    }
+    for (std::size_t leaf = 0; leaf < cut.level.size(); ++leaf) {
+      const int want = cut.level[leaf], draw = draw_level[leaf];
+      if (want < 0) continue;
+      const LodLeaf& l = m_set.leaves[leaf];
       if (draw != want) {
         const float error = lod_leaf_error_px(m_set, static_cast<int>(leaf), draw < 0 ? levels - 1 : draw, camera);
         wanted.emplace_back(draw < 0 ? std::numeric_limits<float>::max() : error, l.levels[static_cast<std::size_t>(want)].file);

@@ -1,4 +1,5 @@
-// Image files: PNG/EXR/anything through OpenImageIO when built with it; PPM/PFM always.
+// Image files: PNG written through libpng; EXR/anything else, and reading PNG, through
+// OpenImageIO when built with it; PPM/PFM always.
 #pragma once
 
 #include <string>
@@ -16,7 +17,9 @@ Image read_image(const std::string& path);
 // Whether write_image knows the format of `path`'s extension (checked before rendering, so
 // that a typo in the name does not cost a whole render).
 bool image_format_writable(const std::string& path);
-// Whether PNG/EXR are available (built with OpenImageIO).
+// Whether OpenImageIO's formats are available (loads its module: 0.3-0.45 s at the first call).
 bool image_io_has_oiio();
+// Whether write_image writes PNG; without loading OpenImageIO where libpng does it.
+bool image_io_writes_png();
 
 }  // namespace flashgs

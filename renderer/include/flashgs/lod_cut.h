@@ -18,11 +18,22 @@ struct LodCutOptions {
   float hysteresis = 1.5f;
 };
 
+// The memory a cut's chunk files take: a chunk file holds the ranges of many leaves and is
+// loaded whole, so a cut within the Gaussian budget can still need more files than fit. A cut
+// given this uses only files that fit together; each is counted once however many leaves use it.
+struct LodFileBudget {
+  std::vector<std::uint64_t> bytes;  // per file of the set: what it takes in memory
+  std::vector<bool> always_held;     // files held whatever the view: counted before any leaf
+  std::uint64_t limit = 0;           // the most the cut's files may take together; 0 = no limit
+};
+
 struct LodCut {
   std::vector<int> level;       // per leaf: the level to draw, -1 = not drawn (outside the view, or over the budget)
   std::uint64_t gaussians = 0;  // drawn in total
+  std::uint64_t file_bytes = 0; // the files the cut draws from, with those always held (given a file budget)
   float worst_error_px = 0;     // the largest error of a drawn leaf's level
   bool budget_bound = false;    // the budget stopped a refinement the error asked for
+  bool files_bound = false;     // a refinement the error asked for needed a file that does not fit
 };
 
 // A leaf's error at `level` as `camera` sees it: the spacing of its Gaussians there
@@ -32,9 +43,10 @@ float lod_leaf_error_px(const LodSet& set, int leaf, int level, const Camera& ca
 bool lod_leaf_in_view(const LodSet& set, int leaf, const Camera& camera);
 
 // Every leaf in view starts at its coarsest level; the leaf with the largest error is refined
-// one level at a time while its error exceeds the bound and the budget allows. `previous`
-// (may be null) gives the hysteresis its memory.
+// one level at a time while its error exceeds the bound and the budget allows, and (given
+// `files`) while the file its finer level lies in fits. `previous` (may be null) gives the
+// hysteresis its memory.
 LodCut choose_lod_cut(const LodSet& set, const Camera& camera, const LodCutOptions& options,
-                      const LodCut* previous = nullptr);
+                      const LodCut* previous = nullptr, const LodFileBudget* files = nullptr);
 
 }  // namespace flashgs

@@ -109,6 +109,7 @@ class LodStreamer {
   std::uint64_t m_budget = 0, m_chunk_cap = 0;
   std::vector<std::uint64_t> m_file_gaussians;  // the largest range end of each file
   std::vector<bool> m_pinned;                   // the coarsest level's files
+  LodFileBudget m_file_budget;                  // what the cut's files may take: the chunk cap less loads in flight
 
   mutable std::mutex m_mutex;
   std::condition_variable m_wake, m_idle;
