@@ -820,12 +820,31 @@ TEST(CliLodCity, ACityOfASetFliesOnTheCpuAndBadOptionsAreOneLine) {
   ASSERT_EQ(city.exit_code, 0) << city.output;
   EXPECT_NE(city.output.find("city " + dir + "/city: 3 blocks"), std::string::npos) << city.output;
   EXPECT_NE(city.output.find("level 0: 90000 Gaussians"), std::string::npos) << city.output;  // 3 x the demo's 30,000
-  const CliResult fly = run_cli("lod fly " + dir + "/city --backend cpu -r 160x90 --steps 1 --fps 1000 --psnr-every 1");
+  const CliResult fly = run_cli("lod fly " + dir + "/city --backend cpu -r 160x90 --steps 1 --fps 1000 --psnr-every 2 "
+                                "--frames-csv " + dir + "/frames.csv");
   ASSERT_EQ(fly.exit_code, 0) << fly.output;
   EXPECT_NE(fly.output.find("(3 instances), 5 levels, level 0 90000 Gaussians; path of 4 frames"), std::string::npos)
       << fly.output;
   EXPECT_NE(fly.output.find("failed 0"), std::string::npos) << fly.output;
-  EXPECT_NE(fly.output.find("PSNR against the full-detail scene"), std::string::npos) << fly.output;
+  EXPECT_NE(fly.output.find("PSNR against the full-detail scene (2 frames"), std::string::npos) << fly.output;
+  // One row per frame; the compared frames (every second) have both PSNRs, the settled cut's
+  // no worse than the frame as shown.
+  const auto rows = read_csv(dir + "/frames.csv");
+  ASSERT_EQ(rows.size(), 5u) << fly.output;
+  EXPECT_EQ(rows[0][6], "psnr_shown_db");
+  for (std::size_t frame = 0; frame < 4; ++frame) {
+    const auto& row = rows[frame + 1];
+    ASSERT_GE(row.size(), 6u) << "frame " << frame;
+    EXPECT_EQ(row[0], std::to_string(frame));
+    EXPECT_GT(std::stod(row[2]), 0.0) << "frame " << frame << " drew nothing";
+    if (frame % 2 != 0) {  // empty PSNR cells (the reader drops a row's empty last cells)
+      EXPECT_TRUE(row.size() < 7 || row[6].empty()) << "frame " << frame;
+      continue;
+    }
+    ASSERT_EQ(row.size(), 8u) << "frame " << frame;
+    EXPECT_GE(std::stod(row[7]), std::stod(row[6]) - 1e-3) << "frame " << frame;
+    EXPECT_GT(std::stod(row[7]), 30.0) << "frame " << frame;
+  }
 
   const std::string base = " " + dir + "/base " + dir + "/refused";
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -841,6 +860,7 @@ TEST(CliLodCity, ACityOfASetFliesOnTheCpuAndBadOptionsAreOneLine) {
       {"lod city " + dir + "/city " + dir + "/refused --blocks 2", "already an instanced set"},
       {"lod city " + dir + "/nothing " + dir + "/refused --blocks 2", dir + "/nothing"},
       {"lod city " + dir + "/base " + dir + "/city --blocks 2", "is not empty"},
+      {"lod fly " + dir + "/city --backend cpu --frames-csv " + dir + "/missing/frames.csv", "--frames-csv"},
   };
   for (const auto& [arguments, fragment] : cases) expect_one_line_error(run_cli(arguments), fragment, arguments);
   EXPECT_FALSE(fs::exists(dir + "/refused"));

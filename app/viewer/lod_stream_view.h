@@ -19,7 +19,7 @@ namespace flashgs::viewer {
 
 struct StreamSettings {
   std::uint64_t budget = 0;   // Gaussians drawn at most, 0: the caps' only
-  float max_error_px = 1.0f;  // refine while a leaf's error is larger
+  float max_error_px = kDefaultLodMaxErrorPx;  // refine while a leaf's error is larger
   std::uint64_t host_bytes = 0, device_bytes = 0;  // 0: no cap
   LodFrameCost host_frame, device_frame;           // what the renderer needs beside the scene
   bool parts_on_device = false;                    // the renderer keeps the parts on the GPU (LodStreamOptions)

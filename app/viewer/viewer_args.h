@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "flashgs/lod_build.h"
+#include "flashgs/lod_cut.h"
 #include "flashgs/options.h"
 #include "compare_mode.h"
 #include "kernel_option.h"
@@ -21,7 +22,7 @@ struct ViewerArgs {
   int tile = 1;               // copies of the scene on a grid (large-scene benchmarks)
   bool stream = false;        // stream a LOD set by view instead of loading one level whole
   std::uint64_t stream_budget = 0;     // --budget: Gaussians drawn at most (0: the caps' only)
-  float stream_max_error_px = 1.0f;    // --max-error-px
+  float stream_max_error_px = kDefaultLodMaxErrorPx;  // --max-error-px
   bool lod_overlay = false;            // --lod-overlay: start with the level colours on
   // --stream of a scene file: its cached set's leaf cells and chunk files, in Gaussians.
   std::uint64_t lod_leaf_size = LodBuildOptions{}.leaf_gaussians;

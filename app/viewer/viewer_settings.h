@@ -6,6 +6,7 @@
 #include <string>
 
 #include "flashgs/debug_view.h"
+#include "flashgs/lod_cut.h"
 #include "flashgs/options.h"
 
 namespace flashgs::viewer {
@@ -49,7 +50,7 @@ struct ViewerSettings {
   RenderOptions options;            // algorithm, every optimisation, tau, background, SH cap
   NavigationMode mode = NavigationMode::fly;
   float fov_x_degrees = 60.0f;      // horizontal field of view of the viewer camera
-  float stream_max_error_px = 1.0f;      // a streamed LOD set: refine while a cell's error is larger
+  float stream_max_error_px = kDefaultLodMaxErrorPx;  // a streamed LOD set: refine while a cell's error is larger
   float stream_budget_millions = 0.0f;   // a streamed LOD set: Gaussians drawn at most (0: the caps')
   bool lod_overlay = false;              // a streamed LOD set: each Gaussian in its level's colour
   float render_scale = 1.0f;        // render resolution = framebuffer size * scale
