@@ -12,9 +12,8 @@ int main(int argc, char** argv) {
   flashgs::viewer::ViewerArgs args;
   const int parsed = flashgs::viewer::parse_viewer_args(argc, argv, &args);
   if (parsed >= 0) return parsed;
-  // OpenImageIO's module is not loaded here: PNG screenshots and exports go through libpng.
-  // It loads at the first EXR (or other such format) a user names; loaded at a screenshot
-  // while the window was open, its ~260 libraries once left the window deaf to the next clicks.
+  // OpenImageIO's module is not loaded here: PNG screenshots and exports go through libpng, and
+  // the module loads only for a scripted --screenshot in another format.
   int code = 3;
   try {
     flashgs::viewer::ViewerApp app(args);
