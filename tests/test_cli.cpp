@@ -816,6 +816,8 @@ TEST(CliLodCity, ACityOfASetFliesOnTheCpuAndBadOptionsAreOneLine) {
   const std::string dir = scratch_dir("lod_city");
   const CliResult build = run_cli("lod build " + demo_scene_path() + " " + dir + "/base --leaf-size 4096 --file-size 16384");
   ASSERT_EQ(build.exit_code, 0) << build.output;
+  const CliResult info = run_cli("info " + dir + "/base --lod 1");  // PLY chunks, named as such
+  EXPECT_NE(info.output.find("LOD set (lod-meta.json) of INRIA PLY chunks, level 1"), std::string::npos) << info.output;
   const CliResult city = run_cli("lod city " + dir + "/base " + dir + "/city --blocks 3 --up +y --cameras 4");
   ASSERT_EQ(city.exit_code, 0) << city.output;
   EXPECT_NE(city.output.find("city " + dir + "/city: 3 blocks"), std::string::npos) << city.output;

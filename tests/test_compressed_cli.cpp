@@ -99,6 +99,7 @@ TEST(CompressedCli, InfoListsTheLodLevelsAndRenderTakesLod) {
   EXPECT_EQ(info.exit_code, 0) << info.output;
   EXPECT_NE(info.output.find("7 levels"), std::string::npos) << info.output;
   EXPECT_NE(info.output.find("level 6: 1873 Gaussians"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("LOD set (lod-meta.json) of SOG (PlayCanvas) chunks, level 6"), std::string::npos) << info.output;
   const std::string out = output_dir() + "/playbot_lod.ppm";
   fs::remove(out);
   const CliRun render = flashgs("render " + formats() + "/playbot_sog --lod 5 --cameras " + scenes() +

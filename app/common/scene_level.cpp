@@ -27,8 +27,8 @@ Scene load_sog_lod_level(const std::string& path, int lod, LoadReport* report) {
   const auto began = std::chrono::steady_clock::now();
   Scene scene = read_sog_lod(path, level, report);
   report->decode_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-  report->format = std::string(format_name(SceneFormat::sog)) + ", LOD level " + std::to_string(level);
-  report->quantisation = format_quantisation(SceneFormat::sog);
+  report->format = "LOD set (lod-meta.json) of " + (report->format.empty() ? std::string("unread") : report->format) +
+                   " chunks, level " + std::to_string(level);
   return scene;
 }
 

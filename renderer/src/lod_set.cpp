@@ -215,7 +215,13 @@ std::string gaussian_span(std::uint64_t begin, std::uint64_t end) {
 }
 
 Scene read_chunk_internal(const std::string& path, LoadReport* report, LoadProgress* progress) {
-  return is_sog_chunk(path) ? read_sog_chunk(path, report, progress) : load_scene_file(path, report, progress);
+  if (!is_sog_chunk(path)) return load_scene_file(path, report, progress);
+  Scene scene = read_sog_chunk(path, report, progress);
+  if (report) {  // a SOG chunk's reader leaves the format to the file-type dispatch, which it skipped
+    report->format = format_name(SceneFormat::sog);
+    report->quantisation = format_quantisation(SceneFormat::sog);
+  }
+  return scene;
 }
 
 // The double whose shortest decimal is the float's (at most 9 digits, where the float widened

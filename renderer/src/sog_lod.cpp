@@ -122,6 +122,8 @@ Scene read_sog_lod(const std::string& path, int level, LoadReport* report, LoadP
       if (first) {
         scene.sh_degree = chunk.sh_degree;
         scene.trained_kernel = chunk.trained_kernel;
+        total.format = chunk_report.format;  // the chunks' own format: SOG from PlayCanvas, PLY from lod build
+        total.quantisation = chunk_report.quantisation;
         first = false;
       }
       total.sh_degree_in_file = std::max(total.sh_degree_in_file, chunk_report.sh_degree_in_file);
