@@ -294,7 +294,7 @@ LeafLevels leaf_levels(Scene level0, int levels) {
   out.levels.push_back(std::move(level0));
   for (int l = 1; l < levels; ++l) {
     const Scene& finer = out.levels.back();
-    out.levels.push_back(finer.size() > 1 ? coarser_level(finer, out.bound) : finer);
+    out.levels.push_back(finer.size() > 1 ? coarser_level(finer) : finer);
   }
   return out;
 }

@@ -56,18 +56,29 @@ void symmetric_eigen(Mat3 a, std::array<double, 3>& values, Mat3& v) {
 
 double section_area(double s0, double s1, double s2) { return s0 * s1 + s1 * s2 + s2 * s0; }
 
-// 10 bits per axis of a point's place inside `bound`, interleaved.
-std::uint32_t morton_code(const float* p, const LodBox& bound) {
-  std::uint32_t code = 0;
-  std::uint32_t cell[3];
-  for (int k = 0; k < 3; ++k) {
-    const float extent = bound.max[k] - bound.min[k];
-    const float t = extent > 0 ? (p[k] - bound.min[k]) / extent : 0.0f;
-    cell[k] = static_cast<std::uint32_t>(std::clamp(t, 0.0f, 1.0f) * 1023.0f);
-  }
-  for (int bit = 9; bit >= 0; --bit)
-    for (int k = 0; k < 3; ++k) code = (code << 1) | ((cell[k] >> bit) & 1u);
-  return code;
+// Orders `ids` so that each pair at an even index holds near neighbours: the group is split at
+// an even count along its box's longest axis (ties by index, so the order is the same
+// everywhere), and each half again, down to pairs. A Morton curve's neighbours, paired before,
+// can lie on either side of one of its jumps.
+void order_in_pairs(const Scene& scene, std::uint32_t* ids, std::size_t n) {
+  if (n <= 2) return;
+  float lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = scene.positions[ids[0] * 3 + k];
+  for (std::size_t i = 1; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], scene.positions[ids[i] * 3 + k]);
+      hi[k] = std::max(hi[k], scene.positions[ids[i] * 3 + k]);
+    }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  const std::size_t half = (n / 2 + 1) & ~std::size_t{1};  // even (pairs never straddle the split), 2..n-1
+  std::nth_element(ids, ids + half, ids + n, [&](std::uint32_t a, std::uint32_t b) {
+    const float pa = scene.positions[a * 3 + axis], pb = scene.positions[b * 3 + axis];
+    return pa != pb ? pa < pb : a < b;
+  });
+  order_in_pairs(scene, ids, half);
+  order_in_pairs(scene, ids + half, n - half);
 }
 
 }  // namespace
@@ -138,13 +149,11 @@ void append_merged(const Scene& scene, const std::uint32_t* indices, std::size_t
   for (int k = 0; k < rest_n; ++k) out.sh_rest.push_back(static_cast<float>(colour[3 + k] / total));
 }
 
-Scene coarser_level(const Scene& level, const LodBox& bound) {
+Scene coarser_level(const Scene& level) {
   const std::size_t n = level.size();
   std::vector<std::uint32_t> order(n);
   std::iota(order.begin(), order.end(), 0u);
-  std::vector<std::uint32_t> codes(n);
-  for (std::size_t i = 0; i < n; ++i) codes[i] = morton_code(&level.positions[i * 3], bound);
-  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return codes[a] < codes[b]; });
+  order_in_pairs(level, order.data(), n);
   Scene out;
   out.sh_degree = level.sh_degree;
   out.trained_kernel = level.trained_kernel;

@@ -19,8 +19,8 @@ double merge_weight(const Scene& scene, std::size_t i);
 // the opacity mass (opacity x area) is kept unless the clamp applies.
 void append_merged(const Scene& scene, const std::uint32_t* indices, std::size_t count, Scene& out);
 
-// The next coarser level of one leaf's Gaussians: about half as many, each a merge of
-// neighbours in Morton order inside `bound` (pairs; a lone last one is kept as it is).
-Scene coarser_level(const Scene& level, const LodBox& bound);
+// The next coarser level of one leaf's Gaussians: about half as many, each a merge of a pair
+// of near neighbours (split by split along the longest axis; a lone last one is kept as it is).
+Scene coarser_level(const Scene& level);
 
 }  // namespace flashgs
