@@ -753,6 +753,37 @@ TEST(LodFeed, HandsTheCutOverAsPartsWhenItChanges) {
 
 // The host's count holds the scene a host renderer assembles from the parts, and none where the
 // renderer keeps them on the GPU. No cap: the same chunks in memory, whatever the loads' timing.
+// The level overlay's tinted copies of the drawn parts count against the host cap: with the
+// overlay on, the budget makes room for a third copy of the drawn scene (the one drawn, the
+// next, the tinted one), the high-water mark stays inside the cap, and it is given back when
+// the overlay goes off.
+TEST(LodFeed, TheOverlaysCopiesCountAgainstTheHostCap) {
+  LodStreamOptions options;
+  options.cut.max_error_px = 0.0f;
+  options.host_bytes = 4u << 20;
+  const std::uint64_t scene_bytes = 4 * (14 + 9);  // per Gaussian: the demo scene is SH degree 1
+  const std::uint64_t plain_budget = (options.host_bytes / 2) / (2 * scene_bytes);
+  const std::uint64_t overlay_budget = (options.host_bytes / 2) / (3 * scene_bytes);
+  const Camera camera = test::load_demo_cameras()[5].resized(160, 90);
+  auto renderer = make_cpu_renderer(2);
+  LodStreamer streamer(read_lod_set(demo_set()), options);
+  LodCutFeed feed(streamer);
+  feed.set_level_overlay(true);
+  for (int frame = 0; frame < 4; ++frame) {
+    feed.update(camera, *renderer);
+    streamer.wait_until_idle();
+  }
+  LodStreamStats s = streamer.stats();
+  EXPECT_EQ(s.budget, overlay_budget);
+  EXPECT_GT(s.drawn_gaussians, 0u);
+  EXPECT_LE(s.drawn_gaussians, s.budget);
+  EXPECT_LE(s.host_high_water, options.host_bytes);
+  EXPECT_GE(s.host_bytes, s.drawn_gaussians * 2 * scene_bytes) << "the copies are not counted";
+  feed.set_level_overlay(false);
+  feed.update(camera, *renderer);
+  EXPECT_EQ(streamer.stats().budget, plain_budget);
+}
+
 TEST(LodStream, TheHostCapCountsTheScenePartsAreAssembledInto) {
   const std::uint64_t scene_bytes = 4 * (14 + 9);  // the demo scene is SH degree 1
   const Camera camera = test::load_demo_cameras()[5].resized(160, 90);

@@ -18,6 +18,7 @@ void LodCutFeed::set_level_overlay(bool on) {
   m_overlay = on;
   m_stale = true;
   if (!on) m_tinted.clear();
+  m_streamer.set_drawn_copies(on ? 1 : 0);  // the tinted copies count against the host cap
 }
 
 bool LodCutFeed::update(const Camera& camera, const HandOver& hand_over) {

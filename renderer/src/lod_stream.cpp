@@ -76,10 +76,23 @@ LodStreamer::LodStreamer(LodSet set, LodStreamOptions options) : m_set(std::move
     }
   }
   if (m_bytes_per_gaussian == 0) throw Error(m_set.meta_path + ": none of the set's chunk files can be read");
-  // Two drawn scenes (the one drawn and the next) and the frame's working memory take at most
-  // half of the host cap; the chunks the rest. On the GPU, the drawn scene and the frame.
+  if (options.host_bytes) {
+    m_file_budget.always_held = m_pinned;
+    for (int f = 0; f < files; ++f)
+      m_file_budget.bytes.push_back(m_file_gaussians[static_cast<std::size_t>(f)] * m_bytes_per_gaussian);
+  }
+  apply_caps();
+  for (int t = 0; t < std::max(1, options.threads); ++t) m_threads.emplace_back([this] { load_loop(); });
+}
+
+void LodStreamer::apply_caps() {
+  const LodStreamOptions& options = m_options;
+  // Two drawn scenes (the one drawn and the next), their copies (the level overlay's) and the
+  // frame's working memory take at most half of the host cap; the chunks the rest. On the GPU,
+  // the drawn scene and the frame.
   m_budget = options.cut.budget ? options.cut.budget : std::numeric_limits<std::uint64_t>::max();
-  const std::uint64_t drawn_per_gaussian = 2 * m_bytes_per_gaussian + options.host_frame.per_gaussian;
+  const std::uint64_t drawn_per_gaussian =
+      (2 + static_cast<std::uint64_t>(m_drawn_copies)) * m_bytes_per_gaussian + options.host_frame.per_gaussian;
   if (options.host_bytes) {
     const std::uint64_t half = options.host_bytes / 2;
     m_budget = std::min(m_budget, half > options.host_frame.fixed ? (half - options.host_frame.fixed) / drawn_per_gaussian : 0);
@@ -102,11 +115,15 @@ LodStreamer::LodStreamer(LodSet set, LodStreamOptions options) : m_set(std::move
     std::uint64_t largest_file = 0;
     for (const Chunk& c : m_chunks) largest_file = std::max(largest_file, c.file_bytes);
     m_file_budget.limit = m_chunk_cap > largest_file ? m_chunk_cap - largest_file : 1;
-    m_file_budget.always_held = m_pinned;
-    for (int f = 0; f < files; ++f)
-      m_file_budget.bytes.push_back(m_file_gaussians[static_cast<std::size_t>(f)] * m_bytes_per_gaussian);
   }
-  for (int t = 0; t < std::max(1, options.threads); ++t) m_threads.emplace_back([this] { load_loop(); });
+}
+
+void LodStreamer::set_drawn_copies(int copies) {
+  std::unique_lock<std::mutex> lock(m_mutex);
+  if (copies == m_drawn_copies) return;
+  m_drawn_copies = std::max(0, copies);
+  apply_caps();
+  make_room(0, lock);  // chunks beyond the smaller share that no frame draws now go at once
 }
 
 LodStreamer::~LodStreamer() {
@@ -327,7 +344,9 @@ std::shared_ptr<const Scene> LodStreamer::update(const Camera& camera) {
     m_drawn = std::move(drawn.ranges);
     std::lock_guard<std::mutex> lock(m_mutex);
     // The scene drawn now and the frame that renders it.
-    m_drawn_bytes = m_scene->size() * (m_bytes_per_gaussian + m_options.host_frame.per_gaussian) + m_options.host_frame.fixed;
+    m_drawn_bytes = m_scene->size() * ((1 + static_cast<std::uint64_t>(m_drawn_copies)) * m_bytes_per_gaussian +
+                                       m_options.host_frame.per_gaussian) +
+                    m_options.host_frame.fixed;
     m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
   }
   m_stats.drawn_gaussians = m_scene->size();
@@ -345,8 +364,9 @@ const std::vector<ScenePart>& LodStreamer::update_parts(const Camera& camera, bo
     // The scene a host renderer assembles, made beside the one it draws now; none on the GPU's.
     const std::uint64_t scene_bytes = m_options.parts_on_device ? 0 : total * m_bytes_per_gaussian;
     std::lock_guard<std::mutex> lock(m_mutex);
-    m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes + scene_bytes);
-    m_drawn_bytes = scene_bytes + total * m_options.host_frame.per_gaussian + m_options.host_frame.fixed;
+    const std::uint64_t copies = static_cast<std::uint64_t>(m_drawn_copies) * total * m_bytes_per_gaussian;
+    m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes + scene_bytes + copies);
+    m_drawn_bytes = scene_bytes + copies + total * m_options.host_frame.per_gaussian + m_options.host_frame.fixed;
     m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
   }
   m_stats.drawn_gaussians = scene_parts_size(m_parts);

@@ -83,6 +83,10 @@ class LodStreamer {
   // One line per chunk that could not be read since the last call (the rest keeps rendering).
   std::vector<std::string> take_errors();
   const LodSet& set() const { return m_set; }
+  // Copies of the drawn scene held on the host beside it (the level overlay's tinted parts,
+  // LodCutFeed): the host cap makes room for them with a smaller budget, from the next cut on.
+  // Called from the thread that calls update().
+  void set_drawn_copies(int copies);
   // The ranges of the scene update() or the parts update_parts() last returned, in their order
   // (the level overlay's input).
   const std::vector<LodRange>& drawn_ranges() const { return m_drawn; }
@@ -100,6 +104,9 @@ class LodStreamer {
   static std::vector<ScenePart> as_parts(const Drawn& drawn);
   void load_loop();
   std::uint64_t chunk_estimate(int file) const;
+  // The budget and the chunks' share of the caps, for m_drawn_copies (under the lock, or before
+  // the loaders start).
+  void apply_caps();
   bool make_room(std::uint64_t bytes, std::unique_lock<std::mutex>& lock);
   void request(const std::vector<int>& files);
 
@@ -107,6 +114,7 @@ class LodStreamer {
   LodStreamOptions m_options;
   std::uint64_t m_bytes_per_gaussian = 0;
   std::uint64_t m_budget = 0, m_chunk_cap = 0;
+  int m_drawn_copies = 0;
   std::vector<std::uint64_t> m_file_gaussians;  // the largest range end of each file
   std::vector<bool> m_pinned;                   // the coarsest level's files
   LodFileBudget m_file_budget;                  // what the cut's files may take: the chunk cap less loads in flight
