@@ -1192,15 +1192,20 @@ TEST(ViewerStream, TheCutGoesAsPartsOrAssembledWhereThePathCannotDrawParts) {
   EXPECT_EQ(drawn, stream.stats().drawn_gaussians);
   EXPECT_FALSE(stream.update(camera, flash, false, 0.0, path).handed) << "the same cut was handed over again";
 
+  // The host cap counts the assembled cut (the demo scene: 92 bytes a Gaussian) while the
+  // path takes it so, and not once parts go to the GPU again.
+  const std::uint64_t host_with_parts = stream.stats().host_bytes;
   u = stream.update(camera, baseline, false, 0.0, path);
   EXPECT_TRUE(u.handed && u.assembled_changed);
   EXPECT_EQ(stream.assembled_because(), "not by the baseline");
   EXPECT_EQ(path.scenes, 1);
   EXPECT_EQ(path.scene_size, drawn);
+  EXPECT_EQ(stream.stats().host_bytes, host_with_parts + drawn * 92);
   EXPECT_FALSE(stream.update(camera, baseline, false, 0.0, path).handed);
   u = stream.update(camera, flash, false, 0.0, path);
   EXPECT_TRUE(u.handed && u.assembled_changed);
   EXPECT_EQ(path.part_sets, 2);
+  EXPECT_EQ(stream.stats().host_bytes, host_with_parts);
 
   // A comparison of the baseline with flash: the cut assembled for it, parts at the next frame.
   EXPECT_EQ(stream.assemble_for({baseline, flash}, path), "not by the baseline");

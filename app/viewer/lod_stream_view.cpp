@@ -52,6 +52,7 @@ StreamUpdate LodStreamView::update(const Camera& camera, const RenderOptions& op
     out.assembled_changed = true;
   }
   m_assembled_because = refusal;
+  m_streamer->set_parts_on_device(m_settings.parts_on_device && refusal.empty());  // an assembled cut is the host's
   if (settle) {
     m_streamer->update_parts(camera, nullptr);
     m_streamer->wait_until_idle();
@@ -91,6 +92,7 @@ std::string LodStreamView::assemble_for(const std::vector<RenderOptions>& option
   for (const RenderOptions& o : options)
     if (refusal.empty()) refusal = path.scene_parts_refusal(o);
   if (refusal.empty()) return "";
+  m_streamer->set_parts_on_device(false);  // until the next update hands parts over again
   path.set_scene(assemble_scene_parts(m_feed->handed_parts()));
   m_feed->hand_over_again();
   return refusal;

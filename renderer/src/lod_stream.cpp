@@ -360,18 +360,36 @@ const std::vector<ScenePart>& LodStreamer::update_parts(const Camera& camera, bo
     m_parts = as_parts(drawn);
     m_drawn = std::move(drawn.ranges);
     m_scene.reset();  // the renderer holds the parts
-    const std::uint64_t total = scene_parts_size(m_parts);
-    // The scene a host renderer assembles, made beside the one it draws now; none on the GPU's.
-    const std::uint64_t scene_bytes = m_options.parts_on_device ? 0 : total * m_bytes_per_gaussian;
     std::lock_guard<std::mutex> lock(m_mutex);
-    const std::uint64_t copies = static_cast<std::uint64_t>(m_drawn_copies) * total * m_bytes_per_gaussian;
-    m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes + scene_bytes + copies);
-    m_drawn_bytes = scene_bytes + copies + total * m_options.host_frame.per_gaussian + m_options.host_frame.fixed;
+    // The next scene is made beside the one drawn now.
+    m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes + parts_scene_bytes());
+    m_drawn_bytes = parts_drawn_bytes();
     m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
   }
   m_stats.drawn_gaussians = scene_parts_size(m_parts);
   if (changed) *changed = differ;
   return m_parts;
+}
+
+std::uint64_t LodStreamer::parts_scene_bytes() const {
+  // The scene a host renderer assembles from the parts (none where the GPU keeps them), and the
+  // overlay's copies.
+  const std::uint64_t total = scene_parts_size(m_parts);
+  const std::uint64_t scenes = (m_options.parts_on_device ? 0 : 1) + static_cast<std::uint64_t>(m_drawn_copies);
+  return scenes * total * m_bytes_per_gaussian;
+}
+
+std::uint64_t LodStreamer::parts_drawn_bytes() const {
+  return parts_scene_bytes() + scene_parts_size(m_parts) * m_options.host_frame.per_gaussian + m_options.host_frame.fixed;
+}
+
+void LodStreamer::set_parts_on_device(bool on) {
+  std::lock_guard<std::mutex> lock(m_mutex);
+  if (on == m_options.parts_on_device) return;
+  m_options.parts_on_device = on;
+  if (m_parts.empty()) return;
+  m_drawn_bytes = parts_drawn_bytes();
+  m_high_water = std::max(m_high_water, m_chunk_bytes + m_reserved + m_drawn_bytes);
 }
 
 std::vector<ScenePart> LodStreamer::as_parts(const Drawn& drawn) {

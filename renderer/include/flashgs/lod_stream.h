@@ -87,6 +87,10 @@ class LodStreamer {
   // LodCutFeed): the host cap makes room for them with a smaller budget, from the next cut on.
   // Called from the thread that calls update().
   void set_drawn_copies(int copies);
+  // Whether update_parts' renderer keeps the parts on the GPU now (LodStreamOptions::
+  // parts_on_device): a GPU path takes the cut assembled for a configuration its pool cannot
+  // draw, and the host cap then counts that scene. From the thread that calls update_parts().
+  void set_parts_on_device(bool on);
   // The ranges of the scene update() or the parts update_parts() last returned, in their order
   // (the level overlay's input).
   const std::vector<LodRange>& drawn_ranges() const { return m_drawn; }
@@ -107,6 +111,10 @@ class LodStreamer {
   // The budget and the chunks' share of the caps, for m_drawn_copies (under the lock, or before
   // the loaders start).
   void apply_caps();
+  // What update_parts' cut holds on the host: its assembled scene and copies (under the lock),
+  // and with the frame's working memory.
+  std::uint64_t parts_scene_bytes() const;
+  std::uint64_t parts_drawn_bytes() const;
   bool make_room(std::uint64_t bytes, std::unique_lock<std::mutex>& lock);
   void request(const std::vector<int>& files);
 
