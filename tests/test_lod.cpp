@@ -397,6 +397,33 @@ TEST(LodStream, TheCutAsPartsHoldsTheAssembledScene) {
   }
 }
 
+// Assembling into a scene that held another cut (the CPU renderer reuses the cut before last):
+// its old Gaussians, degree and kernel are gone, and the result is the fresh assembly's.
+TEST(ScenePartsAssembly, IntoAUsedSceneEqualsAFreshAssembly) {
+  const std::shared_ptr<const Scene> demo = test::load_demo_scene();
+  const std::vector<ScenePart> parts = {{1, demo, 100, 50}, {2, demo, 7, 3}, {3, demo, 20000, 1000}};
+  Scene used = two_gaussians(0.5f, 1.0f);
+  used.append(used);
+  for (int round = 0; round < 3; ++round) used.append(used);
+  used.trained_kernel.kernel = SplatKernel::antialiased();
+  const std::size_t capacity_before = used.positions.capacity();
+  assemble_scene_parts_into(parts, used);
+  const std::shared_ptr<Scene> fresh = assemble_scene_parts(parts);
+  EXPECT_EQ(used.size(), 1053u);
+  EXPECT_EQ(used.sh_degree, fresh->sh_degree);
+  EXPECT_EQ(used.positions, fresh->positions);
+  EXPECT_EQ(used.scales, fresh->scales);
+  EXPECT_EQ(used.rotations, fresh->rotations);
+  EXPECT_EQ(used.opacities, fresh->opacities);
+  EXPECT_EQ(used.sh_dc, fresh->sh_dc);
+  EXPECT_EQ(used.sh_rest, fresh->sh_rest);
+  EXPECT_TRUE(used.trained_kernel.kernel == fresh->trained_kernel.kernel);
+  EXPECT_GE(used.positions.capacity(), capacity_before) << "the arrays were not reused";
+  assemble_scene_parts_into({}, used);
+  EXPECT_EQ(used.size(), 0u);
+  EXPECT_TRUE(used.sh_rest.empty());
+}
+
 TEST(LodStream, UnderATinyCapEveryFrameStillRendersAndTheCapHolds) {
   const LodSet set = read_lod_set(demo_set());
   LodStreamOptions options;

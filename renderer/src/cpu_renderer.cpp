@@ -40,10 +40,20 @@ class CpuRenderer final : public Renderer {
     return "cpu (" + std::to_string(frame_.threads) + " threads, " + kernel_name_ + " blend)";
   }
   void set_scene(std::shared_ptr<const Scene> scene) override {
-    scene_ = std::move(scene);
-    frame_.half_sh_of = nullptr;  // another scene may live at the old one's address
-    frame_.half_shape_of = nullptr;
-    frame_.opacity_terms_of = nullptr;
+    assembled_.reset();
+    spare_.reset();
+    install(std::move(scene));
+  }
+  // A streamed cut changes nearly every frame of a flight: it is assembled into the arrays of
+  // the cut before last when nothing else holds that one, so no new pages are zeroed for it.
+  // The streamer's host cap counts two drawn scenes (the one drawn and the next).
+  void set_scene_parts(const std::vector<ScenePart>& parts, std::uint64_t) override {
+    std::shared_ptr<Scene> target = spare_ && spare_.use_count() == 1 ? std::move(spare_) : std::make_shared<Scene>();
+    spare_.reset();
+    assemble_scene_parts_into(parts, *target);
+    spare_ = std::move(assembled_);
+    assembled_ = target;
+    install(std::move(target));
   }
 
   void render(const Camera& camera, const RenderOptions& options, Image& out, FrameStats* stats_out) override {
@@ -129,8 +139,15 @@ class CpuRenderer final : public Renderer {
     if (stats_out) *stats_out = std::move(stats);
   }
 
- private:
+  void install(std::shared_ptr<const Scene> scene) {
+    scene_ = std::move(scene);
+    frame_.half_sh_of = nullptr;  // another scene may live at the old one's address
+    frame_.half_shape_of = nullptr;
+    frame_.opacity_terms_of = nullptr;
+  }
+
   std::shared_ptr<const Scene> scene_;
+  std::shared_ptr<Scene> assembled_, spare_;  // set_scene_parts' scene drawn now, and the one before
   const cpu::BlendKernel kernel_;
   const std::string kernel_name_;  // the SIMD target, or "scalar"
   cpu::Frame frame_;

@@ -26,6 +26,9 @@ struct ScenePart {
 // The parts' Gaussians one after another in one scene (their SH degree and kernel are the
 // first part's; every part must share the degree).
 std::shared_ptr<Scene> assemble_scene_parts(const std::vector<ScenePart>& parts);
+// The same into `scene`, whose arrays are emptied first and keep their capacity: a renderer
+// that assembles a new cut every frame reuses the memory of one it no longer draws.
+void assemble_scene_parts_into(const std::vector<ScenePart>& parts, Scene& scene);
 
 // The Gaussians of all parts together.
 std::uint64_t scene_parts_size(const std::vector<ScenePart>& parts);
