@@ -78,18 +78,10 @@ class KdTree {
     const int index = static_cast<int>(m_nodes.size());
     m_nodes.emplace_back();
     m_nodes[index].samples = b - a;
-    float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
-    float hi[3] = {std::numeric_limits<float>::lowest(), std::numeric_limits<float>::lowest(), std::numeric_limits<float>::lowest()};
-    for (std::size_t i = a; i < b; ++i)
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], m_centres[order[i] * 3 + k]);
-        hi[k] = std::max(hi[k], m_centres[order[i] * 3 + k]);
-      }
-    int axis = 0;  // the cell's longest side
-    for (int k = 1; k < 3; ++k)
-      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    float length = 0;
+    const int axis = longest_axis(m_centres, order.data() + a, b - a, &length);  // the cell's longest side
     const bool small = static_cast<double>(b - a) * m_per_sample <= static_cast<double>(m_leaf_gaussians);
-    if (small || b - a < 2 || depth >= kMaxDepth || !(hi[axis] > lo[axis])) {
+    if (small || b - a < 2 || depth >= kMaxDepth || !(length > 0)) {
       m_nodes[index].leaf = m_leaves++;
       return index;
     }

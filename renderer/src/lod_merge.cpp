@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "flashgs/rotation.h"
@@ -62,16 +63,7 @@ double section_area(double s0, double s1, double s2) { return s0 * s1 + s1 * s2 
 // can lie on either side of one of its jumps.
 void order_in_pairs(const Scene& scene, std::uint32_t* ids, std::size_t n) {
   if (n <= 2) return;
-  float lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = scene.positions[ids[0] * 3 + k];
-  for (std::size_t i = 1; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], scene.positions[ids[i] * 3 + k]);
-      hi[k] = std::max(hi[k], scene.positions[ids[i] * 3 + k]);
-    }
-  int axis = 0;
-  for (int k = 1; k < 3; ++k)
-    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  const int axis = longest_axis(scene.positions, ids, n, nullptr);
   const std::size_t half = (n / 2 + 1) & ~std::size_t{1};  // even (pairs never straddle the split), 2..n-1
   std::nth_element(ids, ids + half, ids + n, [&](std::uint32_t a, std::uint32_t b) {
     const float pa = scene.positions[a * 3 + axis], pb = scene.positions[b * 3 + axis];
@@ -82,6 +74,21 @@ void order_in_pairs(const Scene& scene, std::uint32_t* ids, std::size_t n) {
 }
 
 }  // namespace
+
+int longest_axis(const std::vector<float>& xyz, const std::uint32_t* ids, std::size_t n, float* length) {
+  float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
+  float hi[3] = {std::numeric_limits<float>::lowest(), std::numeric_limits<float>::lowest(), std::numeric_limits<float>::lowest()};
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], xyz[ids[i] * 3 + k]);
+      hi[k] = std::max(hi[k], xyz[ids[i] * 3 + k]);
+    }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  if (length) *length = hi[axis] - lo[axis];
+  return axis;
+}
 
 double merge_weight(const Scene& scene, std::size_t i) {
   const float* s = &scene.scales[i * 3];

@@ -9,6 +9,10 @@
 
 namespace flashgs {
 
+// The longest side of the box around the points xyz[3 i .. 3 i + 2] for i in ids[0 .. n), and its
+// length: where the builder's k-d tree and a level's pairing split a group.
+int longest_axis(const std::vector<float>& xyz, const std::uint32_t* ids, std::size_t n, float* length);
+
 // A Gaussian's weight in a merge: opacity times the area of its ellipsoid's principal sections
 // (s0 s1 + s1 s2 + s2 s0, up to pi), so that what covers more of the image counts more.
 double merge_weight(const Scene& scene, std::size_t i);
